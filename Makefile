@@ -1,0 +1,44 @@
+# The two commands a newcomer needs: `make demo` and `make test`.
+# Both create .venv on first use and install the package with its dependencies from PyPI.
+# Nothing is cached outside this folder: pip, matplotlib and ROS logs live under .cache/.
+
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed-stamp
+
+export PIP_CACHE_DIR := $(CURDIR)/.cache/pip
+export MPLCONFIGDIR := $(CURDIR)/.cache/matplotlib
+export MPLBACKEND := Agg
+export ROS_LOG_DIR := $(CURDIR)/.cache/ros/log
+export ROS_HOME := $(CURDIR)/.cache/ros
+export ROS_AUTOMATIC_DISCOVERY_RANGE ?= LOCALHOST
+export PYTHONDONTWRITEBYTECODE :=
+
+.PHONY: venv demo test lint bench clean
+
+$(STAMP): setup.py setup.cfg package.xml requirements.txt
+	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install -q --upgrade pip
+	$(BIN)/python -m pip install -q -r requirements.txt
+	$(BIN)/python -m pip install -q --no-deps -e .
+	@touch $@
+
+venv: $(STAMP)
+
+demo: venv
+	$(BIN)/lumpbeam demo --out results
+
+test: venv
+	$(BIN)/ruff check .
+	$(BIN)/python -m pytest
+
+lint: venv
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+
+bench: venv
+	$(BIN)/lumpbeam bench --json results/bench.json
+
+clean:
+	rm -rf $(VENV) .cache results build install log *.egg-info

@@ -1,0 +1,1 @@
+"""rosbag2/MCAP reading and writing, and message <-> numpy conversion."""

@@ -1,0 +1,55 @@
+"""The result record of one benchmark (SPEC section 5, ``bench`` JSON keys)."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+
+@dataclass(frozen=True)
+class BenchResult:
+    """One measured figure beside its baseline.
+
+    Attributes:
+        name: What was measured, e.g. ``'simulate_drop_test_ns10'``.
+        value: The project's figure.
+        unit: Unit of ``value`` and ``baseline_value``.
+        baseline: What the baseline is, e.g. ``"solve_ivp(method='Radau')"``.
+        baseline_value: The baseline's figure, same unit.
+        ratio: How many times better the project is (>1 is better), whatever the unit's
+            direction.
+        details: Further figures (accuracy, sizes) worth printing.
+    """
+
+    name: str
+    value: float
+    unit: str
+    baseline: str
+    baseline_value: float
+    ratio: float
+    details: dict[str, Any] = field(default_factory=dict)
+
+    def as_dict(self) -> dict[str, Any]:
+        """Returns the JSON form."""
+        return asdict(self)
+
+
+def best_time(function: Callable[[], Any], repeat: int = 3) -> tuple[float, Any]:
+    """Times a call, keeping the fastest of ``repeat`` runs (the least disturbed one).
+
+    Args:
+        function: What to time.
+        repeat: Number of runs.
+
+    Returns:
+        The best wall time in seconds and the last run's return value.
+    """
+    best = float('inf')
+    value = None
+    for _ in range(max(1, repeat)):
+        start = time.perf_counter()
+        value = function()
+        best = min(best, time.perf_counter() - start)
+    return best, value

@@ -1,0 +1,63 @@
+"""Runs the benchmark suites and formats their results."""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Iterable
+
+from lumpbeam_ros.bench.result import BenchResult
+
+#: Suite modules under :mod:`lumpbeam_ros.bench`.
+SUITES = ('model', 'tracker', 'ident', 'bagio', 'diagnose')
+
+
+def available_suites() -> list[str]:
+    """Returns the suites that exist in this build."""
+    names = []
+    for name in SUITES:
+        try:
+            importlib.import_module(f'lumpbeam_ros.bench.{name}')
+        except ModuleNotFoundError as exc:
+            if exc.name != f'lumpbeam_ros.bench.{name}':
+                raise
+            continue
+        names.append(name)
+    return names
+
+
+def run_suites(names: Iterable[str], quick: bool = False) -> list[BenchResult]:
+    """Runs suites in order.
+
+    Args:
+        names: Suite names from :func:`available_suites`.
+        quick: Smaller inputs, for tests of the benchmark code itself.
+
+    Returns:
+        All results, suite by suite.
+    """
+    results: list[BenchResult] = []
+    for name in names:
+        module = importlib.import_module(f'lumpbeam_ros.bench.{name}')
+        results.extend(module.run(quick=quick))
+    return results
+
+
+def format_table(results: Iterable[BenchResult]) -> str:
+    """Formats results as an aligned text table, one row per benchmark.
+
+    Args:
+        results: Benchmark results.
+
+    Returns:
+        The table, with details on indented lines below their row.
+    """
+    lines = [f'{"benchmark":<34} {"value":>12} {"baseline":>12}  {"ratio":>8}  unit / baseline']
+    for r in results:
+        lines.append(
+            f'{r.name:<34} {r.value:>12.4g} {r.baseline_value:>12.4g}  {r.ratio:>7.1f}x  '
+            f'{r.unit} / {r.baseline}'
+        )
+        for key, value in r.details.items():
+            shown = f'{value:.4g}' if isinstance(value, float) else str(value)
+            lines.append(f'    {key}: {shown}')
+    return '\n'.join(lines)

@@ -1,0 +1,1 @@
+"""The ``lumpbeam`` command line: one module per subcommand, each parsing and delegating."""

@@ -1,0 +1,1 @@
+"""Model-discrepancy diagnosis: residual signatures, candidate effects, scores."""

@@ -1,0 +1,1 @@
+"""Identification of stiffness, frequency and damping from tip oscillations."""

@@ -1,0 +1,1 @@
+"""The lumped-parameter beam: parameters, statics, dynamics, modes, scenarios."""

@@ -1,0 +1,1 @@
+"""ROS 2 nodes: parameters, QoS and message conversion around core calls."""

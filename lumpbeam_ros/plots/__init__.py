@@ -1,0 +1,1 @@
+"""Figures, drawn with matplotlib on the Agg backend (no display needed)."""

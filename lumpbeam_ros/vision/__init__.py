@@ -1,0 +1,1 @@
+"""Camera side: the checkerboard, the synthetic camera, and the tip tracker."""

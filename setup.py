@@ -1,0 +1,31 @@
+"""Build script: an ament_python package that also installs with plain pip."""
+
+from glob import glob
+
+from setuptools import find_packages, setup
+
+PACKAGE = 'lumpbeam_ros'
+
+setup(
+    name=PACKAGE,
+    version='0.1.0',
+    packages=find_packages(exclude=['test', 'test.*']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE}']),
+        (f'share/{PACKAGE}', ['package.xml']),
+        (f'share/{PACKAGE}/config', glob('config/*.yaml')),
+    ],
+    package_data={PACKAGE: ['data/*.yaml']},
+    install_requires=['setuptools', 'numpy', 'scipy', 'pyyaml'],
+    zip_safe=True,
+    maintainer='lumpbeam_ros maintainers',
+    maintainer_email='lumpbeam@example.org',
+    description='Live tip tracking and online identification of flexible beams (ROS 2).',
+    license='Apache-2.0',
+    python_requires='>=3.10',
+    entry_points={
+        'console_scripts': [
+            'lumpbeam = lumpbeam_ros.cli.main:main',
+        ],
+    },
+)
