@@ -1,0 +1,235 @@
+"""The planar chain of rigid segments: mass distribution, springs, dampers and forces.
+
+The equations of motion are the paper's Newton-Euler form (B.14-B.18) written in the absolute
+segment angles ``phi`` of B.17. With ``phi_i`` the pitch of segment ``i`` (positive when it
+points downward, SPEC section 2) and every mass a point on some segment at a lever ``l_i^p``
+from joint ``i``, B.16 collapses to
+
+    M(phi) phi'' + S(phi) phi'^2 + K phi + C phi' = g G cos(phi) + Q_e(phi, phi'),
+    M_ij = A_ij cos(phi_i - phi_j) + I_i delta_ij,   S_ij = A_ij sin(phi_i - phi_j),
+    A_ij = sum_p m_p l_i^p l_j^p,                     G_i = sum_p m_p l_i^p,
+
+where ``K = D^T diag(k) D`` and ``C = D^T diag(c) D`` act on the joint angles ``D phi``
+(joint 1 against the wall, the others between neighbours: B.10, B.11) and ``Q_e`` holds the
+effects of SPEC section 6 that are forces (friction, drag).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from lumpbeam_ros.model.parameters import BeamParameters
+
+#: Joint velocity (rad/s) below which Coulomb friction is smoothed: sign(v) ~ tanh(v / eps).
+FRICTION_SMOOTHING_RAD_S = 1e-3
+
+
+def _difference_matrix(n: int) -> np.ndarray:
+    """D with ``(D phi)_1 = phi_1`` and ``(D phi)_j = phi_j - phi_{j-1}``: joint angles."""
+    return np.eye(n) - np.eye(n, k=-1)
+
+
+@dataclass(frozen=True)
+class LumpedChain:
+    """A planar chain of ``n`` rigid segments carrying point masses.
+
+    Build one with :meth:`from_beam`; the arrays are not to be modified.
+
+    Attributes:
+        segment_length: L_s, m.
+        masses: Point masses, kg (segment centres, then tip bodies).
+        levers: ``levers[p, i]``: how far mass ``p`` sits along segment ``i`` beyond joint
+            ``i`` (L_s for segments before its own, its offset on its own, 0 after).
+        inertia: Rotary inertia about each segment's own angle, kg m^2.
+        stiffness: Joint stiffnesses, N m/rad.
+        damping: Joint dampings, N m s/rad.
+        gravity: g, m/s^2.
+        coulomb_torque: Dry friction torque at joint 1, N m.
+        drag_c_q: Quadratic drag on the tip, N s^2/m^2.
+    """
+
+    segment_length: float
+    masses: np.ndarray
+    levers: np.ndarray
+    inertia: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    gravity: float
+    coulomb_torque: float = 0.0
+    drag_c_q: float = 0.0
+
+    @classmethod
+    def from_beam(cls, beam: BeamParameters, load_kg: float = 0.0) -> LumpedChain:
+        """Builds the chain of a beam carrying ``load_kg`` at the tip.
+
+        Each segment has mass ``m_b / n_s`` at its centre and inertia ``m L_s^2 / 12`` about
+        it (B.15). The mounted body, the hanging load and any ``added_mass`` effect sit at
+        the free end, or at the last segment's centre in the paper's convention. A compliant
+        mount (``base_compliance``) is a spring in series with joint 1.
+
+        Args:
+            beam: The beam.
+            load_kg: Mass hanging at the tip, kg.
+
+        Returns:
+            The chain.
+        """
+        n = beam.n_segments
+        ls = beam.segment_length_m
+        seg_mass = beam.mass_kg / n
+        levers = np.tril(np.full((n, n), ls), k=-1) + np.eye(n) * (0.5 * ls)
+        tip_lever = ls if beam.tip_placement == 'free_end' else 0.5 * ls
+        tip_mass = beam.tip_mass_kg + load_kg + beam.effects.added_mass_kg
+        tip_row = np.full((1, n), ls)
+        tip_row[0, -1] = tip_lever
+        inertia = np.full(n, seg_mass * ls**2 / 12.0)
+        inertia[-1] += beam.tip_inertia_kgm2
+        stiffness = beam.joint_stiffness()
+        k_base = beam.effects.k_base_nm_per_rad
+        if k_base > 0.0:
+            stiffness[0] = stiffness[0] * k_base / (stiffness[0] + k_base)
+        return cls(
+            segment_length=ls,
+            masses=np.concatenate([np.full(n, seg_mass), [tip_mass]]),
+            levers=np.vstack([levers, tip_row]),
+            inertia=inertia,
+            stiffness=stiffness,
+            damping=beam.joint_damping(),
+            gravity=beam.gravity_mps2,
+            coulomb_torque=beam.effects.coulomb_torque_nm,
+            drag_c_q=beam.effects.drag_c_q,
+        )
+
+    @property
+    def n(self) -> int:
+        """Number of segments."""
+        return int(self.inertia.size)
+
+    @property
+    def inertia_coupling(self) -> np.ndarray:
+        """A_ij = sum_p m_p l_i^p l_j^p."""
+        return (self.levers * self.masses[:, None]).T @ self.levers
+
+    @property
+    def gravity_moment(self) -> np.ndarray:
+        """G_i = sum_p m_p l_i^p: first moment of the masses beyond each joint."""
+        return self.masses @ self.levers
+
+    @property
+    def stiffness_matrix(self) -> np.ndarray:
+        """K = D^T diag(k) D."""
+        d = _difference_matrix(self.n)
+        return d.T @ (self.stiffness[:, None] * d)
+
+    @property
+    def damping_matrix(self) -> np.ndarray:
+        """C = D^T diag(c) D."""
+        d = _difference_matrix(self.n)
+        return d.T @ (self.damping[:, None] * d)
+
+    def mass_matrix(self, phi: np.ndarray) -> np.ndarray:
+        """M(phi) of B.16 for one configuration (n,)."""
+        return self.inertia_coupling * np.cos(phi[:, None] - phi[None, :]) + np.diag(
+            self.inertia
+        )
+
+    def tip_pose(self, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Pose of the free end in beam_base (B.17 chained to the end of segment n).
+
+        Args:
+            phi: Angles, shape (n,) or (samples, n).
+
+        Returns:
+            x, z and pitch of the free end.
+        """
+        ls = self.segment_length
+        return (
+            ls * np.cos(phi).sum(axis=-1),
+            -ls * np.sin(phi).sum(axis=-1),
+            phi[..., -1].copy(),
+        )
+
+    def tip_velocity(self, phi: np.ndarray, phi_dot: np.ndarray) -> np.ndarray:
+        """Velocity (vx, vz) of the free end, shape (..., 2)."""
+        ls = self.segment_length
+        return np.stack(
+            [
+                -ls * (np.sin(phi) * phi_dot).sum(axis=-1),
+                -ls * (np.cos(phi) * phi_dot).sum(axis=-1),
+            ],
+            axis=-1,
+        )
+
+    def effect_forces(
+        self, phi: np.ndarray, phi_dot: np.ndarray, friction: bool = True
+    ) -> np.ndarray:
+        """Generalized forces of dry friction at joint 1 and quadratic tip drag.
+
+        Args:
+            phi: Angles, shape (..., n).
+            phi_dot: Angular velocities, same shape.
+            friction: Include the (smoothed) dry friction; a solver that treats its switching
+                exactly leaves it out.
+
+        Returns:
+            Q_e, same shape.
+        """
+        q = np.zeros(np.broadcast_shapes(phi.shape, phi_dot.shape))
+        if friction and self.coulomb_torque > 0.0:
+            # Joint 1's angle is phi_1 itself (it turns against the wall).
+            q[..., 0] -= self.coulomb_torque * np.tanh(phi_dot[..., 0] / FRICTION_SMOOTHING_RAD_S)
+        if self.drag_c_q > 0.0:
+            v = self.tip_velocity(phi, phi_dot)
+            force = -self.drag_c_q * np.linalg.norm(v, axis=-1, keepdims=True) * v
+            # The free end moves by L_s (-sin phi_i, -cos phi_i) per unit of phi_i.
+            ls = self.segment_length
+            q += -ls * (np.sin(phi) * force[..., :1] + np.cos(phi) * force[..., 1:])
+        return q
+
+    def generalized_forces(
+        self, phi: np.ndarray, phi_dot: np.ndarray, friction: bool = True
+    ) -> np.ndarray:
+        """Right-hand side of B.16 for a batch: every force but the inertial ``M phi''``.
+
+        ``-S(phi) phi'^2 + g G cos(phi) - K phi - C phi' + Q_e``, evaluated with the
+        ``cos(a - b) = cos a cos b + sin a sin b`` split so that a batch costs two matrix
+        products rather than a batch of n x n matrices.
+
+        Args:
+            phi: Angles, shape (..., n).
+            phi_dot: Angular velocities, same shape.
+            friction: Include the dry friction at joint 1 (see :meth:`effect_forces`).
+
+        Returns:
+            The generalized forces, same shape.
+        """
+        a = self.inertia_coupling
+        c, s = np.cos(phi), np.sin(phi)
+        w2 = phi_dot**2
+        coriolis = s * ((c * w2) @ a) - c * ((s * w2) @ a)
+        return (
+            -coriolis
+            + self.gravity * self.gravity_moment * c
+            - phi @ self.stiffness_matrix
+            - phi_dot @ self.damping_matrix
+            + self.effect_forces(phi, phi_dot, friction)
+        )
+
+    def inertial_forces(self, phi: np.ndarray, phi_ddot: np.ndarray) -> np.ndarray:
+        """``M(phi) phi''`` for a batch, without forming the matrices."""
+        a = self.inertia_coupling
+        c, s = np.cos(phi), np.sin(phi)
+        return c * ((c * phi_ddot) @ a) + s * ((s * phi_ddot) @ a) + self.inertia * phi_ddot
+
+    def acceleration(self, phi: np.ndarray, phi_dot: np.ndarray) -> np.ndarray:
+        """Forward dynamics ``phi'' = M(phi)^-1 Q`` for one configuration (n,)."""
+        return np.linalg.solve(self.mass_matrix(phi), self.generalized_forces(phi, phi_dot))
+
+    def energy(self, phi: np.ndarray, phi_dot: np.ndarray) -> np.ndarray:
+        """Kinetic plus potential (springs and gravity) energy, J, for a batch."""
+        kinetic = 0.5 * (phi_dot * self.inertial_forces(phi, phi_dot)).sum(axis=-1)
+        spring = 0.5 * (phi * (phi @ self.stiffness_matrix)).sum(axis=-1)
+        heights = -self.gravity * (self.gravity_moment * np.sin(phi)).sum(axis=-1)
+        return kinetic + spring + heights

@@ -1,0 +1,52 @@
+"""Static equilibrium of the chain under gravity and tip loads (nonlinear, any n_s)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lumpbeam_ros.model.chain import LumpedChain
+from lumpbeam_ros.model.parameters import BeamParameters
+
+
+def static_equilibrium(chain: LumpedChain, tol: float = 1e-13, max_iter: int = 50) -> np.ndarray:
+    """Solves ``K phi = g G cos(phi)`` (B.16 at rest) by Newton's method.
+
+    The beam's deflections are small against its stiffness, so Newton from the straight
+    beam converges in a few steps; large rotations converge too, only slower.
+
+    Args:
+        chain: The chain, with its tip masses.
+        tol: Convergence threshold on the angle update, rad.
+        max_iter: Iteration limit.
+
+    Returns:
+        The segment angles at rest, shape (n,).
+
+    Raises:
+        RuntimeError: No convergence (the beam is too soft to carry its load).
+    """
+    k = chain.stiffness_matrix
+    gg = chain.gravity * chain.gravity_moment
+    phi = np.zeros(chain.n)
+    for _ in range(max_iter):
+        residual = k @ phi - gg * np.cos(phi)
+        jacobian = k + np.diag(gg * np.sin(phi))
+        step = np.linalg.solve(jacobian, residual)
+        phi -= step
+        if np.max(np.abs(step)) < tol:
+            return phi
+    raise RuntimeError('static equilibrium did not converge: the beam cannot carry its load')
+
+
+def static_tip_deflection(beam: BeamParameters, load_kg: float = 0.0) -> float:
+    """Downward static deflection of the free end, m (positive when it sags).
+
+    Args:
+        beam: The beam (its mounted tip mass included).
+        load_kg: Extra mass hanging at the tip.
+
+    Returns:
+        ``-z`` of the free end at rest.
+    """
+    chain = LumpedChain.from_beam(beam, load_kg)
+    return float(-chain.tip_pose(static_equilibrium(chain))[1])
