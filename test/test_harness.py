@@ -27,7 +27,8 @@ def test_a_subprocess_on_another_domain_is_not_seen(ros_graph, tmp_path):
     script = (
         'import rclpy, time\n'
         'from std_msgs.msg import Float64\n'
-        'rclpy.init(); n = rclpy.create_node("p"); pub = n.create_publisher(Float64, "/echo", 10)\n'
+        'rclpy.init(); n = rclpy.create_node("p")\n'
+        'pub = n.create_publisher(Float64, "/echo", 10)\n'
         'for _ in range(15):\n'
         '    pub.publish(Float64(data=1.0)); time.sleep(0.05)\n'
     )

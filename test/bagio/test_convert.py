@@ -47,7 +47,8 @@ def test_bad_times_are_rejected(seconds):
 )
 def test_image_round_trip(encoding, shape):
     pixels = np.random.default_rng(1).integers(0, 256, shape, dtype=np.uint8)
-    msg = deserialize(serialize(convert.image(5, pixels, 'cam', encoding)), 'sensor_msgs/msg/Image')
+    data = serialize(convert.image(5, pixels, 'cam', encoding))
+    msg = deserialize(data, 'sensor_msgs/msg/Image')
     assert msg.step == shape[1] * (1 if len(shape) == 2 else 3)
     np.testing.assert_array_equal(convert.image_array(msg), pixels)
 
