@@ -144,7 +144,7 @@ class BagReader:
                     raise BagError(f'{self.path}: {file.name} is not an MCAP file') from None
                 try:
                     return reader.get_summary()
-                except _READ_ERRORS:
+                except (*_READ_ERRORS, OSError):  # OSError: a file shorter than a footer
                     return None
         except OSError as exc:
             raise BagError(f'{self.path}: cannot read {file.name}: {exc.strerror}') from None

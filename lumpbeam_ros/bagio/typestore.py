@@ -11,6 +11,7 @@ import struct
 from functools import lru_cache
 from typing import Any
 
+from rosbags.serde import SerdeError
 from rosbags.typesys import Stores, get_typestore
 from rosbags.typesys.store import Typestore
 
@@ -93,5 +94,12 @@ def deserialize(data: bytes | memoryview, msgtype: str) -> Any:
     message_class(msgtype)
     try:
         return typestore().deserialize_cdr(data, msgtype)
-    except (struct.error, ValueError, IndexError, AssertionError, UnicodeDecodeError) as exc:
+    except (
+        SerdeError,
+        struct.error,
+        ValueError,
+        IndexError,
+        AssertionError,
+        UnicodeDecodeError,
+    ) as exc:
         raise BagError(f'corrupt {msgtype} message ({len(data)} bytes): {exc}') from None

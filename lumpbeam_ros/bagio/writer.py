@@ -74,6 +74,7 @@ class BagWriter:
         self._closed = False
         self._last_flush = time.monotonic()
         self._flushed_snapshot = self._metadata()
+        self._guard(self._flush_storage)  # the MCAP magic and header, so the file is one
         self._guard(lambda: metadata.write(self.path, self._flushed_snapshot))
 
     # -- topics and raw messages ------------------------------------------------------------
