@@ -72,6 +72,7 @@ class BagWriter:
         self._qos: dict[str, list[Qos]] = {}
         self._failed = False
         self._closed = False
+        self._dirty = False  # messages written since the last flush
         self._last_flush = time.monotonic()
         self._flushed_snapshot = self._metadata()
         self._guard(self._flush_storage)  # the MCAP magic and header, so the file is one
@@ -138,6 +139,7 @@ class BagWriter:
             raise BagError(f'log time must be >= 0 ns, got {log_time_ns}')
         self._check_open()
         self._guard(lambda: self._writer.write(connection, int(log_time_ns), data))
+        self._dirty = True
         if time.monotonic() - self._last_flush >= self._flush_period:
             self.flush()
 
@@ -229,14 +231,20 @@ class BagWriter:
     def flush(self) -> None:
         """Puts every message written so far into the file and refreshes ``metadata.yaml``.
 
+        A recorder calls it on a timer too, so the last messages before a quiet spell reach
+        the disk without waiting for the next message. Nothing happens when nothing is pending.
+
         Raises:
             BagError: An I/O error.
         """
         self._check_open()
+        if not self._dirty:
+            return
         self._guard(self._flush_storage)
         self._flushed_snapshot = self._metadata()
         self._guard(lambda: metadata.write(self.path, self._flushed_snapshot))
         self._last_flush = time.monotonic()
+        self._dirty = False
 
     def close(self) -> None:
         """Writes the MCAP summary and the final ``metadata.yaml``; idempotent.
