@@ -1,1 +1,52 @@
-"""rosbag2/MCAP reading and writing, and message <-> numpy conversion."""
+"""rosbag2/MCAP reading and writing, and message <-> numpy conversion (no ROS imports).
+
+Writing::
+
+    with BagWriter('out/drop') as bag:
+        bag.write_pose('/tip_pose', t, x, z, pitch)      # PoseStamped in beam_base
+        bag.write_float('/tip_load', t, 4.5)             # Float64, kg
+
+Reading::
+
+    t, x, z, pitch, frame = read_tip_poses('out/drop')
+    load = read_load_events('out/drop').changes()
+"""
+
+from lumpbeam_ros.bagio.convert import CameraInfoData, Status
+from lumpbeam_ros.bagio.reader import BagReader, RawMessage, open_bag
+from lumpbeam_ros.bagio.repair import reindex
+from lumpbeam_ros.bagio.series import (
+    ImageFrame,
+    LoadSeries,
+    PointSeries,
+    PoseSeries,
+    iter_images,
+    read_camera_info,
+    read_diagnostics,
+    read_floats,
+    read_load_events,
+    read_points,
+    read_tip_poses,
+)
+from lumpbeam_ros.bagio.writer import BagWriter
+
+__all__ = [
+    'BagReader',
+    'BagWriter',
+    'CameraInfoData',
+    'ImageFrame',
+    'LoadSeries',
+    'PointSeries',
+    'PoseSeries',
+    'RawMessage',
+    'Status',
+    'iter_images',
+    'open_bag',
+    'read_camera_info',
+    'read_diagnostics',
+    'read_floats',
+    'read_load_events',
+    'read_points',
+    'read_tip_poses',
+    'reindex',
+]

@@ -1,0 +1,97 @@
+"""QoS profiles as bags store them (ROS-free, rosbags' :class:`~rosbags.interfaces.Qos`).
+
+A bag keeps each topic's offered QoS so that a player can offer the same again. The project's
+defaults, used for synthetic bags and by the player when a bag has none:
+
+- images and camera info: best effort, volatile, keep last 5 (the sensor-data profile): a
+  late frame is worth less than the next one and must never stall a 180 fps stream;
+- ``/tip_load``: reliable, transient local, keep last 1. It changes rarely (a drop), so a
+  node that starts after the last change still needs the current load; a transient-local
+  publisher also serves volatile subscribers, so nobody is excluded;
+- everything else: reliable, volatile, keep last 10.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from rosbags.interfaces import (
+    Qos,
+    QosDurability,
+    QosHistory,
+    QosLiveliness,
+    QosReliability,
+    QosTime,
+)
+
+#: How rosbag2 writes an infinite duration (``RMW_DURATION_INFINITE``).
+INFINITE = QosTime(2147483647, 4294967295)
+ZERO = QosTime(0, 0)
+
+SENSOR_TYPES = ('sensor_msgs/msg/Image', 'sensor_msgs/msg/CameraInfo')
+LATCHED_TOPICS = ('/tip_load',)
+
+
+def profile(reliable: bool, transient_local: bool, depth: int) -> Qos:
+    """Builds a keep-last profile with the other policies at their defaults.
+
+    Args:
+        reliable: Reliable (else best effort).
+        transient_local: Transient local (else volatile).
+        depth: History depth.
+
+    Returns:
+        The profile.
+    """
+    return Qos(
+        history=QosHistory.KEEP_LAST,
+        depth=depth,
+        reliability=QosReliability.RELIABLE if reliable else QosReliability.BEST_EFFORT,
+        durability=QosDurability.TRANSIENT_LOCAL if transient_local else QosDurability.VOLATILE,
+        deadline=INFINITE,
+        lifespan=INFINITE,
+        liveliness=QosLiveliness.AUTOMATIC,
+        liveliness_lease_duration=INFINITE,
+        avoid_ros_namespace_conventions=False,
+    )
+
+
+def default_profile(topic: str, msgtype: str) -> Qos:
+    """Returns the project's profile for a topic (see the module docstring)."""
+    if msgtype in SENSOR_TYPES:
+        return profile(reliable=False, transient_local=False, depth=5)
+    if topic in LATCHED_TOPICS:
+        return profile(reliable=True, transient_local=True, depth=1)
+    return profile(reliable=True, transient_local=False, depth=10)
+
+
+def from_dict(entry: Mapping[str, Any]) -> Qos:
+    """Parses one offered profile as ``metadata.yaml`` (version 9) lists it.
+
+    Args:
+        entry: E.g. ``{'history': 'keep_last', 'depth': 10, 'reliability': 'reliable', ...}``.
+
+    Returns:
+        The profile; unknown or missing policies become ``SYSTEM_DEFAULT``/``UNKNOWN``.
+    """
+
+    def enum(kind: Any, key: str) -> Any:
+        name = str(entry.get(key, 'system_default')).upper()
+        return kind[name] if name in kind.__members__ else kind['UNKNOWN']
+
+    def duration(key: str) -> QosTime:
+        value = entry.get(key) or {}
+        return QosTime(int(value.get('sec', 0)), int(value.get('nsec', 0)))
+
+    return Qos(
+        history=enum(QosHistory, 'history'),
+        depth=int(entry.get('depth', 0)),
+        reliability=enum(QosReliability, 'reliability'),
+        durability=enum(QosDurability, 'durability'),
+        deadline=duration('deadline'),
+        lifespan=duration('lifespan'),
+        liveliness=enum(QosLiveliness, 'liveliness'),
+        liveliness_lease_duration=duration('liveliness_lease_duration'),
+        avoid_ros_namespace_conventions=bool(entry.get('avoid_ros_namespace_conventions')),
+    )

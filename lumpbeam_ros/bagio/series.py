@@ -1,0 +1,184 @@
+"""Whole topics as numpy arrays: what the offline commands (analyze, diagnose) read.
+
+Times are header stamps (measurement time, SPEC section 2) in float seconds, sorted; a topic
+without a header (``std_msgs/Float64``) uses the log time, which equals the stamp in
+synthetic bags and is the receive time in recorded ones.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+
+from lumpbeam_ros.bagio import convert
+from lumpbeam_ros.bagio.reader import BagReader, open_bag
+from lumpbeam_ros.errors import BagError
+
+Bag = str | Path | BagReader
+
+
+class PoseSeries(NamedTuple):
+    """Planar tip poses: ``t, x, z, pitch`` arrays (s, m, m, rad) and their frame."""
+
+    t: np.ndarray
+    x: np.ndarray
+    z: np.ndarray
+    pitch: np.ndarray
+    frame_id: str
+
+
+class LoadSeries(NamedTuple):
+    """``/tip_load`` samples: log time ``t`` (s) and the hanging mass ``kg``."""
+
+    t: np.ndarray
+    kg: np.ndarray
+
+    def changes(self) -> LoadSeries:
+        """Returns the first sample and every sample whose value differs from the previous."""
+        if self.t.size == 0:
+            return self
+        keep = np.concatenate([[True], self.kg[1:] != self.kg[:-1]])
+        return LoadSeries(self.t[keep], self.kg[keep])
+
+
+class PointSeries(NamedTuple):
+    """Reference points (``/tracker/point``): ``t, x, y, z`` arrays and their frame."""
+
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    frame_id: str
+
+
+class ImageFrame(NamedTuple):
+    """One image: exposure time ``t`` (s), ``pixels`` (uint8), ``encoding``, ``frame_id``."""
+
+    t: float
+    pixels: np.ndarray
+    encoding: str
+    frame_id: str
+
+
+def _stamp_s(msg: object) -> float:
+    return convert.ns_to_seconds(convert.time_ns(msg.header.stamp))  # type: ignore[attr-defined]
+
+
+def _single_frame(frames: set[str], bag: BagReader, topic: str) -> str:
+    if len(frames) > 1:
+        raise BagError(f'{bag.path}: topic {topic} mixes frames {sorted(frames)}')
+    return next(iter(frames), '')
+
+
+def _sorted_columns(rows: list[tuple[float, ...]], width: int) -> list[np.ndarray]:
+    table = np.asarray(rows, dtype=np.float64).reshape(-1, width)
+    table = table[np.argsort(table[:, 0], kind='stable')]
+    return [table[:, i].copy() for i in range(width)]
+
+
+def read_tip_poses(bag: Bag, topic: str = '/tip_pose') -> PoseSeries:
+    """Reads a ``geometry_msgs/PoseStamped`` topic as planar tip poses.
+
+    Args:
+        bag: Bag folder or open reader.
+        topic: E.g. ``'/tip_pose'``, ``'/tip_pose_truth'``, ``'/tip_pose_predicted'``.
+
+    Returns:
+        The poses sorted by stamp (empty arrays for an empty topic).
+
+    Raises:
+        BagError: Missing topic, another type, corrupt messages or mixed frames.
+    """
+    reader = open_bag(bag)
+    rows, frames = [], set()
+    for _, msg in reader.messages(topic, 'geometry_msgs/msg/PoseStamped'):
+        ns, x, z, pitch, frame = convert.pose_values(msg)
+        rows.append((convert.ns_to_seconds(ns), x, z, pitch))
+        frames.add(frame)
+    t, x, z, pitch = _sorted_columns(rows, 4)
+    return PoseSeries(t, x, z, pitch, _single_frame(frames, reader, topic))
+
+
+def read_floats(bag: Bag, topic: str) -> tuple[np.ndarray, np.ndarray]:
+    """Reads a ``std_msgs/Float64`` topic as ``(log time s, value)`` arrays, sorted.
+
+    Raises:
+        BagError: Missing topic, another type or corrupt messages.
+    """
+    rows = [
+        (convert.ns_to_seconds(ns), float(msg.data))
+        for ns, msg in open_bag(bag).messages(topic, 'std_msgs/msg/Float64')
+    ]
+    t, value = _sorted_columns(rows, 2)
+    return t, value
+
+
+def read_load_events(bag: Bag, topic: str = '/tip_load') -> LoadSeries:
+    """Reads ``/tip_load`` (kg at the tip); ``.changes()`` keeps the drops and additions.
+
+    Raises:
+        BagError: Missing topic, another type or corrupt messages.
+    """
+    t, kg = read_floats(bag, topic)
+    return LoadSeries(t, kg)
+
+
+def read_points(bag: Bag, topic: str = '/tracker/point') -> PointSeries:
+    """Reads a ``geometry_msgs/PointStamped`` topic, sorted by stamp.
+
+    Raises:
+        BagError: Missing topic, another type, corrupt messages or mixed frames.
+    """
+    reader = open_bag(bag)
+    rows, frames = [], set()
+    for _, msg in reader.messages(topic, 'geometry_msgs/msg/PointStamped'):
+        ns, x, y, z, frame = convert.point_values(msg)
+        rows.append((convert.ns_to_seconds(ns), x, y, z))
+        frames.add(frame)
+    t, x, y, z = _sorted_columns(rows, 4)
+    return PointSeries(t, x, y, z, _single_frame(frames, reader, topic))
+
+
+def iter_images(bag: Bag, topic: str = '/camera/image_raw') -> Iterator[ImageFrame]:
+    """Iterates over a ``sensor_msgs/Image`` topic in recording order.
+
+    Yields:
+        The frames; ``pixels`` is ``(h, w)`` for mono8 and ``(h, w, 3)`` otherwise.
+
+    Raises:
+        BagError: Missing topic, another type, an unsupported encoding or inconsistent sizes.
+    """
+    for _, msg in open_bag(bag).messages(topic, 'sensor_msgs/msg/Image'):
+        pixels = convert.image_array(msg)
+        yield ImageFrame(_stamp_s(msg), pixels, msg.encoding, msg.header.frame_id)
+
+
+def read_camera_info(bag: Bag, topic: str = '/camera/camera_info') -> convert.CameraInfoData:
+    """Returns the first ``sensor_msgs/CameraInfo`` of a topic.
+
+    Raises:
+        BagError: Missing or empty topic, or another type.
+    """
+    reader = open_bag(bag)
+    for _, msg in reader.messages(topic, 'sensor_msgs/msg/CameraInfo'):
+        return convert.camera_info_data(msg)
+    raise BagError(f'{reader.path}: topic {topic} has no message')
+
+
+def read_diagnostics(
+    bag: Bag, topic: str = '/beam_params'
+) -> list[tuple[float, list[convert.Status]]]:
+    """Reads a ``diagnostic_msgs/DiagnosticArray`` topic as ``(stamp s, statuses)`` pairs.
+
+    Raises:
+        BagError: Missing topic, another type or corrupt messages.
+    """
+    out = [
+        (_stamp_s(msg), convert.diagnostic_statuses(msg))
+        for _, msg in open_bag(bag).messages(topic, 'diagnostic_msgs/msg/DiagnosticArray')
+    ]
+    out.sort(key=lambda item: item[0])
+    return out

@@ -1,0 +1,108 @@
+import logging
+
+import numpy as np
+import pytest
+import yaml
+
+from lumpbeam_ros.bagio import BagReader, BagWriter, read_load_events, read_tip_poses, reindex
+from lumpbeam_ros.errors import BagError
+
+from .helpers import write_drop_bag
+
+
+@pytest.fixture
+def drop(tmp_path):
+    write_drop_bag(tmp_path / 'drop')
+    return tmp_path / 'drop'
+
+
+def test_not_a_bag(tmp_path):
+    (tmp_path / 'plain.txt').write_text('x')
+    (tmp_path / 'folder').mkdir()
+    for path, match in [
+        (tmp_path / 'missing', 'no such bag'),
+        (tmp_path / 'plain.txt', 'not a bag folder'),
+        (tmp_path / 'folder', r'not a rosbag2 bag \(no metadata.yaml\)'),
+    ]:
+        with pytest.raises(BagError, match=match):
+            BagReader(path)
+
+
+@pytest.mark.parametrize(
+    ('text', 'match'),
+    [
+        ('a: [unclosed', 'unreadable metadata'),
+        ('just a string', 'no rosbag2_bagfile_information'),
+        ('rosbag2_bagfile_information: {storage_identifier: mcap}', 'malformed'),
+        ('rosbag2_bagfile_information: {storage_identifier: sqlite3}', 'only mcap'),
+    ],
+)
+def test_corrupt_metadata(drop, text, match):
+    (drop / 'metadata.yaml').write_text(text)
+    with pytest.raises(BagError, match=match):
+        BagReader(drop)
+
+
+def test_a_listed_data_file_that_is_missing(drop):
+    (drop / 'drop.mcap').unlink()
+    with pytest.raises(BagError, match='data file drop.mcap listed in metadata.yaml is missing'):
+        BagReader(drop)
+
+
+@pytest.mark.parametrize(('content', 'match'), [(b'', 'is empty'), (b'PK\3\4' * 8, 'not an MCAP')])
+def test_empty_or_foreign_data_file(drop, content, match):
+    (drop / 'drop.mcap').write_bytes(content)
+    with pytest.raises(BagError, match=match):
+        BagReader(drop)
+
+
+@pytest.mark.parametrize('keep', [0.3, 0.6, 0.8])
+def test_a_truncated_file_reads_what_is_readable_and_warns(drop, keep, caplog):
+    full = read_tip_poses(drop)
+    data = (drop / 'drop.mcap').read_bytes()
+    (drop / 'drop.mcap').write_bytes(data[: int(len(data) * keep)])
+    with caplog.at_level(logging.WARNING):
+        poses = read_tip_poses(drop)
+    assert 'no closing index' in caplog.text and 'incomplete record' in caplog.text
+    # A cut file keeps a prefix of whole chunks: fewer poses, identical to the first ones.
+    assert 0 < poses.t.size < full.t.size
+    np.testing.assert_array_equal(poses.z, full.z[: poses.t.size])
+
+
+def test_a_file_cut_inside_its_header_has_no_messages(drop, caplog):
+    data = (drop / 'drop.mcap').read_bytes()
+    (drop / 'drop.mcap').write_bytes(data[:12])
+    assert read_tip_poses(drop).t.size == 0
+    assert 'kept 0 messages' in caplog.text
+
+
+def test_an_unknown_message_type_is_read_raw_but_not_decoded(tmp_path):
+    with BagWriter(tmp_path / 'b') as bag:
+        bag.add_topic('/custom', 'my_pkg/msg/Thing', msgdef='float64 value', type_hash='RIHS01_00')
+        bag.write_raw('/custom', 5, b'\0\1\0\0' + np.float64(2.5).tobytes())
+    reader = BagReader(tmp_path / 'b')
+    [raw] = reader.iter_raw()
+    assert (raw.topic, raw.msgtype, raw.log_time_ns) == ('/custom', 'my_pkg/msg/Thing', 5)
+    with pytest.raises(BagError, match="unknown message type 'my_pkg/msg/Thing'"):
+        list(reader.messages('/custom', 'my_pkg/msg/Thing'))
+
+
+def test_a_corrupt_message_is_a_clear_error(tmp_path):
+    with BagWriter(tmp_path / 'b') as bag:
+        bag.add_topic('/tip_pose', 'geometry_msgs/msg/PoseStamped')
+        bag.write_raw('/tip_pose', 5, b'\0\1\0\0\7')
+    with pytest.raises(BagError, match='corrupt geometry_msgs/msg/PoseStamped message'):
+        read_tip_poses(tmp_path / 'b')
+
+
+def test_reindex_rebuilds_lost_metadata(drop):
+    original = yaml.safe_load((drop / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
+    (drop / 'metadata.yaml').unlink()
+    assert reindex(drop) == original['message_count']
+    rebuilt = BagReader(drop)
+    assert rebuilt.info.message_count == original['message_count']
+    assert rebuilt.info.start_ns == original['starting_time']['nanoseconds_since_epoch']
+    assert rebuilt.topics['/tip_load'].qos[0]['durability'] == 'transient_local'
+    np.testing.assert_array_equal(read_load_events(rebuilt).changes().kg, [4.5, 0.0])
+    with pytest.raises(BagError, match='exactly one .mcap'):
+        reindex(drop.parent)

@@ -1,0 +1,101 @@
+import shutil
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+from lumpbeam_ros.bagio import BagReader, BagWriter, read_tip_poses
+from lumpbeam_ros.errors import BagError
+
+from .helpers import write_drop_bag
+
+
+def test_an_existing_bag_is_never_overwritten(tmp_path):
+    write_drop_bag(tmp_path / 'drop')
+    before = (tmp_path / 'drop' / 'drop.mcap').read_bytes()
+    with pytest.raises(BagError, match='exists already'):
+        BagWriter(tmp_path / 'drop')
+    assert (tmp_path / 'drop' / 'drop.mcap').read_bytes() == before
+
+
+def test_an_uncreatable_folder_is_a_clear_error(tmp_path):
+    (tmp_path / 'file').write_text('not a folder')
+    with pytest.raises(BagError, match='cannot create bag'):
+        BagWriter(tmp_path / 'file' / 'bag')
+
+
+@pytest.mark.parametrize(
+    ('action', 'match'),
+    [
+        (lambda b: b.write_raw('/nope', 0, b'\0\1\0\0'), 'not declared'),
+        (lambda b: b.add_topic('tip_pose', 'std_msgs/msg/Float64'), 'must start with /'),
+        (lambda b: b.add_topic('/x', 'my_pkg/msg/Unknown'), 'unknown message type'),
+        (lambda b: (b.write_float('/a', 0.0, 1.0), b.write_pose('/a', 0, 0, 0, 0)), 'carries'),
+        (lambda b: b.write_float('/a', -1.0, 1.0), 'time must be'),
+    ],
+)
+def test_bad_writes_are_clear_errors(tmp_path, action, match):
+    with BagWriter(tmp_path / 'b') as bag, pytest.raises(BagError, match=match):
+        action(bag)
+
+
+def test_metadata_exists_while_writing_and_tracks_flushes(tmp_path):
+    bag = BagWriter(tmp_path / 'live', flush_period_s=1e9)
+    assert BagReader(tmp_path / 'live').topics == {}
+    for i in range(50):
+        bag.write_pose('/tip_pose', 1.0 + i, 2.0, -0.01 * i, 0.0)
+    bag.flush()
+    for i in range(50, 60):
+        bag.write_pose('/tip_pose', 1.0 + i, 2.0, -0.01 * i, 0.0)
+    # A copy now is what a SIGKILL would leave: flushed chunks, metadata of the last flush.
+    shutil.copytree(tmp_path / 'live', tmp_path / 'killed')
+    bag.close()
+    killed = BagReader(tmp_path / 'killed')
+    assert killed.truncated and killed.topics['/tip_pose'].count == 50
+    np.testing.assert_array_equal(read_tip_poses(killed).t, 1.0 + np.arange(50))
+    assert read_tip_poses(tmp_path / 'live').t.size == 60
+
+
+def test_the_flush_period_bounds_what_a_kill_loses(tmp_path):
+    bag = BagWriter(tmp_path / 'live', flush_period_s=1e-6)  # every write is flushed
+    for i in range(20):
+        bag.write_float('/tip_load', float(i), 4.5)
+    shutil.copytree(tmp_path / 'live', tmp_path / 'killed')
+    bag.close()
+    assert BagReader(tmp_path / 'killed').topics['/tip_load'].count == 20
+
+
+def test_a_full_disk_keeps_what_was_flushed(tmp_path):
+    # RLIMIT_FSIZE makes writes past 1.2 MB fail with EFBIG, as a full disk fails with ENOSPC.
+    script = textwrap.dedent(
+        f"""
+        import resource, sys
+        import numpy as np
+        from lumpbeam_ros.bagio import BagWriter
+        from lumpbeam_ros.errors import BagError
+        resource.setrlimit(resource.RLIMIT_FSIZE, (1_200_000, 1_200_000))
+        bag = BagWriter({str(tmp_path / 'full')!r}, flush_period_s=1e9)
+        try:
+            for i in range(100):
+                bag.write_pose('/tip_pose', float(i), 2.0, 0.0, 0.0)
+                bag.write_image('/camera/image_raw', float(i), np.full((200, 250), i, np.uint8))
+                if i % 10 == 9:
+                    bag.flush()
+        except BagError as exc:
+            print(exc)
+            sys.exit(3)
+        """
+    )
+    proc = subprocess.run([sys.executable, '-c', script], capture_output=True, text=True)
+    assert proc.returncode == 3, proc.stderr
+    assert (
+        'File too large' in proc.stdout
+        and 'the 40 messages flushed before are kept' in proc.stdout
+    )
+    reader = BagReader(tmp_path / 'full')
+    poses = read_tip_poses(reader)
+    assert reader.truncated and reader.topics['/tip_pose'].count == 20
+    # Chunks close every ~1 MiB or flush, so the 20 flushed poses and maybe a few more survive.
+    np.testing.assert_array_equal(poses.t[:20], np.arange(20.0))

@@ -1,0 +1,120 @@
+import logging
+import os
+import threading
+import time
+
+import numpy as np
+import pytest
+from geometry_msgs.msg import PoseStamped
+from harness import SENSOR_QOS
+from rclpy.qos import DurabilityPolicy, QoSProfile
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import Image
+from std_msgs.msg import Float64
+
+from lumpbeam_ros.bagio import BagReader, BagWriter
+from lumpbeam_ros.cli.main import main
+from lumpbeam_ros.nodes.player import Player
+
+T0 = 1000.0
+
+
+@pytest.fixture
+def short_bag(tmp_path):
+    with BagWriter(tmp_path / 'short') as bag:
+        for i in range(60):  # 0.5 s at 120 Hz
+            bag.write_pose('/tip_pose', T0 + i / 120, 2.3, -0.001 * i, 0.0)
+            if i % 20 == 0:
+                bag.write_image('/camera/image_raw', T0 + i / 120, np.full((4, 6), i, np.uint8))
+        bag.write_float('/tip_load', T0, 4.5)
+    return tmp_path / 'short'
+
+
+def _play(ros_graph, bag, **kwargs):
+    """Plays in a thread (as the CLI does in its own process) while the test's graph spins."""
+    player = Player(BagReader(bag), context=ros_graph.context, **kwargs)
+    ros_graph.spin_for(0.5)  # discovery
+    result = {}
+    thread = threading.Thread(target=lambda: result.update(stats=player.play()))
+    thread.start()
+    ros_graph.spin_until(lambda: not thread.is_alive(), 10.0)
+    thread.join()
+    return player, result['stats']
+
+
+def test_replay_keeps_content_timing_and_clock(ros_graph, short_bag):
+    poses = ros_graph.collect('/tip_pose', PoseStamped, 100)
+    images = ros_graph.collect('/camera/image_raw', Image, SENSOR_QOS)
+    clock = ros_graph.collect('/clock', Clock, 100)
+    arrivals = []
+    ros_graph.node.create_subscription(
+        PoseStamped, '/tip_pose', lambda m: arrivals.append(time.perf_counter()), 100
+    )
+    started = time.perf_counter()
+    _, stats = _play(ros_graph, short_bag)
+    assert ros_graph.spin_until(lambda: len(poses) == 60 and len(arrivals) == 60, 5.0)
+    assert stats.published == {'/camera/image_raw': 3, '/tip_load': 1, '/tip_pose': 60}
+    np.testing.assert_allclose([p.pose.position.z for p in poses], -0.001 * np.arange(60))
+    assert [bytes(m.data)[0] for m in images] == [0, 20, 40]
+    ticks = [c.clock.sec + c.clock.nanosec * 1e-9 for c in clock]
+    assert len(ticks) == 64 and ticks[0] == T0 and np.all(np.diff(ticks) >= 0)
+    # The 59 intervals of 1/120 s took about 0.49 s (generous bounds: a shared 2-core box).
+    assert 0.45 < arrivals[-1] - arrivals[0] < 0.8
+    assert arrivals[0] > started
+    assert stats.lateness_percentile_ms(50) < 20.0
+
+
+def test_rate_scales_the_timing(ros_graph, short_bag):
+    _, stats = _play(ros_graph, short_bag, rate=4.0, topics=['/tip_pose'])
+    assert stats.published == {'/tip_pose': 60}
+    assert stats.lateness_percentile_ms(50) < 20.0
+
+
+def test_tip_load_is_latched_for_late_subscribers(ros_graph, short_bag):
+    player, _ = _play(ros_graph, short_bag, topics=['/tip_load'])  # kept alive: it latches
+    latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    late = ros_graph.collect('/tip_load', Float64, latched)
+    assert ros_graph.spin_until(lambda: len(late) == 1, 5.0)
+    assert late[0].data == 4.5
+    player.destroy_node()
+
+
+def test_a_truncated_bag_plays_what_is_readable(ros_graph, tmp_path, caplog):
+    with BagWriter(tmp_path / 'cut') as bag:
+        for i in range(40):
+            bag.write_float('/tip_load', T0 + i / 100, float(i))
+            if i == 19:
+                bag.flush()
+                flushed_size = os.path.getsize(tmp_path / 'cut' / 'cut.mcap')
+    data = (tmp_path / 'cut' / 'cut.mcap').read_bytes()
+    (tmp_path / 'cut' / 'cut.mcap').write_bytes(data[: flushed_size + 30])  # a kill mid-chunk
+    with caplog.at_level(logging.WARNING):
+        _, stats = _play(ros_graph, tmp_path / 'cut')
+    assert stats.published == {'/tip_load': 20}
+    assert 'no closing index' in caplog.text
+
+
+@pytest.mark.parametrize(
+    ('argv', 'match'),
+    [
+        (['play', '{bag}', '--topics', '/nope'], 'no topic /nope'),
+        (['play', '{custom}'], 'message type my_pkg/msg/Thing is not installed'),
+        (['play', '{missing}'], 'no such bag'),
+    ],
+)
+def test_bad_invocations_print_one_line(tmp_path, short_bag, capsys, argv, match):
+    with BagWriter(tmp_path / 'custom') as bag:
+        bag.add_topic('/custom', 'my_pkg/msg/Thing', msgdef='float64 value', type_hash='RIHS01_0')
+    paths = {'bag': short_bag, 'custom': tmp_path / 'custom', 'missing': tmp_path / 'missing'}
+    assert main([a.format(**paths) for a in argv]) == 2
+    err = capsys.readouterr().err.strip()
+    assert match in err and '\n' not in err
+
+
+def test_play_command_end_to_end(short_bag, capsys, monkeypatch):
+    from harness import next_domain_id
+
+    monkeypatch.setenv('ROS_DOMAIN_ID', str(next_domain_id()))
+    assert main(['play', str(short_bag), '--rate', '5', '--delay', '0.1']) == 0
+    out = capsys.readouterr().out
+    assert 'played' in out and '64 messages' in out

@@ -1,0 +1,92 @@
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from geometry_msgs.msg import PoseStamped
+from harness import ros_env
+from std_msgs.msg import Float64
+
+from lumpbeam_ros.bagio import BagReader, read_load_events, read_tip_poses
+from lumpbeam_ros.cli.main import main
+
+
+def _start_recorder(ros_graph, out, *extra):
+    cmd = [sys.executable, '-m', 'lumpbeam_ros.cli.main', 'record', str(out), *extra]
+    return subprocess.Popen(
+        cmd,
+        env=ros_env(ros_graph.domain_id),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def _publish_poses(ros_graph, n, rate_hz=200.0):
+    msg = PoseStamped()
+    msg.header.frame_id = 'beam_base'
+    ros_graph.publish('/tip_pose', msg)  # creates the publisher
+    assert ros_graph.wait_for_subscribers('/tip_pose', timeout=15.0)
+    ros_graph.spin_for(0.3)  # the recorder's subscription settles on the new publisher
+    for i in range(n):
+        msg.header.stamp.sec, msg.header.stamp.nanosec = 100 + i, 0
+        msg.pose.position.z = -0.001 * i
+        ros_graph.publish('/tip_pose', msg)
+        time.sleep(1.0 / rate_hz)
+
+
+def test_sigkill_keeps_everything_before_the_last_flush(ros_graph, tmp_path):
+    out = tmp_path / 'killed'
+    proc = _start_recorder(ros_graph, out, '/tip_pose', '--flush-period', '0.2')
+    try:
+        _publish_poses(ros_graph, 200)
+        time.sleep(0.6)  # > flush period: every pose is on disk
+    finally:
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(10)
+    reader = BagReader(out)
+    assert reader.truncated  # no summary: the process never closed the file
+    poses = read_tip_poses(reader)
+    stamps = poses.t[poses.t >= 100]
+    np.testing.assert_array_equal(stamps, 100.0 + np.arange(200))
+    np.testing.assert_allclose(poses.z[poses.t >= 100], -0.001 * np.arange(200))
+
+
+@pytest.mark.parametrize('sig', [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_closes_the_bag_cleanly(ros_graph, tmp_path, sig):
+    out = tmp_path / 'clean'
+    proc = _start_recorder(ros_graph, out, '/tip_pose', '/tip_load')
+    try:
+        ros_graph.publish('/tip_load', Float64(data=4.5))
+        _publish_poses(ros_graph, 50)
+        ros_graph.publish('/tip_load', Float64(data=0.0))
+        ros_graph.spin_for(0.3)
+    finally:
+        proc.send_signal(sig)
+        stdout, stderr = proc.communicate(timeout=15)
+    assert proc.returncode == 0, stderr
+    assert 'recorded' in stdout and '/tip_pose 5' in stdout
+    reader = BagReader(out)
+    assert not reader.truncated
+    assert reader.topics['/tip_pose'].count == read_tip_poses(reader).t.size >= 50
+    assert read_load_events(reader).changes().kg[-1] == 0.0
+
+
+@pytest.mark.parametrize(
+    ('argv', 'match'),
+    [
+        (['record', '{out}'], 'name the topics to record, or pass --all'),
+        (['record', '{out}', '/a', '--all'], 'either topics or --all'),
+        (['record', '{existing}', '/a'], 'exists already; a bag is never overwritten'),
+        (['record', '{file}/bag', '/a'], 'cannot create bag'),
+    ],
+)
+def test_bad_invocations_print_one_line(tmp_path, capsys, argv, match):
+    (tmp_path / 'existing').mkdir()
+    (tmp_path / 'file').write_text('x')
+    paths = {'out': tmp_path / 'out', 'existing': tmp_path / 'existing', 'file': tmp_path / 'file'}
+    assert main([a.format(**paths) for a in argv]) == 2
+    err = capsys.readouterr().err.strip()
+    assert match in err and '\n' not in err

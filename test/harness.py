@@ -1,0 +1,171 @@
+"""Launch-free fixtures for tests that run real ROS 2 nodes in the test process.
+
+Every test gets its own ``rclpy`` Context on its own ROS domain, so tests never see each
+other's topics, even when pytest runs several processes at once, and no ``launch`` or
+daemon is needed. Discovery stays on this machine (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``).
+
+Use it from any test (``test/conftest.py`` registers the fixture)::
+
+    def test_echo(ros_graph):
+        from std_msgs.msg import Float64
+        node = MyNode(context=ros_graph.context)      # the node under test
+        ros_graph.add_node(node)                      # spun by the graph's executor
+        got = ros_graph.collect('/out', Float64)      # subscribe before publishing
+        ros_graph.publish('/in', Float64(data=4.5))
+        assert ros_graph.spin_until(lambda: len(got) >= 1, timeout=5.0)
+        assert got[0].data == 4.5
+
+The camera, identifier and simulator node tests reuse it. A node under test must accept a
+``context`` (``rclpy.node.Node(name, context=...)``). ``ros_graph.domain_id`` is also what a
+node started as a subprocess needs (``env={'ROS_DOMAIN_ID': ...}``, see :func:`ros_env`).
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import QoSProfile, qos_profile_sensor_data
+
+# Fast DDS maps domain ids to UDP ports; 0..101 and 215..232 are valid on Linux for any
+# number of participants. Domain 0 is left to a developer's own ROS graph.
+_DOMAINS = [*range(1, 102), *range(215, 233)]
+_counter = itertools.count()
+
+
+def next_domain_id() -> int:
+    """Returns a domain id unique to this process and call (pid-based, cycling)."""
+    return _DOMAINS[(os.getpid() * 7 + next(_counter)) % len(_DOMAINS)]
+
+
+def ros_env(domain_id: int, root: Path | None = None) -> dict[str, str]:
+    """Returns the environment for a ROS subprocess on ``domain_id``.
+
+    Args:
+        domain_id: The test's domain.
+        root: Where ROS logs go (``.cache/ros`` under the working directory when ``None``).
+
+    Returns:
+        A copy of ``os.environ`` with the domain, local discovery and the log folder set.
+    """
+    root = root or Path.cwd() / '.cache' / 'ros'
+    env = dict(os.environ)
+    env.update(
+        ROS_DOMAIN_ID=str(domain_id),
+        ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
+        ROS_LOG_DIR=str(root / 'log'),
+        ROS_HOME=str(root),
+    )
+    return env
+
+
+class RosGraph:
+    """A private ROS 2 graph: one Context, one executor and a helper node.
+
+    Args:
+        domain_id: The ROS domain to use.
+
+    Attributes:
+        context: Pass it to nodes under test.
+        domain_id: The domain.
+        executor: A ``SingleThreadedExecutor`` spinning every added node.
+        node: The helper node that publishes and collects.
+    """
+
+    def __init__(self, domain_id: int):
+        self.domain_id = domain_id
+        self.context = Context()
+        rclpy.init(context=self.context, domain_id=domain_id)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.node = Node('test_harness', context=self.context)
+        self.executor.add_node(self.node)
+        self._publishers: dict[str, Any] = {}
+
+    def add_node(self, node: Node) -> None:
+        """Spins ``node`` together with the helper node."""
+        self.executor.add_node(node)
+
+    def publish(self, topic: str, msg: Any, qos: QoSProfile | int = 10) -> None:
+        """Publishes ``msg`` (a publisher per topic is created on first use).
+
+        Args:
+            topic: Topic name.
+            msg: A message instance (its class fixes the topic's type).
+            qos: Profile or depth.
+        """
+        if topic not in self._publishers:
+            self._publishers[topic] = self.node.create_publisher(type(msg), topic, qos)
+        self._publishers[topic].publish(msg)
+
+    def wait_for_subscribers(self, topic: str, count: int = 1, timeout: float = 5.0) -> bool:
+        """Spins until ``topic``'s publisher (see :meth:`publish`) sees ``count`` subscribers."""
+        publisher = self._publishers[topic]
+        return self.spin_until(lambda: publisher.get_subscription_count() >= count, timeout)
+
+    def collect(
+        self, topic: str, msg_type: type, qos: QoSProfile | int = 10, raw: bool = False
+    ) -> list[Any]:
+        """Subscribes to ``topic`` and returns the list that received messages are appended to.
+
+        Args:
+            topic: Topic name.
+            msg_type: Message class.
+            qos: Profile or depth; use ``qos_profile_sensor_data`` for best-effort publishers.
+            raw: Receive serialized bytes instead of messages.
+
+        Returns:
+            A list that fills while the graph spins.
+        """
+        received: list[Any] = []
+        self.node.create_subscription(msg_type, topic, received.append, qos, raw=raw)
+        return received
+
+    def spin_until(self, predicate: Callable[[], bool], timeout: float = 5.0) -> bool:
+        """Spins the executor until ``predicate()`` is true or ``timeout`` seconds pass.
+
+        Returns:
+            Whether the predicate became true.
+        """
+        deadline = time.monotonic() + timeout
+        while not predicate():
+            if time.monotonic() > deadline:
+                return False
+            self.executor.spin_once(timeout_sec=0.01)
+        return True
+
+    def spin_for(self, seconds: float) -> None:
+        """Spins for a fixed time (to let discovery or a publisher settle)."""
+        self.spin_until(lambda: False, seconds)
+
+    def shutdown(self) -> None:
+        """Destroys the nodes and the context."""
+        self.executor.shutdown()
+        for node in list(self.executor.get_nodes()):
+            node.destroy_node()
+        rclpy.shutdown(context=self.context)
+
+
+SENSOR_QOS = qos_profile_sensor_data
+
+
+@pytest.fixture
+def ros_graph(monkeypatch: pytest.MonkeyPatch) -> Iterator[RosGraph]:
+    """A private ROS graph for one test (see the module docstring)."""
+    monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    log_dir = Path.cwd() / '.cache' / 'ros' / 'log'
+    log_dir.mkdir(parents=True, exist_ok=True)
+    monkeypatch.setenv('ROS_LOG_DIR', str(log_dir))
+    graph = RosGraph(next_domain_id())
+    try:
+        yield graph
+    finally:
+        graph.shutdown()
