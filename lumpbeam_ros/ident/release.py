@@ -8,7 +8,7 @@ springs up) followed by a free decay about a higher level.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -66,6 +66,9 @@ class Release:
 def detect_release(window: PoseWindow, config: IdentifierConfig) -> Release:
     """Finds the last release in a window, from ``/tip_load`` if present, else from the data.
 
+    When ``/tip_load`` readings show no drop but the data show a release, the data's release
+    is returned with half its confidence and a message.
+
     Args:
         window: Cleaned tip poses (and load readings).
         config: Thresholds (``min_step_snr``, ``min_quiet_s``).
@@ -74,7 +77,18 @@ def detect_release(window: PoseWindow, config: IdentifierConfig) -> Release:
         The release; ``source == 'none'`` with a message when there is none.
     """
     if len(window.loads) >= 2:
-        return _from_loads(window, config)
+        release = _from_loads(window, config)
+        if release.found:
+            return release
+        # Readings that never drop may be stale or mislabelled: trust the tip, but say so.
+        found = _from_data(window, config)
+        if found.found:
+            return replace(
+                found,
+                confidence=0.5 * found.confidence,
+                message='/tip_load shows no drop, but the tip does',
+            )
+        return release
     return _from_data(window, config)
 
 
