@@ -14,6 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import fftconvolve
 
+#: Lags looked ahead when deciding that the residual autocorrelation has died out.
+_LOOKAHEAD = 16
+
 
 @dataclass(frozen=True)
 class Covariance:
@@ -58,8 +61,10 @@ def autocorrelation(residuals: np.ndarray, max_lag: int) -> np.ndarray:
 def choose_lag(residuals: np.ndarray) -> int:
     """The Bartlett bandwidth: the Newey-West rule or twice the residual correlation length.
 
-    The correlation length is the last lag (up to N/4) whose autocorrelation exceeds
-    ``4 / sqrt(N)``, a level white noise crosses with probability below 1e-4 per lag.
+    The correlation length is the first lag from which the autocorrelation stays, over the
+    next :data:`_LOOKAHEAD` lags, within 2.5 Bartlett standard errors
+    ``sqrt((1 + 2 sum_{j<k} rho_j^2) / N)`` of zero. Looking ahead keeps an oscillating
+    autocorrelation (an unfitted mode) from ending at its first zero crossing.
 
     Args:
         residuals: Fit residuals.
@@ -71,11 +76,15 @@ def choose_lag(residuals: np.ndarray) -> int:
     rule = int(4.0 * (n / 100.0) ** (2.0 / 9.0))
     limit = max(1, n // 4)
     gamma = autocorrelation(residuals - residuals.mean(), limit)
-    if gamma[0] <= 0.0:
+    if gamma[0] <= 0.0 or limit < 2:
         return max(1, min(rule, limit))
-    rho = gamma[1:] / gamma[0]
-    significant = np.flatnonzero(np.abs(rho) > 4.0 / np.sqrt(n))
-    length = int(significant[-1]) + 1 if significant.size else 0
+    rho = np.abs(gamma[1:] / gamma[0])
+    se = np.sqrt((1.0 + 2.0 * np.concatenate([[0.0], np.cumsum(rho[:-1] ** 2)])) / n)
+    ahead = np.lib.stride_tricks.sliding_window_view(
+        np.concatenate([rho, np.zeros(_LOOKAHEAD - 1)]), _LOOKAHEAD
+    ).max(axis=1)
+    quiet = np.flatnonzero(ahead < 2.5 * se)
+    length = int(quiet[0]) if quiet.size else limit
     return int(np.clip(max(rule, 2 * length), 1, limit))
 
 
