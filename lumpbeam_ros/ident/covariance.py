@@ -72,12 +72,17 @@ def choose_lag(residuals: np.ndarray) -> int:
     Returns:
         The number of lags, at least 1 and at most N/4.
     """
+    return _lag_and_autocovariance(residuals)[0]
+
+
+def _lag_and_autocovariance(residuals: np.ndarray) -> tuple[int, np.ndarray]:
+    """:func:`choose_lag` and the autocovariances up to N/4 it was chosen from."""
     n = residuals.size
     rule = int(4.0 * (n / 100.0) ** (2.0 / 9.0))
     limit = max(1, n // 4)
     gamma = autocorrelation(residuals - residuals.mean(), limit)
     if gamma[0] <= 0.0 or limit < 2:
-        return max(1, min(rule, limit))
+        return max(1, min(rule, limit)), gamma
     rho = np.abs(gamma[1:] / gamma[0])
     se = np.sqrt((1.0 + 2.0 * np.concatenate([[0.0], np.cumsum(rho[:-1] ** 2)])) / n)
     ahead = np.lib.stride_tricks.sliding_window_view(
@@ -85,7 +90,7 @@ def choose_lag(residuals: np.ndarray) -> int:
     ).max(axis=1)
     quiet = np.flatnonzero(ahead < 2.5 * se)
     length = int(quiet[0]) if quiet.size else limit
-    return int(np.clip(max(rule, 2 * length), 1, limit))
+    return int(np.clip(max(rule, 2 * length), 1, limit)), gamma
 
 
 def sandwich_covariance(jacobian: np.ndarray, residuals: np.ndarray) -> Covariance:
@@ -108,10 +113,8 @@ def sandwich_covariance(jacobian: np.ndarray, residuals: np.ndarray) -> Covarian
     s2 = float(residuals @ residuals) / dof
     bread = np.linalg.pinv(jacobian.T @ jacobian)
     white = s2 * bread
-    lag = choose_lag(residuals)
-    gamma = autocorrelation(residuals, lag) * (n / dof)
-    weights = 1.0 - np.arange(lag + 1) / (lag + 1.0)
-    kernel = weights * gamma
+    lag, gamma = _lag_and_autocovariance(residuals)
+    kernel = _bartlett(lag) * gamma[: lag + 1] * (n / dof)
     kernel = np.concatenate([kernel[:0:-1], kernel])
     # J^T Sigma J with Sigma the Toeplitz matrix of the tapered autocovariances: Sigma J is a
     # convolution of each Jacobian column with the kernel, O(N log N) instead of O(N lag).
@@ -126,6 +129,9 @@ def sandwich_covariance(jacobian: np.ndarray, residuals: np.ndarray) -> Covarian
 def mean_with_std(values: np.ndarray) -> tuple[float, float]:
     """Mean of a stationary series and its standard error, allowing for autocorrelation.
 
+    The variance of the mean is the Bartlett long-run variance over N,
+    ``sum_{|k|<=lag} w_k gamma_k / N`` (the sandwich with a column of ones).
+
     Args:
         values: The series (at least 2 samples).
 
@@ -134,10 +140,17 @@ def mean_with_std(values: np.ndarray) -> tuple[float, float]:
     """
     if values.size < 2:
         return (float(values.mean()) if values.size else float('nan')), float('nan')
-    design = np.ones((values.size, 1))
+    n = values.size
     mean = float(values.mean())
-    cov = sandwich_covariance(design, values - mean)
-    return mean, float(np.sqrt(cov.matrix[0, 0]))
+    lag, gamma = _lag_and_autocovariance(values - mean)
+    weights = _bartlett(lag)
+    long_run = gamma[0] + 2.0 * float(weights[1:] @ gamma[1 : lag + 1])
+    return mean, float(np.sqrt(max(long_run, 0.0) * n / (n - 1) / n))
+
+
+def _bartlett(lag: int) -> np.ndarray:
+    """Bartlett weights ``1 - k / (lag + 1)`` for k = 0..lag."""
+    return 1.0 - np.arange(lag + 1) / (lag + 1.0)
 
 
 def propagate(gradient: np.ndarray, covariance: np.ndarray) -> float:

@@ -78,7 +78,8 @@ class MatrixPencil:
         centre = float(u.mean())
         scale = float(np.max(np.abs(u - centre))) or 1.0
         u = (u - centre) / scale
-        hankel = np.lib.stride_tricks.sliding_window_view(u, length + 1)
+        # Contiguous, so the Gram product below runs in BLAS.
+        hankel = np.ascontiguousarray(np.lib.stride_tricks.sliding_window_view(u, length + 1))
         # The right singular vectors from the small Gram matrix: an (L+1)^2 eigenproblem
         # instead of an SVD of the whole (N-L) x (L+1) Hankel matrix.
         gram = hankel.T @ hankel

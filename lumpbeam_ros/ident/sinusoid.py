@@ -105,36 +105,66 @@ class DampedSinusoidParams:
         return float(coef[0]), float(math.sqrt(cov.matrix[0, 0]))
 
 
+class _Decay:
+    """The model and its Jacobian on fixed stamps, sharing the exponentials between them.
+
+    The solver asks for the residuals and then the Jacobian at the same point; the decays,
+    cosines and sines (the costly part) are computed once for both.
+    """
+
+    def __init__(self, tau: np.ndarray, n_modes: int, drift: bool):
+        self.tau = tau
+        self.n_modes = n_modes
+        self.drift = drift
+        self._x: np.ndarray | None = None
+        self._basis: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def _update(self, x: np.ndarray) -> None:
+        if self._x is not None and np.array_equal(x, self._x):
+            return
+        self._x = x.copy()
+        first = 2 if self.drift else 1
+        self._basis = []
+        for m in range(self.n_modes):
+            s, w = x[first + 4 * m + 2 : first + 4 * m + 4]
+            decay = np.exp(-s * self.tau)
+            phase = w * self.tau
+            self._basis.append((decay * np.cos(phase), decay * np.sin(phase)))
+
+    def value(self, x: np.ndarray) -> np.ndarray:
+        """The model at parameters ``x``."""
+        self._update(x)
+        y = np.full(self.tau.shape, x[0])
+        first = 1
+        if self.drift:
+            y += x[1] * self.tau
+            first = 2
+        for m, (cos, sin) in enumerate(self._basis):
+            a, b = x[first + 4 * m : first + 4 * m + 2]
+            y += a * cos + b * sin
+        return y
+
+    def jacobian(self, x: np.ndarray) -> np.ndarray:
+        """d model / d x at parameters ``x``."""
+        self._update(x)
+        jac = np.empty((self.tau.size, x.size))
+        jac[:, 0] = 1.0
+        first = 1
+        if self.drift:
+            jac[:, 1] = self.tau
+            first = 2
+        for m, (cos, sin) in enumerate(self._basis):
+            k = first + 4 * m
+            a, b = x[k : k + 2]
+            jac[:, k] = cos
+            jac[:, k + 1] = sin
+            jac[:, k + 2] = -self.tau * (a * cos + b * sin)
+            jac[:, k + 3] = self.tau * (b * cos - a * sin)
+        return jac
+
+
 def _model(x: np.ndarray, tau: np.ndarray, n_modes: int, drift: bool) -> np.ndarray:
-    y = np.full(tau.shape, x[0])
-    first = 1
-    if drift:
-        y += x[1] * tau
-        first = 2
-    for m in range(n_modes):
-        a, b, s, w = x[first + 4 * m : first + 4 * m + 4]
-        y += np.exp(-s * tau) * (a * np.cos(w * tau) + b * np.sin(w * tau))
-    return y
-
-
-def _jacobian(x: np.ndarray, tau: np.ndarray, n_modes: int, drift: bool) -> np.ndarray:
-    jac = np.empty((tau.size, x.size))
-    jac[:, 0] = 1.0
-    first = 1
-    if drift:
-        jac[:, 1] = tau
-        first = 2
-    for m in range(n_modes):
-        k = first + 4 * m
-        a, b, s, w = x[k : k + 4]
-        decay = np.exp(-s * tau)
-        cos = decay * np.cos(w * tau)
-        sin = decay * np.sin(w * tau)
-        jac[:, k] = cos
-        jac[:, k + 1] = sin
-        jac[:, k + 2] = -tau * (a * cos + b * sin)
-        jac[:, k + 3] = tau * (b * cos - a * sin)
-    return jac
+    return _Decay(tau, n_modes, drift).value(x)
 
 
 def _design(tau: np.ndarray, decays: np.ndarray, omegas: np.ndarray, drift: bool) -> np.ndarray:
@@ -267,12 +297,9 @@ class DampedSinusoidFit:
             decays.append(zeta * w / math.sqrt(max(1.0 - zeta * zeta, 1e-12)))
         x0 = self._start(tau, y, np.asarray(decays), np.asarray(omegas))
         n_modes, drift = self.n_modes, self.drift
+        decay = _Decay(tau, n_modes, drift)
         solution = least_squares(
-            lambda x: _model(x, tau, n_modes, drift) - y,
-            x0,
-            jac=lambda x: _jacobian(x, tau, n_modes, drift),
-            method='lm',
-            x_scale='jac',
+            lambda x: decay.value(x) - y, x0, jac=decay.jacobian, method='lm', x_scale='jac'
         )
         x = solution.x
         if not np.all(np.isfinite(x)):
@@ -283,8 +310,8 @@ class DampedSinusoidFit:
             if x[k + 3] < 0.0:
                 x[k + 1] = -x[k + 1]
                 x[k + 3] = -x[k + 3]
-        residuals = _model(x, tau, n_modes, drift) - y
-        cov = sandwich_covariance(_jacobian(x, tau, n_modes, drift), residuals)
+        residuals = decay.value(x) - y
+        cov = sandwich_covariance(decay.jacobian(x), residuals)
         self.params_ = DampedSinusoidParams(
             origin,
             x,

@@ -18,7 +18,7 @@ def test_sandwich_equals_the_direct_lag_sum():
     res = np.convolve(rng.normal(size=410), np.ones(6), 'valid')[:400]
     cov = sandwich_covariance(jac, res)
     n, p = jac.shape
-    gamma = autocorrelation(res, cov.lag) * n / (n - p)
+    gamma = autocorrelation(res - res.mean(), cov.lag) * n / (n - p)
     meat = gamma[0] * jac.T @ jac
     for k in range(1, cov.lag + 1):
         cross = jac[:-k].T @ jac[k:]
