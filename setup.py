@@ -16,7 +16,7 @@ setup(
         (f'share/{PACKAGE}/config', glob('config/*.yaml')),
     ],
     package_data={PACKAGE: ['data/*.yaml']},
-    install_requires=['setuptools', 'numpy', 'scipy', 'pyyaml'],
+    install_requires=['setuptools', 'numpy', 'scipy', 'pyyaml', 'threadpoolctl'],
     zip_safe=True,
     maintainer='lumpbeam_ros maintainers',
     maintainer_email='lumpbeam@example.org',

@@ -1,0 +1,369 @@
+"""Identification of one window of tip poses: the paper's section B.3.2, automated.
+
+The steps: find the release (:mod:`~lumpbeam_ros.ident.release`); fit the free decay after
+it by least squares (:class:`~lumpbeam_ros.ident.sinusoid.DampedSinusoidFit`), started from
+the matrix pencil (:class:`~lumpbeam_ros.ident.pencil.MatrixPencil`), which also serves as a
+cross-check; take k_tE from the static rise by B.12 and c_tE from the damping by B.22; add
+the paper's own log decrement (B.20, B.21) for comparison; grade the result.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ident import stiffness
+from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.logdec import LogDecrement, LogDecrementResult, difference_noise_std
+from lumpbeam_ros.ident.modes import ModeEstimate
+from lumpbeam_ros.ident.pencil import MatrixPencil
+from lumpbeam_ros.ident.release import Release, detect_release
+from lumpbeam_ros.ident.result import Identification, Status
+from lumpbeam_ros.ident.samples import PoseWindow
+from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParams, ModeGuess
+from lumpbeam_ros.ident.threads import single_threaded_blas
+from lumpbeam_ros.model import rules
+from lumpbeam_ros.model.parameters import BeamParameters
+
+NAN = float('nan')
+METHOD = 'nls_damped_sinusoid'
+
+
+def identify(
+    window: PoseWindow,
+    beam: BeamParameters,
+    config: IdentifierConfig | None = None,
+    *,
+    strict: bool = False,
+) -> Identification:
+    """Identifies frequency, damping and stiffness from a window holding a load drop.
+
+    Args:
+        window: Cleaned tip poses (:func:`~lumpbeam_ros.ident.samples.clean_window` or
+            :meth:`~lumpbeam_ros.ident.window.SlidingWindow.snapshot`), with the
+            ``/tip_load`` readings if any.
+        beam: Supplies L, g, m_b and m_d (for B.12 and the frequency cross-check).
+        config: Settings (default: :class:`IdentifierConfig` defaults).
+        strict: Raise on unusable input (a batch call) instead of returning ERROR (live).
+
+    Returns:
+        The identification; ``status`` ERROR when the window holds no oscillation.
+
+    Raises:
+        LumpbeamError: Only with ``strict``: too few valid samples in the window or after
+            the release.
+    """
+    with single_threaded_blas():
+        return _identify(window, beam, config or IdentifierConfig(), strict)
+
+
+def _identify(
+    window: PoseWindow, beam: BeamParameters, config: IdentifierConfig, strict: bool
+) -> Identification:
+    base = {
+        'window_start_s': window.start_s,
+        'window_end_s': window.end_s,
+        'n_samples': len(window),
+        'n_rejected': window.counts.non_finite + window.counts.duplicates,
+    }
+
+    def fail(message: str, unusable: bool = False, **extra: object) -> Identification:
+        if strict and unusable:
+            raise LumpbeamError(message)
+        return Identification(Status.ERROR, message, **base, **extra)  # type: ignore[arg-type]
+
+    if len(window) < config.min_samples:
+        return fail(
+            f'{len(window)} valid pose samples, need at least {config.min_samples}',
+            unusable=True,
+        )
+    release = detect_release(window, config)
+    release_keys = {
+        'release_time_s': release.time_s,
+        'release_confidence': release.confidence,
+        'release_source': release.source,
+    }
+    start = window.start_s
+    if release.found and release.time_s >= window.start_s:
+        start = release.time_s + config.skip_after_release_s
+    keep = (window.t >= start) & (window.t <= start + config.max_fit_s)
+    t, z = window.t[keep], window.z[keep]
+    if t.size < config.min_samples:
+        return fail(
+            f'{t.size} pose samples after the release at {release.time_s:.3f} s, need '
+            f'{config.min_samples}',
+            unusable=True,
+            **release_keys,
+        )
+    noise = difference_noise_std(z)
+    guesses = _initial_modes(t, z, noise, config)
+    if not guesses:
+        return fail('no oscillation in the window', **release_keys)
+    try:
+        params = _fit_decay(t, z, guesses, start, config)
+    except LumpbeamError as exc:
+        return fail(f'no oscillation in the window ({exc})', **release_keys)
+    mode = params.mode(0)
+    rejection = _reject_mode(mode, params, config)
+    if rejection:
+        return fail(rejection, **release_keys)
+    return _assemble(window, beam, config, release, t, z, params, mode, guesses, base)
+
+
+def _initial_modes(
+    t: np.ndarray, z: np.ndarray, noise: float, config: IdentifierConfig
+) -> list[ModeGuess]:
+    """Starting modes from the matrix pencil: the strongest in band, then a second one."""
+    rate = 1.0 / float(np.median(np.diff(t)))
+    # Block means down to 2.25 samples per period of the highest frequency of interest:
+    # below Nyquist with a margin, and a quarter of the pencil's cost at 180 Hz.
+    decimation = max(1, int(rate / (2.25 * config.max_frequency_hz)))
+    try:
+        pencil = MatrixPencil(order=2 * config.max_modes + 3, decimation=decimation).fit(t, z)
+    except LumpbeamError:
+        return []
+    in_band = [
+        m
+        for m in pencil.modes
+        if config.min_frequency_hz <= m.damped_frequency_hz <= config.max_frequency_hz
+        and 0.0 < m.damping_ratio < 0.5
+    ]
+    if not in_band:
+        return []
+    first = in_band[0]
+    guesses = [(first.damped_frequency_hz, first.damping_ratio)]
+    if config.max_modes >= 2:
+        nyquist = 0.5 * rate / decimation
+        for m in pencil.modes:
+            if (
+                1.5 * first.damped_frequency_hz < m.damped_frequency_hz < 0.8 * nyquist
+                and 0.0 < m.damping_ratio < 0.3
+                and m.amplitude > 10.0 * noise
+            ):
+                guesses.append((m.damped_frequency_hz, m.damping_ratio))
+                break
+    return guesses
+
+
+def _fit_decay(
+    t: np.ndarray, z: np.ndarray, guesses: list[ModeGuess], start: float, config: IdentifierConfig
+) -> DampedSinusoidParams:
+    """The least-squares decay; a second mode that does not hold up is dropped."""
+    fit = DampedSinusoidFit(n_modes=len(guesses), drift=config.drift)
+    params = fit.fit(t, z, initial=guesses, t0=start)
+    if params.n_modes == 2:
+        second = params.mode(1)
+        sane = (
+            second.damped_frequency_hz > guesses[0][0]
+            and second.amplitude > 3.0 * second.amplitude_std
+            and second.decay_rate > 0.0
+        )
+        if not sane:
+            params = DampedSinusoidFit(n_modes=1, drift=config.drift).fit(
+                t, z, initial=guesses[:1], t0=start
+            )
+    return params
+
+
+def _reject_mode(
+    mode: ModeEstimate, params: DampedSinusoidParams, config: IdentifierConfig
+) -> str:
+    """Why the fitted first mode is not an oscillation of the beam, or ``''``."""
+    snr = mode.amplitude / max(params.residual_rms, 1e-15)
+    if snr < config.min_amplitude_snr:
+        return f'no oscillation in the window (amplitude {snr:.1f} x the residual noise)'
+    if not config.min_frequency_hz <= mode.damped_frequency_hz <= config.max_frequency_hz:
+        return (
+            f'no oscillation in the window (fitted {mode.damped_frequency_hz:.3g} Hz is '
+            f'outside {config.min_frequency_hz:g}..{config.max_frequency_hz:g} Hz)'
+        )
+    if not mode.damping_ratio > 0.0:
+        return 'no free decay in the window: the oscillation grows'
+    return ''
+
+
+def _damping_total(params: DampedSinusoidParams, mode: ModeEstimate) -> tuple[float, float]:
+    """c_tE = 2 zeta omega_d (B.22) and its std from the (sigma, omega_d) covariance."""
+    s, w = params.x[params.mode_slice(0)][2:]
+    wn = math.hypot(s, w)
+    value = rules.total_damping_from_ratio(mode.damping_ratio, mode.damped_omega)
+    grad = np.array([2.0 * w**3 / wn**3, 2.0 * s**3 / wn**3])
+    cov = params.covariance.matrix[params.mode_slice(0), params.mode_slice(0)][2:, 2:]
+    return value, float(math.sqrt(max(grad @ cov @ grad, 0.0)))
+
+
+def _assemble(
+    window: PoseWindow,
+    beam: BeamParameters,
+    config: IdentifierConfig,
+    release: Release,
+    t: np.ndarray,
+    z: np.ndarray,
+    params: DampedSinusoidParams,
+    mode: ModeEstimate,
+    guesses: list[ModeGuess],
+    base: dict[str, float | int],
+) -> Identification:
+    warnings: list[str] = []
+    cycles = float((t[-1] - t[0]) * mode.damped_frequency_hz)
+    damping_total, damping_total_std = _damping_total(params, mode)
+    load = release.load_kg if math.isfinite(release.load_kg) else config.assumed_load_kg
+    tip_mass = beam.tip_mass_kg + (
+        release.load_after_kg if math.isfinite(release.load_after_kg) else 0.0
+    )
+    k_freq, k_freq_std = stiffness.from_frequency(
+        mode.natural_frequency_hz,
+        mode.natural_frequency_hz_std,
+        tip_mass,
+        beam.mass_kg,
+        config.beam_mass_fraction,
+    )
+    level_after, level_after_std = params.offset, params.offset_std
+    deflection = level_after - release.level_before_m
+    deflection_std = math.hypot(level_after_std, release.level_before_std_m)
+    static = stiffness.from_static_change(
+        deflection, deflection_std, load, beam.length_m, beam.gravity_mps2
+    )
+    k_pitch, k_pitch_std = _pitch_stiffness(window, release, params, float(t[-1]), load, beam)
+    logdec = _log_decrement(t, z, params)
+    pencil = _pencil_first(guesses)
+
+    if not release.found:
+        warnings.append(f'{release.message}; stiffness needs a release in the window')
+    elif release.confidence < config.min_release_confidence:
+        warnings.append(f'release uncertain (confidence {release.confidence:.2f})')
+    if release.message and release.found:
+        warnings.append(release.message)
+    if release.found and math.isfinite(release.level_before_m) and not deflection > 0.0:
+        warnings.append(f'the static tip level did not rise at the release ({deflection:.3g} m)')
+    if cycles < config.min_cycles:
+        warnings.append(f'only {cycles:.1f} cycles fitted')
+    _check_rel(
+        warnings,
+        'frequency',
+        mode.natural_frequency_hz,
+        mode.natural_frequency_hz_std,
+        config.warn_rel_std_frequency,
+    )
+    _check_rel(
+        warnings,
+        'damping ratio',
+        mode.damping_ratio,
+        mode.damping_ratio_std,
+        config.warn_rel_std_damping,
+    )
+    _check_rel(
+        warnings,
+        'stiffness',
+        static.total_nm_per_rad,
+        static.total_nm_per_rad_std,
+        config.warn_rel_std_stiffness,
+    )
+    pencil_zeta = pencil[1]
+    if math.isfinite(pencil_zeta):
+        gap = abs(pencil_zeta - mode.damping_ratio) / mode.damping_ratio
+        if gap > config.warn_cross_check_damping:
+            warnings.append(
+                f'matrix pencil damping ratio {pencil_zeta:.3g} disagrees with the fit '
+                f'{mode.damping_ratio:.3g}'
+            )
+    method = METHOD if params.n_modes == 1 else f'{METHOD}_{params.n_modes}modes'
+    if warnings:
+        status, message = Status.WARN, '; '.join(warnings)
+    else:
+        status = Status.OK
+        message = (
+            f'f_n {mode.natural_frequency_hz:.4f} Hz, zeta {mode.damping_ratio:.4g}, '
+            f'k_tE {static.total_nm_per_rad:.1f} N m/rad over {cycles:.1f} cycles'
+        )
+    return Identification(
+        status=status,
+        message=message,
+        method=method,
+        natural_frequency_hz=mode.natural_frequency_hz,
+        natural_frequency_hz_std=mode.natural_frequency_hz_std,
+        damped_frequency_hz=mode.damped_frequency_hz,
+        damped_frequency_hz_std=mode.damped_frequency_hz_std,
+        damping_ratio=mode.damping_ratio,
+        damping_ratio_std=mode.damping_ratio_std,
+        log_decrement=mode.log_decrement,
+        log_decrement_std=mode.log_decrement_std,
+        stiffness_total_nm_per_rad=static.total_nm_per_rad,
+        stiffness_total_nm_per_rad_std=static.total_nm_per_rad_std,
+        stiffness_vertical_n_per_m=static.vertical_n_per_m,
+        stiffness_vertical_n_per_m_std=static.vertical_n_per_m_std,
+        damping_total=damping_total,
+        damping_total_std=damping_total_std,
+        cycles=cycles,
+        release_time_s=release.time_s,
+        static_deflection_m=deflection,
+        static_deflection_m_std=deflection_std,
+        release_confidence=release.confidence,
+        release_source=release.source,
+        released_load_kg=load,
+        level_before_m=release.level_before_m,
+        level_before_m_std=release.level_before_std_m,
+        level_after_m=level_after,
+        level_after_m_std=level_after_std,
+        log_decrement_b20=logdec.log_decrement if logdec else NAN,
+        log_decrement_b20_std=logdec.log_decrement_std if logdec else NAN,
+        damping_ratio_b20=logdec.damping_ratio if logdec else NAN,
+        damping_ratio_b20_std=logdec.damping_ratio_std if logdec else NAN,
+        damped_frequency_b20_hz=logdec.damped_frequency_hz if logdec else NAN,
+        damped_frequency_b20_hz_std=logdec.damped_frequency_hz_std if logdec else NAN,
+        natural_frequency_pencil_hz=pencil[0],
+        damping_ratio_pencil=pencil_zeta,
+        stiffness_vertical_from_frequency_n_per_m=k_freq,
+        stiffness_vertical_from_frequency_n_per_m_std=k_freq_std,
+        stiffness_total_from_pitch_nm_per_rad=k_pitch,
+        stiffness_total_from_pitch_nm_per_rad_std=k_pitch_std,
+        amplitude_m=mode.amplitude,
+        residual_rms_m=params.residual_rms,
+        covariance_inflation=params.covariance.inflation,
+        second_mode_hz=params.mode(1).damped_frequency_hz if params.n_modes > 1 else NAN,
+        **base,  # type: ignore[arg-type]
+    )
+
+
+def _check_rel(warnings: list[str], name: str, value: float, std: float, limit: float) -> None:
+    if math.isfinite(value) and value != 0.0 and std / abs(value) > limit:
+        warnings.append(f'{name} uncertain (relative std {std / abs(value):.2g})')
+
+
+def _pencil_first(guesses: list[ModeGuess]) -> tuple[float, float]:
+    """Natural frequency and damping ratio of the pencil's first mode (the fit's start)."""
+    f_d, zeta = guesses[0]
+    return f_d / math.sqrt(1.0 - zeta * zeta), zeta
+
+
+def _log_decrement(
+    t: np.ndarray, z: np.ndarray, params: DampedSinusoidParams
+) -> LogDecrementResult | None:
+    """The paper's B.20/B.21 on the same stretch, about the fitted level; None if it fails."""
+    try:
+        return LogDecrement().fit(t, z, offset=params.offset, noise_std=params.residual_rms)
+    except LumpbeamError:
+        return None
+
+
+def _pitch_stiffness(
+    window: PoseWindow,
+    release: Release,
+    params: DampedSinusoidParams,
+    end: float,
+    load: float,
+    beam: BeamParameters,
+) -> tuple[float, float]:
+    """k_tE from the fall of the static pitch (slope form of B.12), as a cross-check."""
+    if not math.isfinite(release.pitch_before_rad):
+        return NAN, NAN
+    keep = (window.t >= params.t0) & (window.t <= end)
+    pitch = window.pitch[keep]
+    if pitch.size < 10 or not np.all(np.isfinite(pitch)):
+        return NAN, NAN
+    after, after_std = params.offset_of(window.t[keep], pitch)
+    change = release.pitch_before_rad - after
+    change_std = math.hypot(after_std, release.pitch_before_std_rad)
+    return stiffness.from_pitch_change(change, change_std, load, beam.length_m, beam.gravity_mps2)

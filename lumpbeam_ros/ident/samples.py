@@ -1,0 +1,169 @@
+"""Tip-pose samples as the estimators take them, and their validation.
+
+A :class:`PoseWindow` is what the identifier analyses: stamps, vertical tip position and tip
+pitch (SPEC section 2), plus the ``/tip_load`` readings that fall in or just before it.
+:func:`clean_window` turns raw samples (a bag, a live buffer) into strictly increasing, finite
+arrays and counts what it dropped, so a bad sample never becomes an exception in a live node.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from lumpbeam_ros.errors import LumpbeamError
+
+
+@dataclass(frozen=True)
+class LoadReadings:
+    """``/tip_load`` readings: the mass hanging at the tip from each stamp on.
+
+    Attributes:
+        t: Stamps, s, increasing.
+        kg: Mass at the tip from that stamp on, kg.
+    """
+
+    t: np.ndarray = field(default_factory=lambda: np.empty(0))
+    kg: np.ndarray = field(default_factory=lambda: np.empty(0))
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+
+@dataclass(frozen=True)
+class SampleCounts:
+    """What validation removed from a window.
+
+    Attributes:
+        received: Samples given.
+        non_finite: Samples dropped for a NaN or inf stamp, z or pitch.
+        duplicates: Samples dropped because an earlier one had the same stamp.
+        reordered: Whether the stamps had to be sorted.
+    """
+
+    received: int = 0
+    non_finite: int = 0
+    duplicates: int = 0
+    reordered: bool = False
+
+    @property
+    def kept(self) -> int:
+        """Samples left after validation."""
+        return self.received - self.non_finite - self.duplicates
+
+
+@dataclass(frozen=True)
+class PoseWindow:
+    """Tip poses in frame ``beam_base`` over a stretch of time.
+
+    Attributes:
+        t: Stamps, s (strictly increasing after :func:`clean_window`).
+        z: Vertical tip position, m.
+        pitch: Tip slope about +y, rad.
+        loads: ``/tip_load`` readings in the window (and the last one before it), if any.
+        counts: What validation removed.
+    """
+
+    t: np.ndarray
+    z: np.ndarray
+    pitch: np.ndarray
+    loads: LoadReadings = field(default_factory=LoadReadings)
+    counts: SampleCounts = field(default_factory=SampleCounts)
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    @property
+    def start_s(self) -> float:
+        """First stamp (NaN when empty)."""
+        return float(self.t[0]) if self.t.size else float('nan')
+
+    @property
+    def end_s(self) -> float:
+        """Last stamp (NaN when empty)."""
+        return float(self.t[-1]) if self.t.size else float('nan')
+
+
+def _as_1d(name: str, values: object) -> np.ndarray:
+    try:
+        array = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise LumpbeamError(f'{name}: expected numbers') from None
+    if array.ndim != 1:
+        raise LumpbeamError(f'{name}: expected a 1-D sequence, got shape {array.shape}')
+    return array
+
+
+def clean_loads(t: object, kg: object) -> LoadReadings:
+    """Validates ``/tip_load`` readings: drops non-finite ones, sorts, keeps the last per stamp.
+
+    Args:
+        t: Stamps, s.
+        kg: Mass at the tip, kg.
+
+    Returns:
+        The readings, increasing in time.
+
+    Raises:
+        LumpbeamError: The arrays are not 1-D or differ in length.
+    """
+    t_arr, kg_arr = _as_1d('load stamps', t), _as_1d('load masses', kg)
+    if t_arr.size != kg_arr.size:
+        raise LumpbeamError(f'load readings: {t_arr.size} stamps but {kg_arr.size} masses')
+    keep = np.isfinite(t_arr) & np.isfinite(kg_arr)
+    t_arr, kg_arr = t_arr[keep], kg_arr[keep]
+    order = np.argsort(t_arr, kind='stable')
+    t_arr, kg_arr = t_arr[order], kg_arr[order]
+    # The later reading of a stamp wins: it is the one the experiment published last.
+    last = np.ones(t_arr.size, dtype=bool)
+    last[:-1] = np.diff(t_arr) > 0.0
+    return LoadReadings(t_arr[last], kg_arr[last])
+
+
+def clean_window(
+    t: object,
+    z: object,
+    pitch: object | None = None,
+    loads: LoadReadings | None = None,
+) -> PoseWindow:
+    """Validates tip-pose samples.
+
+    Non-finite samples are dropped, stamps sorted, and of several samples with one stamp the
+    first is kept. Gaps are left as they are: the estimators work on uneven stamps.
+
+    Args:
+        t: Stamps, s.
+        z: Vertical tip positions, m.
+        pitch: Tip pitches, rad; ``None`` fills NaN (the pitch cross-check is then skipped).
+        loads: ``/tip_load`` readings, if any.
+
+    Returns:
+        The cleaned window, with the counts of what was removed.
+
+    Raises:
+        LumpbeamError: The arrays are not 1-D numbers or differ in length.
+    """
+    t_arr, z_arr = _as_1d('stamps', t), _as_1d('z', z)
+    p_arr = np.full(t_arr.size, np.nan) if pitch is None else _as_1d('pitch', pitch)
+    if not t_arr.size == z_arr.size == p_arr.size:
+        raise LumpbeamError(
+            f'pose samples: {t_arr.size} stamps, {z_arr.size} z and {p_arr.size} pitch values'
+        )
+    received = int(t_arr.size)
+    keep = np.isfinite(t_arr) & np.isfinite(z_arr)
+    if pitch is not None:
+        keep &= np.isfinite(p_arr)
+    non_finite = received - int(np.count_nonzero(keep))
+    t_arr, z_arr, p_arr = t_arr[keep], z_arr[keep], p_arr[keep]
+    reordered = bool(np.any(np.diff(t_arr) < 0.0))
+    if reordered:
+        order = np.argsort(t_arr, kind='stable')
+        t_arr, z_arr, p_arr = t_arr[order], z_arr[order], p_arr[order]
+    first = np.ones(t_arr.size, dtype=bool)
+    first[1:] = np.diff(t_arr) > 0.0
+    duplicates = int(t_arr.size - np.count_nonzero(first))
+    if duplicates:
+        t_arr, z_arr, p_arr = t_arr[first], z_arr[first], p_arr[first]
+    counts = SampleCounts(received, non_finite, duplicates, reordered)
+    return PoseWindow(t_arr, z_arr, p_arr, loads or LoadReadings(), counts)

@@ -1,0 +1,52 @@
+import math
+
+import numpy as np
+import pytest
+
+from lumpbeam_ros.ident.covariance import (
+    autocorrelation,
+    choose_lag,
+    mean_with_std,
+    propagate,
+    sandwich_covariance,
+)
+
+
+def test_sandwich_equals_the_direct_lag_sum():
+    rng = np.random.default_rng(1)
+    jac = rng.normal(size=(400, 3))
+    res = np.convolve(rng.normal(size=410), np.ones(6), 'valid')[:400]
+    cov = sandwich_covariance(jac, res)
+    n, p = jac.shape
+    gamma = autocorrelation(res - res.mean(), cov.lag) * n / (n - p)
+    meat = gamma[0] * jac.T @ jac
+    for k in range(1, cov.lag + 1):
+        cross = jac[:-k].T @ jac[k:]
+        meat += (1 - k / (cov.lag + 1)) * gamma[k] * (cross + cross.T)
+    bread = np.linalg.inv(jac.T @ jac)
+    np.testing.assert_allclose(cov.matrix, bread @ meat @ bread, rtol=1e-10)
+    assert cov.lag >= 8  # the moving average correlates 5 lags
+
+
+def test_white_residuals_give_the_textbook_covariance():
+    rng = np.random.default_rng(2)
+    cov = sandwich_covariance(rng.normal(size=(3000, 2)), rng.normal(size=3000))
+    assert cov.inflation == pytest.approx(1.0, abs=0.2)
+    assert choose_lag(rng.normal(size=3000)) == int(4 * 30 ** (2 / 9))
+
+
+def test_mean_of_correlated_series_has_a_wider_error():
+    rng = np.random.default_rng(3)
+    e = rng.normal(size=20000)
+    ar = np.empty_like(e)
+    ar[0] = e[0]
+    for i in range(1, e.size):
+        ar[i] = 0.8 * ar[i - 1] + e[i]
+    _, std = mean_with_std(ar)
+    # Long-run std of an AR(1) mean: sigma_e / (1 - phi) / sqrt(N).
+    assert std == pytest.approx(1 / 0.2 / math.sqrt(ar.size), rel=0.2)
+    assert math.isnan(mean_with_std(np.array([1.0]))[1])
+
+
+def test_propagate():
+    assert propagate(np.array([1.0, 2.0]), np.diag([4.0, 1.0])) == pytest.approx(math.sqrt(8.0))

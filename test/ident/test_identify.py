@@ -1,0 +1,182 @@
+import math
+
+import numpy as np
+import pytest
+
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.identify import identify
+from lumpbeam_ros.ident.result import Status
+from lumpbeam_ros.ident.samples import clean_loads, clean_window
+from lumpbeam_ros.model.parameters import BeamParameters
+
+BEAM = BeamParameters()
+
+# (damping scale, noise m, tolerances on f_n, zeta, k_tE, all relative), from the brief.
+CASES = {
+    'nominal': (1.0, 20e-6, 1e-3, 0.05, 0.01),
+    'damped10x_noise50um': (10.0, 50e-6, 5e-3, 0.15, 0.03),
+}
+
+
+def _window(trajectory, with_loads):
+    loads = clean_loads(trajectory.t, trajectory.load_kg) if with_loads else None
+    return clean_window(trajectory.t, trajectory.z, trajectory.pitch, loads)
+
+
+@pytest.mark.parametrize('with_loads', [True, False], ids=['tip_load', 'data_only'])
+@pytest.mark.parametrize('seed', [0, 1, 2])
+@pytest.mark.parametrize('case', sorted(CASES))
+def test_accuracy_and_honest_std(drop_case, case, seed, with_loads):
+    scale, noise, tol_f, tol_zeta, tol_k = CASES[case]
+    trajectory, truth = drop_case(damping_scale=scale, noise_m=noise, seed=seed)
+    result = identify(_window(trajectory, with_loads), BEAM)
+    assert result.status == Status.OK, result.message
+    assert result.release_source == ('tip_load' if with_loads else 'data')
+    assert abs(result.release_time_s - truth.release_time_s) < 2.0 / 180.0
+    checks = [
+        ('natural_frequency_hz', truth.natural_frequency_hz, tol_f),
+        ('damping_ratio', truth.damping_ratio, tol_zeta),
+        ('stiffness_total_nm_per_rad', truth.stiffness_total_nm_per_rad, tol_k),
+        ('static_deflection_m', truth.static_deflection_m, tol_k),
+    ]
+    for key, true, tol in checks:
+        value, std = getattr(result, key), getattr(result, f'{key}_std')
+        assert abs(value - true) <= tol * true, (key, value, true)
+        assert abs(value - true) <= 3.0 * std, (key, value, true, std)
+
+
+def test_derived_figures_follow_the_paper(drop_case):
+    trajectory, _ = drop_case()
+    r = identify(_window(trajectory, True), BEAM)
+    # B.21 links the decrement and the damping ratio; B.22 gives c_tE; f_n = f_d/sqrt(1-z^2).
+    assert r.damping_ratio == pytest.approx(
+        1 / math.sqrt(1 + (2 * math.pi / r.log_decrement) ** 2)
+    )
+    assert r.damping_total == pytest.approx(
+        2 * r.damping_ratio * 2 * math.pi * r.damped_frequency_hz
+    )
+    assert r.natural_frequency_hz == pytest.approx(
+        r.damped_frequency_hz / math.sqrt(1 - r.damping_ratio**2)
+    )
+    force = 4.5 * BEAM.gravity_mps2
+    assert r.stiffness_vertical_n_per_m == pytest.approx(force / r.static_deflection_m)
+    assert r.stiffness_total_nm_per_rad == pytest.approx(
+        2 * force * BEAM.length_m**2 / (3 * r.static_deflection_m)
+    )
+    # The cross-checks agree with the headline figures within their own accuracy.
+    assert r.damping_ratio_b20 == pytest.approx(r.damping_ratio, rel=0.05)
+    assert r.natural_frequency_pencil_hz == pytest.approx(r.natural_frequency_hz, rel=1e-3)
+    assert r.stiffness_total_from_pitch_nm_per_rad == pytest.approx(3899.1, rel=0.01)
+    assert r.stiffness_vertical_from_frequency_n_per_m == pytest.approx(
+        r.stiffness_vertical_n_per_m, rel=0.05
+    )
+
+
+def test_result_carries_the_spec_keys(drop_case):
+    trajectory, _ = drop_case()
+    r = identify(_window(trajectory, True), BEAM)
+    d = r.as_dict()
+    spec = [
+        'natural_frequency_hz',
+        'damped_frequency_hz',
+        'damping_ratio',
+        'log_decrement',
+        'stiffness_total_nm_per_rad',
+        'stiffness_vertical_n_per_m',
+        'damping_total',
+    ]
+    for key in spec:
+        assert math.isfinite(d[key]) and math.isfinite(d[f'{key}_std']) and d[f'{key}_std'] > 0
+    for key in [
+        'window_start_s',
+        'window_end_s',
+        'cycles',
+        'release_time_s',
+        'static_deflection_m',
+    ]:
+        assert math.isfinite(d[key])
+    assert d['status'] == 'OK' and d['method'].startswith('nls_damped_sinusoid')
+    assert 29 < d['cycles'] < 31
+    pairs = dict(r.key_values())
+    assert float(pairs['natural_frequency_hz']) == r.natural_frequency_hz
+    assert pairs['natural_frequency_hz'] == repr(r.natural_frequency_hz)
+    assert 'status' not in pairs and pairs['method'] == r.method
+
+
+def test_second_mode_is_fitted_when_present(drop_case):
+    trajectory, _ = drop_case()
+    r = identify(_window(trajectory, False), BEAM)
+    assert r.method.endswith('2modes')
+    assert r.second_mode_hz == pytest.approx(25.0, rel=0.01)
+    single = identify(_window(trajectory, False), BEAM, IdentifierConfig(max_modes=1))
+    assert single.method == 'nls_damped_sinusoid' and math.isnan(single.second_mode_hz)
+
+
+def test_static_window_is_an_error_not_an_exception(drop_case):
+    trajectory, _ = drop_case()
+    quiet = trajectory.slice_time(0.0, 1.9)
+    r = identify(clean_window(quiet.t, quiet.z, quiet.pitch), BEAM, strict=True)
+    assert r.status == Status.ERROR and 'no oscillation' in r.message
+    assert math.isnan(r.natural_frequency_hz)
+
+
+def test_too_few_samples_is_error_live_and_raises_in_batch(drop_case):
+    trajectory, _ = drop_case()
+    few = trajectory.slice_time(2.5, 2.6)
+    window = clean_window(few.t, few.z, few.pitch)
+    r = identify(window, BEAM)
+    assert r.status == Status.ERROR and 'valid pose samples' in r.message
+    with pytest.raises(LumpbeamError, match='valid pose samples'):
+        identify(window, BEAM, strict=True)
+    late = trajectory.slice_time(0.0, 2.1)
+    with pytest.raises(LumpbeamError, match='after the release'):
+        identify(clean_window(late.t, late.z, late.pitch), BEAM, strict=True)
+
+
+def test_bad_samples_and_gaps_are_tolerated(drop_case):
+    trajectory, truth = drop_case(seed=3)
+    t, z, pitch = trajectory.t.copy(), trajectory.z.copy(), trajectory.pitch.copy()
+    z[::97] = np.nan
+    pitch[5::113] = np.inf
+    gap = (t > 6.0) & (t < 6.7)
+    t, z, pitch = t[~gap], z[~gap], pitch[~gap]
+    order = np.random.default_rng(0).permutation(t.size)
+    t = np.concatenate([t[order], t[:40]])
+    z = np.concatenate([z[order], z[:40]])
+    pitch = np.concatenate([pitch[order], pitch[:40]])
+    window = clean_window(t, z, pitch)
+    r = identify(window, BEAM)
+    assert r.ok, r.message
+    assert r.n_rejected == window.counts.non_finite + window.counts.duplicates > 40
+    assert r.natural_frequency_hz == pytest.approx(truth.natural_frequency_hz, rel=1e-3)
+    assert r.damping_ratio == pytest.approx(truth.damping_ratio, rel=0.05)
+
+
+def test_short_decay_warns(drop_case):
+    trajectory, _ = drop_case()
+    part = trajectory.slice_time(0.0, 2.6)
+    r = identify(clean_window(part.t, part.z, part.pitch), BEAM)
+    assert r.status == Status.WARN and 'cycles' in r.message
+    assert r.natural_frequency_hz == pytest.approx(3.07, rel=0.01)
+
+
+def test_window_without_release_gives_dynamics_but_warns_on_stiffness(drop_case):
+    trajectory, truth = drop_case()
+    part = trajectory.slice_time(3.0, 12.0)
+    r = identify(clean_window(part.t, part.z, part.pitch), BEAM)
+    assert r.status == Status.WARN and 'stiffness' in r.message
+    assert math.isnan(r.stiffness_total_nm_per_rad)
+    assert r.natural_frequency_hz == pytest.approx(truth.natural_frequency_hz, rel=1e-3)
+
+
+def test_loads_that_never_drop_fall_back_to_the_data_with_a_warning(drop_case):
+    trajectory, truth = drop_case()
+    loads = clean_loads(trajectory.t, np.full(trajectory.t.size, 4.5))
+    r = identify(clean_window(trajectory.t, trajectory.z, trajectory.pitch, loads), BEAM)
+    assert r.release_source == 'data' and r.status == Status.WARN
+    assert 'shows no drop' in r.message
+    assert r.release_confidence == pytest.approx(0.5)
+    assert r.stiffness_total_nm_per_rad == pytest.approx(
+        truth.stiffness_total_nm_per_rad, rel=0.01
+    )

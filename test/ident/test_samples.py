@@ -1,0 +1,44 @@
+import numpy as np
+import pytest
+
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ident.samples import clean_loads, clean_window
+
+
+def test_clean_window_drops_sorts_and_dedups():
+    t = [0.3, 0.1, 0.2, 0.2, np.nan, 0.4, 0.5]
+    z = [3.0, 1.0, 2.0, 9.0, 5.0, np.inf, 5.0]
+    pitch = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, np.nan]
+    w = clean_window(t, z, pitch)
+    np.testing.assert_array_equal(w.t, [0.1, 0.2, 0.3])
+    np.testing.assert_array_equal(w.z, [1.0, 2.0, 3.0])  # the first of a repeated stamp
+    assert w.counts.non_finite == 3 and w.counts.duplicates == 1
+    assert w.counts.reordered and w.counts.kept == 3
+    assert (w.start_s, w.end_s) == (0.1, 0.3)
+
+
+def test_missing_pitch_is_nan_and_not_a_rejection():
+    w = clean_window([0.0, 1.0], [1.0, 2.0])
+    assert np.all(np.isnan(w.pitch)) and w.counts.non_finite == 0
+
+
+@pytest.mark.parametrize(
+    ('t', 'z', 'pitch', 'match'),
+    [
+        ([0.0, 1.0], [1.0], None, '2 stamps, 1 z'),
+        ([[0.0, 1.0]], [[1.0, 2.0]], None, '1-D'),
+        (['a', 'b'], [1.0, 2.0], None, 'expected numbers'),
+        ([0.0, 1.0], [1.0, 2.0], [0.0], 'pitch values'),
+    ],
+)
+def test_clean_window_rejects_malformed_input(t, z, pitch, match):
+    with pytest.raises(LumpbeamError, match=match):
+        clean_window(t, z, pitch)
+
+
+def test_clean_loads_keeps_last_reading_per_stamp():
+    loads = clean_loads([1.0, 0.0, 1.0, np.nan], [0.0, 4.5, 2.0, 1.0])
+    np.testing.assert_array_equal(loads.t, [0.0, 1.0])
+    np.testing.assert_array_equal(loads.kg, [4.5, 2.0])
+    with pytest.raises(LumpbeamError, match='2 stamps but 1 masses'):
+        clean_loads([0.0, 1.0], [1.0])

@@ -1,0 +1,85 @@
+import math
+
+import numpy as np
+import pytest
+
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, spectral_peak_hz
+
+T = np.arange(0.0, 8.0, 1.0 / 180.0)
+F_D, ZETA, OFFSET, AMP = 3.1, 0.01, -0.01, 0.02
+
+
+def _decay(t, f_d=F_D, zeta=ZETA, amp=AMP, phase=0.3):
+    w = 2 * math.pi * f_d
+    sigma = zeta * w / math.sqrt(1 - zeta**2)
+    return amp * np.exp(-sigma * t) * np.cos(w * t + phase)
+
+
+def _ar1(rng, n, phi, std):
+    """AR(1) noise of marginal std ``std``: what a smoothing tracker leaves."""
+    e = rng.normal(0.0, std * math.sqrt(1 - phi**2), n + 200)
+    out = np.empty_like(e)
+    out[0] = e[0]
+    for i in range(1, e.size):
+        out[i] = phi * out[i - 1] + e[i]
+    return out[200:]
+
+
+def test_fit_recovers_a_clean_decay_and_predicts_it():
+    y = OFFSET + _decay(T)
+    fit = DampedSinusoidFit()
+    params = fit.fit(T, y)
+    mode = params.mode(0)
+    assert mode.damped_frequency_hz == pytest.approx(F_D, rel=1e-9)
+    assert mode.damping_ratio == pytest.approx(ZETA, rel=1e-7)
+    assert params.offset == pytest.approx(OFFSET, abs=1e-12)
+    assert mode.amplitude == pytest.approx(AMP, rel=1e-8)
+    np.testing.assert_allclose(fit.predict(T), y, atol=1e-12)
+
+
+def test_drift_and_second_mode_are_fitted():
+    y = OFFSET + 1e-4 * T + _decay(T) + _decay(T, f_d=21.0, zeta=0.02, amp=5e-4)
+    params = DampedSinusoidFit(n_modes=2, drift=True).fit(T, y)
+    assert params.drift_rate == pytest.approx(1e-4, rel=1e-6)
+    assert params.mode(1).damped_frequency_hz == pytest.approx(21.0, rel=1e-6)
+    assert params.mode(0).damping_ratio == pytest.approx(ZETA, rel=1e-6)
+
+
+@pytest.mark.parametrize(('phi', 'noise'), [(0.0, 50e-6), (0.9, 50e-6)], ids=['white', 'ar1'])
+def test_reported_std_matches_the_scatter(phi, noise):
+    # Monte Carlo: the spread of 80 fits must match the std each fit reports, also when the
+    # noise is correlated, where the white-noise formula would be ~4x too small.
+    rng = np.random.default_rng(11)
+    freqs, zetas, f_std, z_std, white = [], [], [], [], []
+    for _ in range(80):
+        y = OFFSET + _decay(T) + _ar1(rng, T.size, phi, noise)
+        params = DampedSinusoidFit().fit(T, y)
+        mode = params.mode(0)
+        freqs.append(mode.damped_frequency_hz)
+        zetas.append(mode.damping_ratio)
+        f_std.append(mode.damped_frequency_hz_std)
+        z_std.append(mode.damping_ratio_std)
+        white.append(math.sqrt(params.covariance.white[4, 4]) / (2 * math.pi))
+    for values, stds in ((freqs, f_std), (zetas, z_std)):
+        ratio = np.std(values) / np.mean(stds)
+        assert 0.75 < ratio < 1.33, ratio
+    white_ratio = np.std(freqs) / np.mean(white)
+    assert (white_ratio > 2.0) if phi else (0.75 < white_ratio < 1.33)
+
+
+def test_predict_before_fit_and_too_few_samples_raise():
+    with pytest.raises(LumpbeamError, match='before fit'):
+        DampedSinusoidFit().predict(T)
+    with pytest.raises(LumpbeamError, match='7 samples for 5 parameters'):
+        DampedSinusoidFit().fit(T[:7], T[:7])
+    with pytest.raises(ValueError):
+        DampedSinusoidFit(n_modes=0)
+
+
+def test_spectral_peak_on_uneven_stamps():
+    t = np.sort(np.random.default_rng(1).uniform(0, 10, 1500))
+    assert spectral_peak_hz(t, np.sin(2 * math.pi * 4.2 * t), 1.0, 20.0) == pytest.approx(
+        4.2, rel=2e-3
+    )
+    assert math.isnan(spectral_peak_hz(t, np.sin(t), 500.0, 600.0))

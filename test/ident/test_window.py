@@ -1,0 +1,92 @@
+import math
+
+import numpy as np
+import pytest
+
+from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.identify import identify
+from lumpbeam_ros.ident.result import Status
+from lumpbeam_ros.ident.window import SlidingWindow
+from lumpbeam_ros.model.parameters import BeamParameters
+
+
+def test_rejections_are_counted_not_raised():
+    w = SlidingWindow(length_s=1.0, max_rate_hz=10.0)
+    assert w.push(1.0, 0.1, 0.0)
+    assert not w.push(1.0, 0.2, 0.0)  # duplicate
+    assert not w.push(0.5, 0.2, 0.0)  # out of order, within the jump
+    assert not w.push(2.0, math.nan, 0.0)
+    assert not w.push(math.inf, 0.1, 0.0)
+    assert w.push(1.1, 0.3, 0.0)
+    c = w.counts
+    assert (c.accepted, c.duplicates, c.out_of_order, c.non_finite) == (2, 1, 1, 2)
+    snap = w.snapshot()
+    np.testing.assert_array_equal(snap.z, [0.1, 0.3])
+    assert snap.counts.non_finite == 2 and snap.counts.duplicates == 2
+
+
+def test_ring_keeps_the_last_length_s_in_order():
+    w = SlidingWindow(length_s=1.0, max_rate_hz=100.0)
+    t = np.arange(0.0, 5.0, 0.01)
+    for stamp in t:
+        w.push(stamp, stamp * 2.0, -stamp)
+    snap = w.snapshot()
+    expected = t[t >= t[-1] - 1.0 - 1e-12]
+    np.testing.assert_allclose(snap.t, expected)
+    np.testing.assert_allclose(snap.z, 2.0 * expected)
+    np.testing.assert_allclose(snap.pitch, -expected)
+    assert np.all(np.diff(snap.t) > 0)
+
+
+def test_faster_input_than_sized_covers_less_time():
+    w = SlidingWindow(length_s=1.0, max_rate_hz=10.0)
+    for stamp in np.arange(0.0, 2.0, 0.01):
+        w.push(stamp, 0.0)
+    assert len(w.snapshot()) == 11  # capacity, not 100 samples
+
+
+def test_clock_jumping_back_resets():
+    w = SlidingWindow(length_s=10.0, max_rate_hz=10.0, reset_jump_back_s=1.0)
+    for stamp in range(5, 10):
+        w.push(float(stamp), 1.0)
+    w.push_load(9.0, 4.5)
+    assert w.push(0.0, 2.0)  # a bag loop
+    assert w.counts.resets == 1 and len(w) == 1
+    snap = w.snapshot()
+    assert snap.z.tolist() == [2.0] and len(snap.loads) == 0
+
+
+def test_loads_keep_the_reading_before_the_window():
+    w = SlidingWindow(length_s=2.0, max_rate_hz=10.0)
+    for stamp in np.arange(0.0, 10.0, 1.0):
+        w.push_load(stamp, 4.5)
+    assert not w.push_load(9.0, 4.5) and not w.push_load(9.5, math.nan)
+    assert not w.push_load(9.5, -1.0)
+    w.push(9.9, 0.0)
+    loads = w.snapshot().loads
+    assert loads.t.tolist() == [7.0, 8.0, 9.0]  # 7.0 gives the load at the window start
+    assert w.counts.loads_rejected == 3
+
+
+def test_bad_window_settings():
+    with pytest.raises(ValueError):
+        SlidingWindow(length_s=0.0)
+
+
+def test_live_stream_identifies_like_a_batch(drop_case):
+    trajectory, truth = drop_case()
+    trajectory = trajectory.slice_time(0.0, 11.0)  # the window holds 1 s before the release
+    config = IdentifierConfig(window_s=10.0)
+    window = SlidingWindow.from_config(config)
+    for t, z, p, kg in zip(
+        trajectory.t, trajectory.z, trajectory.pitch, trajectory.load_kg, strict=True
+    ):
+        window.push(t, z, p)
+        window.push_load(t, kg)
+    snap = window.snapshot()
+    assert snap.end_s - snap.start_s == pytest.approx(10.0, abs=0.01)
+    result = identify(snap, BeamParameters(), config)
+    assert result.status == Status.OK, result.message
+    assert result.release_source == 'tip_load'
+    assert result.natural_frequency_hz == pytest.approx(truth.natural_frequency_hz, rel=1e-3)
+    assert result.stiffness_total_nm_per_rad == pytest.approx(3899.1, rel=0.01)
