@@ -131,9 +131,7 @@ class LumpedChain:
 
     def mass_matrix(self, phi: np.ndarray) -> np.ndarray:
         """M(phi) of B.16 for one configuration (n,)."""
-        return self.inertia_coupling * np.cos(phi[:, None] - phi[None, :]) + np.diag(
-            self.inertia
-        )
+        return self.inertia_coupling * np.cos(phi[:, None] - phi[None, :]) + np.diag(self.inertia)
 
     def tip_pose(self, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Pose of the free end in beam_base (B.17 chained to the end of segment n).

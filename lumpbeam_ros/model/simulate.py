@@ -145,9 +145,7 @@ def simulate_loads(
     for te, kg in events:
         if te <= start:
             simulation.set_load(kg)
-            simulation.state = ChainState(
-                static_equilibrium(simulation.chain), np.zeros(n)
-            )
+            simulation.state = ChainState(static_equilibrium(simulation.chain), np.zeros(n))
     lo = 0
     for index, boundary in enumerate(boundaries):
         hi = int(np.searchsorted(physical_t, boundary, side='left'))

@@ -1,0 +1,1 @@
+"""Synthetic experiments: the paper's drop test simulated and written as a bag."""

@@ -1,0 +1,163 @@
+"""The synthetic drop-test bag of ``lumpbeam synth`` (SPEC section 5).
+
+The model is simulated under the drop-test load schedule and written as a rosbag2 MCAP bag:
+``/tip_pose`` (the measurement: with pose noise and any hidden effects), ``/tip_pose_truth``
+(the exact pose of the beam at each stamp) and ``/tip_load`` (on change and at 1 Hz).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from lumpbeam_ros.bagio import BagWriter
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters, DropTestConfig
+from lumpbeam_ros.model.simulate import drop_test_events, simulate_loads
+from lumpbeam_ros.model.trajectory import TipTrajectory
+
+#: Pitch noise per metre of position noise: the camera sees the board about 1 m away.
+PITCH_NOISE_PER_M = 1.0
+
+#: How often ``/tip_load`` repeats its value (SPEC section 3: at least 1 Hz).
+LOAD_REPEAT_S = 1.0
+
+
+@dataclass(frozen=True)
+class SynthOptions:
+    """What ``lumpbeam synth`` varies.
+
+    Attributes:
+        duration_s: Record length, s.
+        rate_hz: Pose rate, Hz.
+        noise_m: Standard deviation of the position noise on ``/tip_pose``, m; the pitch
+            gets ``noise_m * PITCH_NOISE_PER_M`` rad.
+        seed: Seed of the noise.
+        effects: Hidden effects, SPEC section 6 name to parameter value.
+    """
+
+    duration_s: float = 12.0
+    rate_hz: float = 180.0
+    noise_m: float = 20e-6
+    seed: int = 0
+    effects: Mapping[str, float] = field(default_factory=dict)
+
+
+def parse_effect(text: str) -> tuple[str, float]:
+    """Parses ``NAME=VALUE`` for ``--effect``.
+
+    Args:
+        text: The option's value, e.g. ``'coulomb_friction=1.0'``.
+
+    Returns:
+        The effect's SPEC name and its parameter.
+
+    Raises:
+        LumpbeamError: Not ``NAME=VALUE``, an unknown name, or a negative or non-finite value.
+    """
+    name, sep, value_text = text.partition('=')
+    name = name.strip()
+    if not sep:
+        raise LumpbeamError(f'--effect {text!r}: expected NAME=VALUE')
+    if name not in EFFECT_PARAMETERS:
+        raise LumpbeamError(
+            f'--effect {text!r}: unknown effect {name!r}; '
+            f'choose from {", ".join(EFFECT_PARAMETERS)}'
+        )
+    try:
+        value = float(value_text)
+    except ValueError:
+        raise LumpbeamError(f'--effect {text!r}: {value_text!r} is not a number') from None
+    if not math.isfinite(value) or value < 0.0:
+        raise LumpbeamError(f'--effect {text!r}: the value must be zero or positive')
+    return name, value
+
+
+def with_effects(beam: BeamParameters, effects: Mapping[str, float]) -> BeamParameters:
+    """Returns the beam with the given effects switched on (added to any it has)."""
+    combined = beam.effects
+    for name, value in effects.items():
+        combined = combined.with_effect(name, value)
+    return replace(beam, effects=combined)
+
+
+def simulate_experiment(
+    beam: BeamParameters, drop: DropTestConfig, options: SynthOptions
+) -> tuple[TipTrajectory, TipTrajectory]:
+    """Simulates the drop test as measured and as it truly was.
+
+    Args:
+        beam: The nominal beam.
+        drop: The load and its release time.
+        options: Duration, rate and hidden effects.
+
+    Returns:
+        ``(measured, truth)``: the measurement without noise (every effect, latency
+        included) and the true pose at the same stamps (no latency).
+    """
+    hidden = with_effects(beam, options.effects)
+    count = int(math.floor(options.duration_s * options.rate_hz + 1e-9)) + 1
+    t = np.arange(count) / options.rate_hz
+    events = drop_test_events(drop)
+    measured = simulate_loads(hidden, t, events, drop.load_kg)
+    if hidden.effects.latency_s == 0.0:
+        return measured, measured
+    on_time = replace(hidden, effects=hidden.effects.with_effect('sensor_latency', 0.0))
+    return measured, simulate_loads(on_time, t, events, drop.load_kg)
+
+
+def load_messages(drop: DropTestConfig, duration_s: float) -> list[tuple[float, float]]:
+    """``/tip_load`` samples: the load at 0 s, at every whole second, and at the release."""
+    stamps = sorted({*np.arange(0.0, duration_s + 1e-9, LOAD_REPEAT_S), drop.release_time_s})
+    return [
+        (float(s), drop.load_kg if s < drop.release_time_s else 0.0)
+        for s in stamps
+        if s <= duration_s
+    ]
+
+
+def write_drop_test_bag(
+    out: str | Path, beam: BeamParameters, drop: DropTestConfig, options: SynthOptions
+) -> tuple[TipTrajectory, TipTrajectory]:
+    """Simulates the drop test and writes it as a bag.
+
+    Args:
+        out: The bag folder to create (it must not exist).
+        beam: The nominal beam.
+        drop: The load and its release time.
+        options: What to vary.
+
+    Returns:
+        ``(measured, truth)`` as :func:`simulate_experiment` returns them.
+
+    Raises:
+        BagError: ``out`` exists or cannot be written.
+    """
+    if options.duration_s <= drop.release_time_s:
+        raise LumpbeamError(
+            f'duration {options.duration_s} s ends before the release at {drop.release_time_s} s'
+        )
+    measured, truth = simulate_experiment(beam, drop, options)
+    rng = np.random.default_rng(options.seed)
+    noise = options.noise_m * rng.standard_normal((3, len(measured)))
+    noise[2] *= PITCH_NOISE_PER_M
+    with BagWriter(out) as bag:
+        loads = iter(load_messages(drop, options.duration_s))
+        pending = next(loads, None)
+        for i, stamp in enumerate(measured.t):
+            while pending is not None and pending[0] <= stamp:
+                bag.write_float('/tip_load', pending[0], pending[1])
+                pending = next(loads, None)
+            bag.write_pose(
+                '/tip_pose',
+                stamp,
+                measured.x[i] + noise[0, i],
+                measured.z[i] + noise[1, i],
+                measured.pitch[i] + noise[2, i],
+            )
+            bag.write_pose('/tip_pose_truth', stamp, truth.x[i], truth.z[i], truth.pitch[i])
+    return measured, truth
