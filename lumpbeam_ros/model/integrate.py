@@ -23,8 +23,16 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.signal import lfilter
 
+from lumpbeam_ros.ident.threads import single_threaded_blas
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.modes import LinearModel
+
+#: Dry friction is stepped at first order (see ``_propagate_with_friction``): its grid is
+#: this many times finer than the smooth dynamics need.
+FRICTION_REFINEMENT = 4
+
+#: Longest chain solved with single-threaded BLAS (see :meth:`ModalSolver.solve`).
+SINGLE_THREAD_MAX_SEGMENTS = 64
 
 
 @dataclass(frozen=True)
@@ -74,9 +82,14 @@ class ModalSolver:
         self._n = n
         self._m0_inv = np.linalg.inv(self.linear.mass)
         eigenvalues, vectors = np.linalg.eig(self.linear.state_matrix())
-        self._lam = eigenvalues
-        self._v = vectors
-        self._v_inv = np.linalg.inv(vectors)
+        v_inv = np.linalg.inv(vectors)
+        # A real input keeps conjugate modes conjugate: propagate one of each pair (and the
+        # real, overdamped modes) and rebuild the state as 2 Re(.) (Re(.) for real modes).
+        keep = eigenvalues.imag >= 0.0
+        self._lam = eigenvalues[keep]
+        weight = np.where(self._lam.imag > 0.0, 2.0, 1.0)
+        self._v = vectors[:, keep] * weight
+        self._v_inv = v_inv[keep]
         # Modal input matrix: r enters the velocity rows through M0^-1.
         self._b = self._v_inv[:, n:] @ self._m0_inv
         self._m0_inv_k = self._m0_inv @ self.linear.stiffness
@@ -168,10 +181,15 @@ class ModalSolver:
     ) -> ChainSolution | None:
         """Integrates from ``state`` over ``duration`` on a uniform grid.
 
+        For chains up to ``SINGLE_THREAD_MAX_SEGMENTS`` the products are small, so BLAS runs
+        single-threaded: handing them to threads costs more than it saves, badly so on a busy
+        two-core machine. Longer chains keep the threads.
+
         Args:
             state: Initial angles and velocities.
             duration: Time span, s.
-            step: Largest grid spacing, s (the grid is uniform, ending exactly at duration).
+            step: Largest grid spacing, s (the grid is uniform, ending exactly at duration;
+                ``FRICTION_REFINEMENT`` times finer with dry friction).
             tol: Convergence threshold on the change of the angles between sweeps, rad.
             max_sweeps: Sweeps before giving up.
 
@@ -179,6 +197,16 @@ class ModalSolver:
             The solution on the grid (starting at 0), or ``None`` when the sweeps did not
             converge and a general integrator is needed.
         """
+        if self._n > SINGLE_THREAD_MAX_SEGMENTS:
+            return self._solve(state, duration, step, tol, max_sweeps)
+        with single_threaded_blas():
+            return self._solve(state, duration, step, tol, max_sweeps)
+
+    def _solve(
+        self, state: ChainState, duration: float, step: float, tol: float, max_sweeps: int
+    ) -> ChainSolution | None:
+        if self.chain.coulomb_torque > 0.0:
+            step /= FRICTION_REFINEMENT
         steps = max(1, int(np.ceil(duration / step - 1e-9)))
         h = duration / steps
         t = np.linspace(0.0, duration, steps + 1)

@@ -1,0 +1,96 @@
+from dataclasses import replace
+
+import pytest
+
+from lumpbeam_ros.cli.main import main
+from lumpbeam_ros.errors import ConfigError
+from lumpbeam_ros.model.parameters import (
+    BeamParameters,
+    DropTestConfig,
+    load_beam_config,
+    write_beam_config,
+)
+
+GOOD = """\
+/**:
+  ros__parameters:
+    beam:
+      length_m: 2.0
+      n_segments: 4
+    tip:
+      mass_kg: 1.0
+"""
+
+
+def test_default_config_is_spec_section_1():
+    beam, drop = load_beam_config()
+    assert beam == BeamParameters()
+    assert drop == DropTestConfig()
+
+
+def test_partial_file_takes_defaults(tmp_path):
+    path = tmp_path / 'beam.yaml'
+    path.write_text(GOOD)
+    beam, _ = load_beam_config(path)
+    assert (beam.length_m, beam.n_segments, beam.tip_mass_kg) == (2.0, 4, 1.0)
+    assert beam.k_total_nm_per_rad == BeamParameters().k_total_nm_per_rad
+
+
+def test_roundtrip(tmp_path):
+    beam = BeamParameters(n_segments=7, tip_placement='segment_com')
+    beam = replace(beam, effects=beam.effects.with_effect('added_mass', 0.3))
+    path = tmp_path / 'out.yaml'
+    write_beam_config(path, beam, DropTestConfig(load_kg=3.0), header='written by a test')
+    assert load_beam_config(path) == (beam, DropTestConfig(load_kg=3.0))
+    assert path.read_text().startswith('# written by a test')
+
+
+@pytest.mark.parametrize(
+    ('body', 'key', 'problem'),
+    [
+        ('beam:\n      length_m: -1.0', 'beam.length_m', 'must be positive'),
+        ('beam:\n      mass_kg: 0', 'beam.mass_kg', 'must be positive'),
+        ('beam:\n      k_total_nm_per_rad: 0.0', 'beam.k_total_nm_per_rad', 'must be positive'),
+        ('beam:\n      n_segments: 0', 'beam.n_segments', 'at least 1'),
+        ('beam:\n      n_segments: 2.5', 'beam.n_segments', 'integer'),
+        ('beam:\n      length_m: abc', 'beam.length_m', 'number'),
+        ('beam:\n      length_m: .nan', 'beam.length_m', 'finite'),
+        ('beam:\n      lenght_m: 2.0', 'beam.lenght_m', 'unknown key'),
+        ('tip:\n      placement: middle', 'tip.placement', 'must be one of'),
+        ('tip:\n      mass_kg: -2.5', 'tip.mass_kg', 'must not be negative'),
+    ],
+)
+def test_bad_values_name_file_and_key(tmp_path, body, key, problem):
+    path = tmp_path / 'bad.yaml'
+    path.write_text(f'/**:\n  ros__parameters:\n    {body}\n')
+    with pytest.raises(ConfigError) as caught:
+        load_beam_config(path)
+    assert caught.value.key == key
+    assert str(path) in str(caught.value)
+    assert problem in str(caught.value)
+
+
+@pytest.mark.parametrize(
+    'text',
+    ['beam: [1, 2', 'just a string', '/**:\n  parameters: {}\n', '/**:\n  ros__parameters: 3\n'],
+)
+def test_malformed_files(tmp_path, text):
+    path = tmp_path / 'bad.yaml'
+    path.write_text(text)
+    with pytest.raises(ConfigError):
+        load_beam_config(path)
+
+
+def test_missing_file():
+    with pytest.raises(ConfigError, match='no such file'):
+        load_beam_config('/nonexistent/beam.yaml')
+
+
+def test_cli_reports_one_line_and_exit_2(tmp_path, capsys):
+    path = tmp_path / 'bad.yaml'
+    path.write_text('/**:\n  ros__parameters:\n    beam:\n      length_m: -2.3\n')
+    assert main(['reproduce', '--config', str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count('\n') == 0
+    assert 'beam.length_m' in err and str(path) in err
+    assert 'Traceback' not in err

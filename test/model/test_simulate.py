@@ -1,0 +1,83 @@
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from lumpbeam_ros.model.chain import LumpedChain
+from lumpbeam_ros.model.modes import chain_modes
+from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, Effects
+from lumpbeam_ros.model.simulate import BeamSimulation, simulate_drop_test, simulate_loads
+from lumpbeam_ros.model.statics import static_tip_deflection
+
+BEAM = BeamParameters()
+
+
+@pytest.fixture(scope='module')
+def drop_test():
+    return simulate_drop_test(BEAM)
+
+
+def test_drop_test_starts_loaded_and_oscillates_about_the_released_level(drop_test):
+    loaded = -static_tip_deflection(BEAM, 4.5)
+    released = -static_tip_deflection(BEAM, 0.0)
+    before = drop_test.slice_time(0.0, 2.0)
+    assert np.allclose(before.z, loaded, atol=1e-12)
+    assert np.all(before.load_kg == 4.5)
+    after = drop_test.slice_time(2.0 + 1e-9, 12.1)
+    assert np.all(after.load_kg == 0.0)
+    assert after.z.max() > released > after.z.min()
+    # The first swing reaches the level it fell from, minus the damping of half a period.
+    assert after.z.min() == pytest.approx(loaded, rel=0.02)
+
+
+def test_drop_test_oscillates_at_the_first_mode(drop_test):
+    after = drop_test.slice_time(2.0, 12.0)
+    z = after.z - after.z.mean()
+    crossings = after.t[1:][np.diff(np.sign(z)) > 0]
+    period = np.diff(crossings).mean()
+    mode = chain_modes(LumpedChain.from_beam(BEAM)).damped_frequency_hz[0]
+    assert 1.0 / period == pytest.approx(mode, rel=2e-3)
+
+
+def test_streaming_matches_batch(drop_test):
+    simulation = BeamSimulation(BEAM, load_kg=4.5)
+    t = drop_test.t
+    chunks = [t[t < 2.0]]
+    simulation_phi = [simulation.advance(chunks[0])[0]]
+    simulation.advance(np.array([2.0]))
+    simulation.set_load(0.0)
+    rest = t[t >= 2.0]
+    for part in np.array_split(rest, 17):
+        simulation_phi.append(simulation.advance(part)[0])
+    z = simulation.chain.tip_pose(np.vstack(simulation_phi))[1]
+    assert np.max(np.abs(z - drop_test.z)) < 1e-8
+
+
+def test_latency_delays_the_measurement():
+    late = replace(BEAM, effects=Effects(latency_s=0.015))
+    t = np.arange(0, 3.0, 1 / 1000)
+    on_time = simulate_loads(BEAM, t, [(1.0, 0.0)], 4.5)
+    delayed = simulate_loads(late, t, [(1.0, 0.0)], 4.5)
+    shift = 15
+    # The same motion, sampled on grids 15 ms apart: equal to within interpolation (~10 nm).
+    assert np.max(np.abs(delayed.z[shift:] - on_time.z[:-shift])) < 1e-7
+    assert np.max(np.abs(delayed.z - on_time.z)) > 1e-3
+
+
+def test_event_at_the_start_releases_the_load():
+    trajectory = simulate_drop_test(BEAM, DropTestConfig(release_time_s=0.0, duration_s=1.0))
+    assert trajectory.z[0] == pytest.approx(-static_tip_deflection(BEAM, 4.5))
+    assert np.ptp(trajectory.z) > 0.03
+
+
+@pytest.mark.parametrize('load', [-1.0, float('nan'), float('inf')])
+def test_bad_load_is_refused(load):
+    with pytest.raises(ValueError, match='non-negative'):
+        BeamSimulation(BEAM).set_load(load)
+
+
+@pytest.mark.parametrize('times', [[], [1.0, 0.5], [-1.0]])
+def test_bad_output_times_are_refused(times):
+    simulation = BeamSimulation(BEAM, t0=0.0)
+    with pytest.raises(ValueError, match='increasing'):
+        simulation.advance(np.array(times))

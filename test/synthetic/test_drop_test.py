@@ -1,0 +1,85 @@
+import numpy as np
+import pytest
+
+from lumpbeam_ros.bagio import read_load_events, read_tip_poses
+from lumpbeam_ros.cli.main import main
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
+from lumpbeam_ros.model.simulate import simulate_loads
+from lumpbeam_ros.synthetic.drop_test import (
+    SynthOptions,
+    parse_effect,
+    simulate_experiment,
+    write_drop_test_bag,
+)
+
+
+def test_bag_holds_noisy_poses_truth_and_loads(tmp_path):
+    options = SynthOptions(duration_s=4.0, seed=3)
+    write_drop_test_bag(tmp_path / 'bag', BeamParameters(), DropTestConfig(), options)
+    measured = read_tip_poses(tmp_path / 'bag')
+    truth = read_tip_poses(tmp_path / 'bag', '/tip_pose_truth')
+    assert len(measured.t) == len(truth.t) == 4 * 180 + 1
+    assert measured.frame_id == 'beam_base'
+    noise = measured.z - truth.z
+    assert np.std(noise) == pytest.approx(20e-6, rel=0.1)
+    loads = read_load_events(tmp_path / 'bag')
+    assert loads.t[0] == 0.0 and np.all(np.diff(loads.t) <= 1.0)
+    changes = loads.changes()
+    assert list(changes.kg) == [4.5, 0.0]
+    assert changes.t[1] == 2.0
+
+
+def test_latency_is_hidden_from_the_truth():
+    options = SynthOptions(duration_s=3.0, effects={'sensor_latency': 0.02})
+    measured, truth = simulate_experiment(BeamParameters(), DropTestConfig(), options)
+    assert np.max(np.abs(measured.z - truth.z)) > 1e-3
+    # The sample stamped t shows the beam as it was at t - 0.02 s.
+    earlier = simulate_loads(BeamParameters(), truth.t - 0.02, [(2.0, 0.0)], 4.5)
+    assert np.max(np.abs(measured.z - earlier.z)) < 1e-7
+
+
+@pytest.mark.parametrize(
+    ('text', 'message'),
+    [
+        ('coulomb_friction', 'expected NAME=VALUE'),
+        ('gravity_wave=1', 'unknown effect'),
+        ('added_mass=heavy', 'not a number'),
+        ('added_mass=-0.3', 'zero or positive'),
+        ('added_mass=nan', 'zero or positive'),
+    ],
+)
+def test_bad_effects(text, message):
+    with pytest.raises(LumpbeamError, match=message):
+        parse_effect(text)
+
+
+def test_good_effect():
+    assert parse_effect('base_compliance=2e4') == ('base_compliance', 2e4)
+
+
+@pytest.mark.parametrize(
+    'args',
+    [
+        ['--effect', 'nonsense=1'],
+        ['--duration', '1.0'],  # ends before the release at 2 s
+        ['--config', '/nonexistent.yaml'],
+    ],
+)
+def test_cli_errors_are_one_line(tmp_path, capsys, args):
+    assert main(['synth', str(tmp_path / 'bag'), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and err.startswith('lumpbeam synth: error:')
+    assert not (tmp_path / 'bag').exists()
+
+
+def test_cli_never_overwrites(tmp_path, capsys):
+    (tmp_path / 'bag').mkdir()
+    assert main(['synth', str(tmp_path / 'bag')]) == 2
+    assert 'never overwritten' in capsys.readouterr().err
+
+
+def test_cli_writes_a_bag(tmp_path, capsys):
+    assert main(['synth', str(tmp_path / 'bag'), '--duration', '3', '--seed', '1']) == 0
+    assert 'wrote' in capsys.readouterr().out
+    assert len(read_tip_poses(tmp_path / 'bag').t) == 541
