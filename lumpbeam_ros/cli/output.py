@@ -45,6 +45,17 @@ def write_json(path: str | Path, result: dict[str, Any]) -> None:
         raise LumpbeamError(f'cannot write JSON to {path}: {exc.strerror or exc}') from None
 
 
+def _bounded_float(text: str, allow_zero: bool) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
+    if not math.isfinite(value) or value < 0.0 or (value == 0.0 and not allow_zero):
+        kind = 'zero or positive' if allow_zero else 'a positive number'
+        raise argparse.ArgumentTypeError(f'must be {kind}, got {text!r}')
+    return value
+
+
 def positive_float(text: str) -> float:
     """Argument type: a finite number greater than zero.
 
@@ -57,13 +68,7 @@ def positive_float(text: str) -> float:
     Raises:
         argparse.ArgumentTypeError: Not a positive finite number.
     """
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
-    if not math.isfinite(value) or value <= 0.0:
-        raise argparse.ArgumentTypeError(f'must be a positive number, got {text!r}')
-    return value
+    return _bounded_float(text, allow_zero=False)
 
 
 def non_negative_float(text: str) -> float:
@@ -78,10 +83,4 @@ def non_negative_float(text: str) -> float:
     Raises:
         argparse.ArgumentTypeError: Not a non-negative finite number.
     """
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
-    if not math.isfinite(value) or value < 0.0:
-        raise argparse.ArgumentTypeError(f'must be zero or positive, got {text!r}')
-    return value
+    return _bounded_float(text, allow_zero=True)
