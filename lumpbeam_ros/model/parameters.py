@@ -316,6 +316,7 @@ def write_beam_config(
         header: Comment lines written first (without ``#``), e.g. where the values came from.
     """
     text = ''.join(f'# {line}\n' for line in header.splitlines())
-    text += yaml.safe_dump({'/**': {'ros__parameters': beam_to_parameters(beam, drop)}},
-                           sort_keys=False)
+    text += yaml.safe_dump(
+        {'/**': {'ros__parameters': beam_to_parameters(beam, drop)}}, sort_keys=False
+    )
     Path(path).write_text(text, encoding='utf-8')

@@ -198,8 +198,8 @@ class TipTracker:
 
     def _check_exposure(self, gray: np.ndarray) -> tuple[TrackStatus, str] | None:
         # A sparse sample is plenty for grey-level statistics, and keeps this off the budget.
-        step = max(1, int(math.sqrt(gray.size / 16384)))
-        sample = gray[::step, ::step].ravel()
+        step = max(1, int(math.sqrt(gray.size / 4096)))
+        sample = gray[::step, ::step].reshape(-1)
         counts = np.bincount(sample, minlength=256)
         cumulative = np.cumsum(counts)
         low = int(np.searchsorted(cumulative, 0.01 * sample.size))
