@@ -136,7 +136,7 @@ class CameraInfo:
             return np.asarray(pixels, dtype=float)
         pts = np.ascontiguousarray(pixels, dtype=np.float64).reshape(-1, 1, 2)
         criteria = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 20, 1e-10)
-        ideal = cv2.undistortPointsIter(pts, self.k, self.d, None, self.k, criteria)
+        ideal = cv2.undistortPoints(pts, self.k, self.d, None, None, self.k, criteria)
         return ideal.reshape(-1, 2)
 
     def pinhole_only(self) -> CameraInfo:

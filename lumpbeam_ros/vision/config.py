@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from lumpbeam_ros.errors import ConfigError, LumpbeamError
+from lumpbeam_ros.errors import ConfigError
 from lumpbeam_ros.paramfile import check_known_keys, get_float, get_int, read_parameter_file
 from lumpbeam_ros.resources import config_path
 from lumpbeam_ros.vision.board import Checkerboard
@@ -140,16 +140,12 @@ def camera_config_from_parameters(params: Mapping[str, Any], source: str | Path)
     pos = {'positive': True}
     nonneg = {'non_negative': True}
     half_pi = np.pi / 2.0
-    try:
-        camera_info = CameraInfo.pinhole(
-            get_int(params, 'camera.width_px', source, 2048, minimum=64),
-            get_int(params, 'camera.height_px', source, 2048, minimum=64),
-            get_float(params, 'camera.focal_length_px', source, 2400.0, **pos),
-            _get_vector(params, 'camera.principal_point_offset_px', source, (0.0, 0.0)),  # type: ignore[arg-type]
-            _get_vector(params, 'camera.distortion', source, (0.0,) * 5),
-        )
-    except LumpbeamError as exc:
-        raise ConfigError(source, 'camera', str(exc)) from None
+    width = get_int(params, 'camera.width_px', source, 2048, minimum=64)
+    height = get_int(params, 'camera.height_px', source, 2048, minimum=64)
+    focal = get_float(params, 'camera.focal_length_px', source, 2400.0, **pos)
+    offset = _get_vector(params, 'camera.principal_point_offset_px', source, (0.0, 0.0))
+    distortion = _get_vector(params, 'camera.distortion', source, (0.0,) * 5)
+    camera_info = CameraInfo.pinhole(width, height, focal, offset, distortion)  # type: ignore[arg-type]
     board = Checkerboard(
         squares_x=get_int(params, 'board.squares_x', source, 9, minimum=3),
         squares_y=get_int(params, 'board.squares_y', source, 7, minimum=3),

@@ -180,7 +180,13 @@ def solve_board_pnp(
         # Ambiguous: the errors do not decide, the orientation does.
         best = min(candidates, key=lambda item: item[1])
     rvec, tvec = cv2.solvePnPRefineLM(obj, img, camera_info.k, None, best[2], best[3])
-    return Transform(cv2.Rodrigues(rvec)[0], tvec.ravel())
+    if not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):
+        return None
+    rotation, t = cv2.Rodrigues(rvec)[0], tvec.ravel()
+    # The refinement must not have wandered behind the camera or to the board's back.
+    if t[2] <= 0 or rotation[:, 2] @ t <= 0:
+        return None
+    return Transform(rotation, t)
 
 
 def tip_pose_from_board_pose(rig: RigGeometry, camera_board: Transform) -> np.ndarray:
