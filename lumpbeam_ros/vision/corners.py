@@ -54,6 +54,29 @@ def refine_corners(
     return refined
 
 
+def corner_contrast(image: np.ndarray, corners: np.ndarray, offset: int) -> np.ndarray:
+    """Saddle strength at each corner: the two diagonals' grey levels, differenced.
+
+    A checkerboard corner has dark squares on one diagonal and light ones on the other; an
+    occluded corner, or one sitting on a blank wall, has no such difference, whatever
+    ``cornerSubPix`` returned for it.
+
+    Args:
+        image: Grey image, H x W.
+        corners: Corners (N x 2), finite and at least ``offset`` px inside the image.
+        offset: Distance of the diagonal samples from the corner along x and y, px.
+
+    Returns:
+        ``|I(+,+) + I(-,-) - I(+,-) - I(-,+)| / 2`` per corner, in grey levels.
+    """
+    h, w = image.shape[:2]
+    centre = np.rint(corners).astype(np.int64)
+    x = np.clip(centre[:, 0, None] + offset * np.array([1, -1, 1, -1]), 0, w - 1)
+    y = np.clip(centre[:, 1, None] + offset * np.array([1, -1, -1, 1]), 0, h - 1)
+    v = image[y, x].astype(np.float64)
+    return np.abs(v[:, 0] + v[:, 1] - v[:, 2] - v[:, 3]) / 2.0
+
+
 def homography_residual(object_xy: np.ndarray, pixels: np.ndarray) -> float:
     """Largest distance between the corners and a homography fitted through all of them.
 

@@ -23,7 +23,12 @@ from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.vision.calibration import RigCalibration, calibrate_rig
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import CameraConfig
-from lumpbeam_ros.vision.corners import grid_is_regular, homography_residual, refine_corners
+from lumpbeam_ros.vision.corners import (
+    corner_contrast,
+    grid_is_regular,
+    homography_residual,
+    refine_corners,
+)
 from lumpbeam_ros.vision.detect import detect_board
 from lumpbeam_ros.vision.pose import (
     PlaneFit,
@@ -231,11 +236,12 @@ class TipTracker:
         return corners1 + ratio * (corners1 - corners0), pose1 + ratio * (pose1 - pose0)
 
     def _verify(
-        self, corners: np.ndarray, homography: bool = True
+        self, gray: np.ndarray, corners: np.ndarray, homography: bool = True
     ) -> tuple[np.ndarray | None, str]:
         """Returns the undistorted corners if they form a whole, consistent board.
 
         Args:
+            gray: The frame.
             corners: Measured corners (N x 2).
             homography: Whether to fit a homography; once the rig is calibrated, the
                 plane-constrained fit's per-corner residual is the same test, stricter.
@@ -243,6 +249,10 @@ class TipTracker:
         if not np.all(np.isfinite(corners)):
             missing = int(np.sum(~np.all(np.isfinite(corners), axis=1)))
             return None, f'{missing} of {len(corners)} corners not found'
+        contrast = corner_contrast(gray, corners, self._half_window)
+        if np.min(contrast) < self.settings.min_contrast_dn:
+            weak = int(np.sum(contrast < self.settings.min_contrast_dn))
+            return None, f'{weak} corners show no checkerboard contrast (occluded?)'
         ideal = self.camera_info.undistort_pixels(corners)
         if not grid_is_regular(ideal, self._board.pattern_size):
             return None, 'corner grid is folded or irregular'
@@ -271,7 +281,7 @@ class TipTracker:
         else:
             guess, pose_guess = prediction
             corners = refine_corners(gray, guess, self._half_window)
-            ideal, _ = self._verify(corners, homography=not self._is_calibrated())
+            ideal, _ = self._verify(gray, corners, homography=not self._is_calibrated())
             if ideal is not None:
                 fit, _ = self._fit(ideal, pose_guess)
                 if fit is not None:
@@ -290,7 +300,7 @@ class TipTracker:
                 stamp, TrackStatus.BOARD_NOT_FOUND, 'no complete checkerboard in the frame',
                 detected=True,
             )  # fmt: skip
-        ideal, problem = self._verify(corners)
+        ideal, problem = self._verify(gray, corners)
         if ideal is None:
             self.reset()
             return _failure(
