@@ -1,0 +1,129 @@
+"""Estimating the rig's fixed unknowns once, from many frames.
+
+The tip moves in the bending plane, which the board is parallel to, so three things never
+change between frames: the camera's distance to the board and the two angles by which its
+optical axis tilts out of the plane. A single frame's PnP resolves them poorly (they trade
+off against the in-plane translation), but they are common to every frame, so a joint fit of
+them and of every frame's ``(x, z, pitch)`` over many frames pins them down; afterwards each
+frame needs only the well-conditioned 3-DoF fit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.sparse import lil_matrix
+
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.vision.camera_model import CameraInfo
+from lumpbeam_ros.vision.config import RigGeometry
+from lumpbeam_ros.vision.geometry import Transform, rotation_x, rotation_z
+from lumpbeam_ros.vision.pose import PlaneModel
+
+
+@dataclass(frozen=True)
+class RigCalibration:
+    """The refined rig and what was changed.
+
+    Attributes:
+        rig: The rig with the camera's tilt and the board's distance corrected.
+        tilt_rad: Added rotation of the camera mount about the tip's x and z axes, rad.
+        depth_offset_m: Added offset of the board along ``beam_base`` y, m.
+        std: Standard deviations of ``(tilt_x, tilt_z, depth_offset)``.
+        rms_px: RMS reprojection error per corner over all frames, px.
+        frames: Frames used.
+    """
+
+    rig: RigGeometry
+    tilt_rad: tuple[float, float]
+    depth_offset_m: float
+    std: np.ndarray
+    rms_px: float
+    frames: int
+
+
+def adjusted_rig(rig: RigGeometry, tilt_x: float, tilt_z: float, depth: float) -> RigGeometry:
+    """Returns ``rig`` with the camera tilted about the tip's x, z axes and the board moved.
+
+    Args:
+        rig: The configured rig.
+        tilt_x: Extra camera rotation about the tip's x axis, rad.
+        tilt_z: Extra camera rotation about the tip's z axis, rad.
+        depth: Extra board offset along ``beam_base`` y, m.
+
+    Returns:
+        The adjusted rig.
+    """
+    mount = rig.tip_camera
+    turned = Transform(rotation_x(tilt_x) @ rotation_z(tilt_z) @ mount.rotation, mount.translation)
+    board = Transform(
+        rig.base_board.rotation, rig.base_board.translation + np.array([0.0, depth, 0.0])
+    )
+    return replace(rig, tip_camera=turned, base_board=board)
+
+
+def calibrate_rig(
+    rig: RigGeometry,
+    camera_info: CameraInfo,
+    pixels: Sequence[np.ndarray],
+    poses: Sequence[np.ndarray],
+) -> RigCalibration:
+    """Jointly fits the fixed unknowns and every frame's in-plane pose.
+
+    Args:
+        rig: The configured rig (the starting point and the gauge: in-plane offsets of the
+            camera and the board stay as configured).
+        camera_info: Intrinsics.
+        pixels: Per frame, the undistorted corners (N x 2).
+        poses: Per frame, a starting ``(x, z, pitch)``.
+
+    Returns:
+        The calibration.
+
+    Raises:
+        LumpbeamError: Fewer than three frames, or the fit fails.
+    """
+    n_frames = len(pixels)
+    if n_frames < 3 or len(poses) != n_frames:
+        raise LumpbeamError('calibration: need at least 3 frames, each with a start pose')
+    measured = np.stack([np.asarray(p, dtype=float) for p in pixels])
+    n_points = measured.shape[1]
+
+    def residuals(params: np.ndarray) -> np.ndarray:
+        model = PlaneModel(adjusted_rig(rig, *params[:3]), camera_info)
+        frame_poses = params[3:].reshape(n_frames, 3)
+        return np.concatenate(
+            [(model.project(q) - m).ravel() for q, m in zip(frame_poses, measured, strict=True)]
+        )
+
+    sparsity = lil_matrix((n_frames * n_points * 2, 3 + 3 * n_frames), dtype=int)
+    for k in range(n_frames):
+        rows = slice(k * n_points * 2, (k + 1) * n_points * 2)
+        sparsity[rows, :3] = 1
+        sparsity[rows, 3 + 3 * k : 6 + 3 * k] = 1
+    start = np.concatenate([np.zeros(3), np.asarray(poses, dtype=float).ravel()])
+    # Steps of 1e-7 (rad, m) resolve micrometre effects without drowning in round-off.
+    fit = least_squares(
+        residuals, start, jac_sparsity=sparsity, method='trf', x_scale='jac', diff_step=1e-7
+    )
+    if not fit.success or not np.all(np.isfinite(fit.x)):
+        raise LumpbeamError(f'calibration: the fit failed ({fit.message})')
+    j = fit.jac.toarray() if hasattr(fit.jac, 'toarray') else fit.jac
+    dof = max(fit.fun.size - fit.x.size, 1)
+    sigma2 = float(fit.fun @ fit.fun) / dof
+    try:
+        std = np.sqrt(np.diag(np.linalg.inv(j.T @ j))[:3] * sigma2)
+    except np.linalg.LinAlgError:
+        std = np.full(3, np.inf)
+    tilt_x, tilt_z, depth = (float(v) for v in fit.x[:3])
+    return RigCalibration(
+        rig=adjusted_rig(rig, tilt_x, tilt_z, depth),
+        tilt_rad=(tilt_x, tilt_z),
+        depth_offset_m=depth,
+        std=std,
+        rms_px=float(np.sqrt(np.mean(fit.fun.reshape(-1, 2) ** 2) * 2)),
+        frames=n_frames,
+    )

@@ -1,0 +1,93 @@
+"""Full checkerboard detection: find the board anywhere in a frame, from scratch.
+
+OpenCV's detector runs on a shrunk copy (it needs only a few pixels per square, and its cost
+grows with the image), and its corners are then refined at full resolution. The corner
+order is made canonical with the orientation the configured rig implies, because a 180-degree
+turned or mirrored labelling of the same grid is equally valid to the detector.
+"""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+
+from lumpbeam_ros.vision.corners import refine_corners
+
+_FLAGS = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE | cv2.CALIB_CB_FAST_CHECK
+
+
+def detection_scale(width: int, height: int, max_side_px: int) -> int:
+    """Integer shrink factor so the detector sees at most ``max_side_px`` on the longer side."""
+    return max(1, math.ceil(max(width, height) / max_side_px))
+
+
+def canonical_order(
+    corners: np.ndarray, pattern_size: tuple[int, int], expected_axes: np.ndarray
+) -> np.ndarray:
+    """Reorders detected corners so rows and columns run along the expected image directions.
+
+    Args:
+        corners: Corners (N x 2) in the detector's row-major order.
+        pattern_size: ``(corners per row, rows)``.
+        expected_axes: 2 x 2; row 0 is the image direction of the board's +x axis, row 1 of
+            its +y axis.
+
+    Returns:
+        The corners in the board's own row-major order.
+    """
+    cols, rows = pattern_size
+    grid = corners.reshape(rows, cols, 2)
+    along = np.mean(grid[:, -1] - grid[:, 0], axis=0)
+    down = np.mean(grid[-1] - grid[0], axis=0)
+    # The detector's rows might run along the board's y axis only for a square pattern,
+    # which the configuration rejects; here only their direction along each axis can flip.
+    if along @ expected_axes[0] < 0:
+        grid = grid[:, ::-1]
+    if down @ expected_axes[1] < 0:
+        grid = grid[::-1]
+    return np.ascontiguousarray(grid.reshape(-1, 2))
+
+
+def detect_board(
+    image: np.ndarray,
+    pattern_size: tuple[int, int],
+    expected_axes: np.ndarray,
+    max_side_px: int,
+    half_window: int,
+) -> np.ndarray | None:
+    """Finds all inner corners of the board in a grey frame.
+
+    Args:
+        image: Grey image (uint8, H x W).
+        pattern_size: ``(corners per row, rows)``.
+        expected_axes: Image directions of the board's x and y axes (2 x 2).
+        max_side_px: The detector's input is shrunk to at most this on its longer side.
+        half_window: Refinement window half-size at full resolution, px.
+
+    Returns:
+        Sub-pixel corners (N x 2) in board order, or ``None`` when the whole board is not
+        found.
+    """
+    h, w = image.shape[:2]
+    scale = detection_scale(w, h, max_side_px)
+    small = image
+    if scale > 1:
+        small = cv2.resize(image, (w // scale, h // scale), interpolation=cv2.INTER_AREA)
+    try:
+        found, corners = cv2.findChessboardCorners(small, pattern_size, flags=_FLAGS)
+    except cv2.error:
+        return None
+    if not found or corners is None or len(corners) != pattern_size[0] * pattern_size[1]:
+        return None
+    criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_MAX_ITER, 20, 0.01)
+    small_window = max(2, min(5, round(half_window / scale)))
+    corners = cv2.cornerSubPix(small, corners, (small_window, small_window), (-1, -1), criteria)
+    # Pixel centres sit at integers, so a shrunk pixel i covers full pixels scale * i ...
+    # scale * (i + 1) - 1, centred at scale * (i + 0.5) - 0.5.
+    full = (corners.reshape(-1, 2).astype(np.float64) + 0.5) * scale - 0.5
+    full = refine_corners(image, full, half_window)
+    if not np.all(np.isfinite(full)):
+        return None
+    return canonical_order(full, pattern_size, expected_axes)

@@ -1,0 +1,209 @@
+"""Tip pose from checkerboard corners: the plane-constrained fit and free PnP.
+
+The tip moves in the bending plane, so once the camera mount and the board pose are fixed,
+the corners' image positions depend on three numbers only: the tip's ``x``, ``z`` and
+``pitch``. Fitting those three to all corners is far better conditioned than a 6-DoF PnP,
+whose depth and out-of-plane tilt trade off against the in-plane translation frame by frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from lumpbeam_ros.vision.camera_model import CameraInfo
+from lumpbeam_ros.vision.config import RigGeometry
+from lumpbeam_ros.vision.geometry import Transform, tip_pose_from_transform, tip_transform
+
+
+@dataclass(frozen=True)
+class PlaneFit:
+    """The result of a plane-constrained pose fit.
+
+    Attributes:
+        pose: ``(x, z, pitch)`` of the tip in ``beam_base``, m, m, rad.
+        covariance: 3x3 covariance of ``pose`` from the reprojection residuals.
+        rms_px: RMS reprojection error per corner, px.
+        max_px: The largest reprojection error of a corner, px.
+        converged: Whether Gauss-Newton met its step tolerance.
+    """
+
+    pose: np.ndarray
+    covariance: np.ndarray
+    rms_px: float
+    max_px: float
+    converged: bool
+
+
+class PlaneModel:
+    """Projects the board's corners for an in-plane tip pose, with the Jacobian.
+
+    Args:
+        rig: Camera mount and board pose.
+        camera_info: Intrinsics; only the pinhole part is used (measured corners are
+            undistorted before they are fitted).
+    """
+
+    def __init__(self, rig: RigGeometry, camera_info: CameraInfo):
+        self.rig = rig
+        self._points = rig.base_board.apply(rig.board.object_points())
+        cam_tip = rig.tip_camera.inverse()
+        self._r_ct = cam_tip.rotation
+        self._t_ct = cam_tip.translation
+        self._f = np.diag(camera_info.k)[:2].copy()
+        self._c = camera_info.k[:2, 2].copy()
+
+    @property
+    def n_points(self) -> int:
+        """Number of board corners."""
+        return int(self._points.shape[0])
+
+    def camera_points(self, pose: np.ndarray) -> np.ndarray:
+        """Returns the corners in the camera frame (N x 3) for a tip pose ``(x, z, pitch)``."""
+        x, z, pitch = pose
+        c, s = np.cos(pitch), np.sin(pitch)
+        d = self._points - np.array([x, 0.0, z])
+        # R_y(pitch)^T applied to the offsets from the tip, written out for speed.
+        tip = np.column_stack([c * d[:, 0] - s * d[:, 2], d[:, 1], s * d[:, 0] + c * d[:, 2]])
+        return tip @ self._r_ct.T + self._t_ct
+
+    def project(self, pose: np.ndarray) -> np.ndarray:
+        """Returns the ideal (undistorted) pixel positions of the corners (N x 2)."""
+        p = self.camera_points(pose)
+        return p[:, :2] / p[:, 2:3] * self._f + self._c
+
+    def project_with_jacobian(self, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Returns the projected corners (N x 2) and d(pixels)/d(pose) (N x 2 x 3)."""
+        x, z, pitch = pose
+        c, s = np.cos(pitch), np.sin(pitch)
+        d = self._points - np.array([x, 0.0, z])
+        tip = np.column_stack([c * d[:, 0] - s * d[:, 2], d[:, 1], s * d[:, 0] + c * d[:, 2]])
+        p = tip @ self._r_ct.T + self._t_ct
+        # Derivatives of the tip-frame point with respect to x, z and pitch.
+        d_tip = np.empty((d.shape[0], 3, 3))
+        d_tip[:, :, 0] = [-c, 0.0, -s]
+        d_tip[:, :, 1] = [s, 0.0, -c]
+        d_tip[:, :, 2] = np.column_stack(
+            [-s * d[:, 0] - c * d[:, 2], np.zeros(d.shape[0]), c * d[:, 0] - s * d[:, 2]]
+        )
+        d_cam = np.einsum('ij,njk->nik', self._r_ct, d_tip)
+        inv_z = 1.0 / p[:, 2]
+        uv = p[:, :2] * inv_z[:, None]
+        jac = (d_cam[:, :2, :] - uv[:, :, None] * d_cam[:, 2:3, :]) * inv_z[:, None, None]
+        return uv * self._f + self._c, jac * self._f[None, :, None]
+
+    def fit(self, pixels: np.ndarray, initial: np.ndarray, max_iterations: int = 10) -> PlaneFit:
+        """Fits ``(x, z, pitch)`` to measured corners by Gauss-Newton on reprojection error.
+
+        Args:
+            pixels: Undistorted corner positions (N x 2), in the board's corner order.
+            initial: Starting pose ``(x, z, pitch)``.
+            max_iterations: Gauss-Newton iterations at most.
+
+        Returns:
+            The fitted pose with its covariance ``sigma^2 (J^T J)^-1``, where ``sigma^2`` is
+            the residual variance with 2N - 3 degrees of freedom.
+        """
+        pose = np.asarray(initial, dtype=float).copy()
+        converged = False
+        for _ in range(max_iterations):
+            proj, jac = self.project_with_jacobian(pose)
+            r = (proj - pixels).ravel()
+            j = jac.reshape(-1, 3)
+            jtj = j.T @ j
+            step = np.linalg.solve(jtj, -(j.T @ r))
+            pose += step
+            # After a step below 0.1 um (or urad) the next would be below 1e-13: the model
+            # is that close to linear, so the last Jacobian serves for the covariance.
+            if np.max(np.abs(step)) < 1e-7:
+                converged = True
+                break
+        residual = (r + j @ step).reshape(-1, 2)
+        ssr = float(np.sum(residual * residual))
+        dof = max(residual.size - 3, 1)
+        try:
+            covariance = np.linalg.inv(jtj) * (ssr / dof)
+        except np.linalg.LinAlgError:
+            covariance = np.full((3, 3), np.inf)
+        rms = float(np.sqrt(ssr / residual.shape[0]))
+        worst = float(np.sqrt(np.max(np.sum(residual * residual, axis=1))))
+        ok = converged and bool(np.isfinite(rms))
+        return PlaneFit(pose, covariance, rms, worst, ok)
+
+
+def solve_board_pnp(
+    object_points: np.ndarray,
+    pixels: np.ndarray,
+    camera_info: CameraInfo,
+    expected_rotation: np.ndarray,
+) -> Transform | None:
+    """Free 6-DoF board pose by IPPE, refined by Levenberg-Marquardt.
+
+    IPPE returns the two poses a planar target is ambiguous between; the one behind the
+    camera or seen from the back is dropped, and when both explain the corners about equally
+    the one nearer the expected orientation wins, so a flipped solution never comes out.
+
+    Args:
+        object_points: Board corners in the board frame (N x 3).
+        pixels: Undistorted corner pixels (N x 2).
+        camera_info: Intrinsics (pinhole part used).
+        expected_rotation: Roughly expected ``R_camera_board`` (from the configured rig).
+
+    Returns:
+        ``T_camera_board``, or ``None`` when no valid solution exists.
+    """
+    obj = np.ascontiguousarray(object_points, dtype=np.float64)
+    img = np.ascontiguousarray(pixels, dtype=np.float64).reshape(-1, 1, 2)
+    try:
+        n, rvecs, tvecs, errors = cv2.solvePnPGeneric(
+            obj, img, camera_info.k, None, flags=cv2.SOLVEPNP_IPPE
+        )
+    except cv2.error:
+        return None
+    candidates = []
+    for i in range(n):
+        rotation = cv2.Rodrigues(rvecs[i])[0]
+        t = tvecs[i].ravel()
+        # The board's +z points into the wall, away from the camera.
+        if t[2] <= 0 or rotation[:, 2] @ t <= 0:
+            continue
+        error = float(np.ravel(errors)[i])
+        angle = np.arccos(np.clip((np.trace(expected_rotation.T @ rotation) - 1) / 2, -1, 1))
+        candidates.append((error, angle, rvecs[i], tvecs[i]))
+    if not candidates:
+        return None
+    candidates.sort(key=lambda item: item[0])
+    best = candidates[0]
+    if len(candidates) > 1 and candidates[1][0] < 1.5 * best[0] + 1e-3:
+        # Ambiguous: the errors do not decide, the orientation does.
+        best = min(candidates, key=lambda item: item[1])
+    rvec, tvec = cv2.solvePnPRefineLM(obj, img, camera_info.k, None, best[2], best[3])
+    if not (np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec))):
+        return None
+    rotation, t = cv2.Rodrigues(rvec)[0], tvec.ravel()
+    # The refinement must not have wandered behind the camera or to the board's back.
+    if t[2] <= 0 or rotation[:, 2] @ t <= 0:
+        return None
+    return Transform(rotation, t)
+
+
+def tip_pose_from_board_pose(rig: RigGeometry, camera_board: Transform) -> np.ndarray:
+    """Converts a 6-DoF board pose in the camera into an in-plane tip pose.
+
+    Args:
+        rig: Camera mount and board pose.
+        camera_board: ``T_camera_board``.
+
+    Returns:
+        ``(x, z, pitch)`` of the tip.
+    """
+    base_tip = rig.base_board @ camera_board.inverse() @ rig.tip_camera.inverse()
+    return np.array(tip_pose_from_transform(base_tip))
+
+
+def camera_board_transform(rig: RigGeometry, pose: np.ndarray) -> Transform:
+    """Returns ``T_camera_board`` for a tip pose ``(x, z, pitch)``."""
+    base_tip = tip_transform(*pose)
+    return rig.tip_camera.inverse() @ base_tip.inverse() @ rig.base_board

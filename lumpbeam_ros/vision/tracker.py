@@ -1,0 +1,362 @@
+"""The tip tracker: camera frames in, tip poses in ``beam_base`` out.
+
+Per frame: predict the corners from the last two frames (constant velocity in pixels),
+refine them in small windows, verify them (all corners, one homography through them, a
+regular grid), and fit the tip's ``(x, z, pitch)`` to them with the plane-constrained model.
+When tracking fails, or there is nothing to track, the full detector searches the frame.
+The first good frames also feed a one-off calibration of the rig's fixed unknowns.
+
+A node only converts messages and calls :meth:`TipTracker.process`; every problem with a
+frame comes back as a status, never as an exception or a stale pose.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import Enum
+
+import cv2
+import numpy as np
+
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.vision.calibration import RigCalibration, calibrate_rig
+from lumpbeam_ros.vision.camera_model import CameraInfo
+from lumpbeam_ros.vision.config import CameraConfig
+from lumpbeam_ros.vision.corners import (
+    corner_contrast,
+    grid_is_regular,
+    homography_residual,
+    refine_corners,
+)
+from lumpbeam_ros.vision.detect import detect_board
+from lumpbeam_ros.vision.pose import (
+    PlaneFit,
+    PlaneModel,
+    camera_board_transform,
+    solve_board_pnp,
+    tip_pose_from_board_pose,
+)
+
+#: Image encodings :meth:`TipTracker.process` takes (those of SPEC section 3).
+ENCODINGS = ('mono8', 'bgr8', 'rgb8')
+
+
+class TrackStatus(str, Enum):
+    """Why a frame did or did not give a pose."""
+
+    OK = 'ok'
+    BAD_IMAGE = 'bad_image'
+    TOO_DARK = 'too_dark'
+    SATURATED = 'saturated'
+    BOARD_NOT_FOUND = 'board_not_found'
+    CORNERS_REJECTED = 'corners_rejected'
+    POSE_REJECTED = 'pose_rejected'
+
+
+@dataclass(frozen=True)
+class TrackResult:
+    """The outcome of one frame.
+
+    Attributes:
+        stamp: The frame's stamp, s.
+        status: :class:`TrackStatus`.
+        reason: One human-readable line (empty when OK).
+        pose: Tip ``(x, z, pitch)`` in ``beam_base`` (m, m, rad), or ``None``.
+        covariance: 3x3 covariance of ``pose`` from the reprojection residuals, or ``None``.
+        rms_px: RMS reprojection error per corner, px (NaN without a fit).
+        corners: The measured (distorted) corner pixels (N x 2), or ``None``.
+        detected: Whether the full detector ran on this frame (tracking was lost or new).
+        calibrated: Whether the rig's fixed unknowns were already estimated.
+    """
+
+    stamp: float
+    status: TrackStatus
+    reason: str = ''
+    pose: np.ndarray | None = None
+    covariance: np.ndarray | None = None
+    rms_px: float = math.nan
+    corners: np.ndarray | None = None
+    detected: bool = False
+    calibrated: bool = False
+
+    @property
+    def ok(self) -> bool:
+        """Whether the frame gave a pose."""
+        return self.status is TrackStatus.OK
+
+
+def _failure(stamp: float, status: TrackStatus, reason: str, **extra) -> TrackResult:
+    return TrackResult(stamp, status, reason, **extra)
+
+
+class TipTracker:
+    """Tracks the tip pose through a stream of frames.
+
+    Args:
+        camera_info: The camera's intrinsics (from ``/camera/camera_info`` or the config).
+        config: Rig geometry and tracker settings (``config/camera.yaml``); its own
+            ``camera_info`` is not used.
+
+    Raises:
+        LumpbeamError: The configuration is unusable: the board is behind the camera or not
+            in view at the rig's reference pose.
+    """
+
+    def __init__(self, camera_info: CameraInfo, config: CameraConfig):
+        self.camera_info = camera_info
+        self.config = config
+        self.settings = config.tracker
+        self._board = config.rig.board
+        self._object_xy = self._board.object_points()[:, :2]
+        self._calibration: RigCalibration | None = None
+        self._set_rig(config.rig)
+        self._pending: list[tuple[np.ndarray, np.ndarray]] = []
+        self.reset()
+
+    def _set_rig(self, rig) -> None:
+        self._model = PlaneModel(rig, self.camera_info)
+        centre = rig.base_board.translation
+        reference = np.array([centre[0], centre[2], 0.0])
+        camera_board = camera_board_transform(rig, reference)
+        if camera_board.translation[2] <= 0:
+            raise LumpbeamError('tracker: the configured board is behind the camera')
+        self._expected_rotation = camera_board.rotation
+        # Image directions of the board's axes (a fronto-parallel approximation suffices:
+        # they only decide between labellings 180 degrees apart).
+        self._expected_axes = camera_board.rotation[:2, :2].T.copy()
+        corners = self._model.project(reference)
+        spacing = np.median(np.linalg.norm(np.diff(corners, axis=0), axis=1))
+        # Beyond 8 px the window costs time without measurable gain (the corner error is then
+        # dominated by the image, not the window).
+        self._half_window = int(np.clip(round(self.settings.window_fraction * spacing), 3, 8))
+
+    @property
+    def calibration(self) -> RigCalibration | None:
+        """The estimate of the rig's fixed unknowns, once made."""
+        return self._calibration
+
+    @property
+    def half_window(self) -> int:
+        """Corner refinement window half-size, px."""
+        return self._half_window
+
+    def reset(self) -> None:
+        """Forgets the tracking history (the next frame runs full detection)."""
+        self._history: list[tuple[float, np.ndarray, np.ndarray]] = []
+
+    def process(self, image: np.ndarray, stamp: float, encoding: str = 'mono8') -> TrackResult:
+        """Measures the tip pose in one frame.
+
+        Args:
+            image: H x W (mono8) or H x W x 3 (bgr8, rgb8) uint8 array.
+            stamp: Middle of the exposure, s.
+            encoding: ``'mono8'``, ``'bgr8'`` or ``'rgb8'``.
+
+        Returns:
+            The result; ``result.ok`` tells whether ``result.pose`` is set. Bad frames,
+            lost boards and failed fits come back as a status with a reason.
+        """
+        try:
+            stamp = float(stamp)
+        except (TypeError, ValueError):
+            stamp = math.nan
+        try:
+            gray, problem = self._to_gray(image, encoding)
+            if gray is None:
+                return _failure(stamp, TrackStatus.BAD_IMAGE, problem)
+            if not math.isfinite(stamp):
+                return _failure(stamp, TrackStatus.BAD_IMAGE, f'stamp {stamp!r} is not finite')
+            exposure = self._check_exposure(gray)
+            if exposure is not None:
+                self.reset()
+                return _failure(stamp, *exposure)
+            return self._track(gray, stamp)
+        except (cv2.error, np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:
+            # Corrupt data can drive OpenCV or the solver into an error; it is this frame's
+            # problem, not the stream's.
+            self.reset()
+            return _failure(stamp, TrackStatus.BAD_IMAGE, f'{type(exc).__name__}: {exc}')
+
+    def _to_gray(self, image: object, encoding: str) -> tuple[np.ndarray | None, str]:
+        if encoding not in ENCODINGS:
+            return None, f'encoding {encoding!r} is not one of {", ".join(ENCODINGS)}'
+        if not isinstance(image, np.ndarray):
+            return None, f'expected a numpy array, got {type(image).__name__}'
+        if image.dtype != np.uint8:
+            return None, f'expected uint8 pixels, got {image.dtype}'
+        channels = 1 if encoding == 'mono8' else 3
+        want = (self.camera_info.height, self.camera_info.width)
+        if (
+            image.shape[:2] != want
+            or (image.ndim == 3) != (channels == 3)
+            or (channels == 3 and image.shape[2] != 3)
+        ):
+            return None, (
+                f'{encoding} image of shape {image.shape} does not match the camera '
+                f'({want[1]} x {want[0]})'
+            )
+        if channels == 3:
+            code = cv2.COLOR_BGR2GRAY if encoding == 'bgr8' else cv2.COLOR_RGB2GRAY
+            return cv2.cvtColor(image, code), ''
+        return np.ascontiguousarray(image), ''
+
+    def _check_exposure(self, gray: np.ndarray) -> tuple[TrackStatus, str] | None:
+        # A sparse sample is plenty for grey-level statistics, and keeps this off the budget.
+        step = max(1, int(math.sqrt(gray.size / 4096)))
+        sample = gray[::step, ::step].reshape(-1)
+        counts = np.bincount(sample, minlength=256)
+        cumulative = np.cumsum(counts)
+        low = int(np.searchsorted(cumulative, 0.01 * sample.size))
+        high = int(np.searchsorted(cumulative, 0.99 * sample.size))
+        saturated = counts[255] / sample.size
+        if saturated > self.settings.max_saturated_fraction:
+            return TrackStatus.SATURATED, f'{100 * saturated:.0f} % of the pixels are at 255'
+        if high - low < self.settings.min_contrast_dn:
+            return TrackStatus.TOO_DARK, (
+                f'contrast {high - low} DN (1st to 99th percentile) is below '
+                f'{self.settings.min_contrast_dn:g} DN'
+            )
+        return None
+
+    def _predict(self, stamp: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """Constant-velocity prediction of the corners and the pose at ``stamp``."""
+        if not self._history:
+            return None
+        t1, corners1, pose1 = self._history[-1]
+        if stamp <= t1:
+            return None
+        if len(self._history) < 2:
+            return corners1, pose1
+        t0, corners0, pose0 = self._history[-2]
+        ratio = (stamp - t1) / (t1 - t0)
+        if ratio > 4.0:
+            # After a gap the velocity is stale; the last position is the better guess.
+            return corners1, pose1
+        return corners1 + ratio * (corners1 - corners0), pose1 + ratio * (pose1 - pose0)
+
+    def _verify(
+        self, gray: np.ndarray, corners: np.ndarray, homography: bool = True
+    ) -> tuple[np.ndarray | None, str]:
+        """Returns the undistorted corners if they form a whole, consistent board.
+
+        Args:
+            gray: The frame.
+            corners: Measured corners (N x 2).
+            homography: Whether to fit a homography; once the rig is calibrated, the
+                plane-constrained fit's per-corner residual is the same test, stricter.
+        """
+        if not np.all(np.isfinite(corners)):
+            missing = int(np.sum(~np.all(np.isfinite(corners), axis=1)))
+            return None, f'{missing} of {len(corners)} corners not found'
+        contrast = corner_contrast(gray, corners, self._half_window)
+        if np.min(contrast) < self.settings.min_contrast_dn:
+            weak = int(np.sum(contrast < self.settings.min_contrast_dn))
+            return None, f'{weak} corners show no checkerboard contrast (occluded?)'
+        ideal = self.camera_info.undistort_pixels(corners)
+        if not grid_is_regular(ideal, self._board.pattern_size):
+            return None, 'corner grid is folded or irregular'
+        residual = homography_residual(self._object_xy, ideal) if homography else 0.0
+        if residual > self.settings.max_homography_residual_px:
+            return None, f'corners miss a homography by {residual:.2f} px'
+        return ideal, ''
+
+    def _fit(self, ideal: np.ndarray, initial: np.ndarray) -> tuple[PlaneFit | None, str]:
+        fit = self._model.fit(ideal, initial)
+        if not fit.converged or not np.all(np.isfinite(fit.pose)):
+            return None, 'plane-constrained fit did not converge'
+        # Until the rig's fixed unknowns are estimated the model itself may be off by a few
+        # pixels; the homography check has already vouched for the corners then.
+        if self._is_calibrated():
+            if fit.rms_px > self.settings.max_rms_px:
+                return None, f'reprojection error {fit.rms_px:.2f} px exceeds the limit'
+            if fit.max_px > self.settings.max_homography_residual_px:
+                return None, f'a corner misses the fitted pose by {fit.max_px:.2f} px'
+        return fit, ''
+
+    def _track(self, gray: np.ndarray, stamp: float) -> TrackResult:
+        prediction = self._predict(stamp)
+        if prediction is None:
+            self.reset()
+        else:
+            guess, pose_guess = prediction
+            corners = refine_corners(gray, guess, self._half_window)
+            ideal, _ = self._verify(gray, corners, homography=not self._is_calibrated())
+            if ideal is not None:
+                fit, _ = self._fit(ideal, pose_guess)
+                if fit is not None:
+                    return self._accept(stamp, corners, ideal, fit, detected=False)
+        # Nothing to track, or tracking failed: search the whole frame.
+        corners = detect_board(
+            gray,
+            self._board.pattern_size,
+            self._expected_axes,
+            self.settings.detect_max_side_px,
+            self._half_window,
+        )
+        if corners is None:
+            self.reset()
+            return _failure(
+                stamp, TrackStatus.BOARD_NOT_FOUND, 'no complete checkerboard in the frame',
+                detected=True,
+            )  # fmt: skip
+        ideal, problem = self._verify(gray, corners)
+        if ideal is None:
+            self.reset()
+            return _failure(
+                stamp, TrackStatus.CORNERS_REJECTED, problem, corners=corners, detected=True
+            )
+        camera_board = solve_board_pnp(
+            self._board.object_points(), ideal, self.camera_info, self._expected_rotation
+        )
+        if camera_board is None:
+            self.reset()
+            return _failure(
+                stamp, TrackStatus.POSE_REJECTED, 'no valid PnP solution', corners=corners,
+                detected=True,
+            )  # fmt: skip
+        fit, problem = self._fit(ideal, tip_pose_from_board_pose(self._model.rig, camera_board))
+        if fit is None:
+            self.reset()
+            return _failure(
+                stamp, TrackStatus.POSE_REJECTED, problem, corners=corners, detected=True
+            )
+        return self._accept(stamp, corners, ideal, fit, detected=True)
+
+    def _accept(
+        self, stamp: float, corners: np.ndarray, ideal: np.ndarray, fit: PlaneFit, detected: bool
+    ) -> TrackResult:
+        calibrated = self._is_calibrated()
+        self._history = [*self._history[-1:], (stamp, corners, fit.pose)]
+        if not calibrated:
+            self._pending.append((ideal, fit.pose))
+            if len(self._pending) >= self.settings.calibration_frames:
+                self._calibrate()
+        return TrackResult(
+            stamp,
+            TrackStatus.OK,
+            pose=fit.pose,
+            covariance=fit.covariance,
+            rms_px=fit.rms_px,
+            corners=corners,
+            detected=detected,
+            calibrated=calibrated,
+        )
+
+    def _is_calibrated(self) -> bool:
+        return self._calibration is not None or self.settings.calibration_frames == 0
+
+    def _calibrate(self) -> None:
+        pixels = [p for p, _ in self._pending]
+        poses = [q for _, q in self._pending]
+        self._pending = []
+        try:
+            calibration = calibrate_rig(self.config.rig, self.camera_info, pixels, poses)
+        except LumpbeamError:
+            return  # keep the configured rig and try again with the next frames
+        self._calibration = calibration
+        self._set_rig(calibration.rig)
+        # The last pose was fitted with the old rig; re-fit it so the velocity is consistent.
+        t1, corners1, _ = self._history[-1]
+        refit = self._model.fit(pixels[-1], poses[-1])
+        self._history = [(t1, corners1, refit.pose)]
