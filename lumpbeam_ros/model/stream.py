@@ -108,11 +108,13 @@ class PredictionStream:
             ValueError: A negative or non-finite load.
         """
         load = _check_load(self.load_kg if load_kg is None else load_kg)
-        latency = self._beam.effects.latency_s
-        self._simulation = BeamSimulation(self._beam, load, t0=t - latency, step=self.step)
         first_index = math.ceil(t * self._rate_hz - _GRID_SLACK)
         if hasattr(self, '_time') and t >= self._time:
             first_index = max(first_index, self._next_index)  # never a stamp twice
+        # The grid slack may put the first stamp a hair before t: start the (resting) beam
+        # there, so that its first sample is not in its past.
+        start = min(t, first_index / self._rate_hz) - self._beam.effects.latency_s
+        self._simulation = BeamSimulation(self._beam, load, t0=start, step=self.step)
         self._events.clear()
         self._time = float(t)
         self._next_index = first_index

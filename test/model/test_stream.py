@@ -134,3 +134,12 @@ def test_nothing_due_gives_empty_samples():
     assert len(stream.advance_to(1.0)) == 0  # the clock has not moved
     assert len(stream.advance_to(0.5)) == 0  # went back: the caller decides
     assert len(stream.advance_to(1.001)) == 1  # the stamp at 1.0
+
+
+@pytest.mark.parametrize('t0', [3 / 180 + 3e-10, 1.0 + 1e-10, 2.5 - 1e-10])
+def test_start_a_hair_after_a_stamp_includes_it(t0):
+    # A /clock in whole nanoseconds lands a fraction of a nanosecond off the 1/180 s grid.
+    stream = PredictionStream(BEAM, 4.5, t0)
+    samples = stream.advance_to(t0 + 0.1)
+    assert samples.t[0] == pytest.approx(t0, abs=1e-9)
+    assert np.ptp(samples.z) < 1e-12
