@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from lumpbeam_ros.bagio import BagReader
+from lumpbeam_ros.bagio import BagReader, read_tip_poses
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.adopt import first_mode
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, load_beam_config
@@ -251,6 +251,11 @@ def normalize(run: DemoRun) -> None:
 def analyze(run: DemoRun) -> None:
     """Identifies the recorded drop test and compares the prediction with the measurement."""
     run.analysis = analyze_recording(run.normalized_bag, run.beam)
+    if not run.with_camera:
+        played = len(read_tip_poses(run.input_bag).t)
+        recorded = len(run.analysis.measured.t)
+        if recorded < played:
+            run.echo(f'  warning: the recorder got {recorded} of {played} poses (slow discovery?)')
 
 
 def diagnose(run: DemoRun) -> None:

@@ -149,7 +149,7 @@ class ProcessGraph:
         Raises:
             LumpbeamError: Naming the child, its exit code and the end of its log.
         """
-        for name in names or list(self.children):
+        for name in list(self.children) if names is None else names:
             child = self.children[name]
             code = child.process.poll()
             if code is not None:

@@ -123,7 +123,7 @@ def plot_measured_vs_predicted(
             label='predicted /tip_pose_predicted',
         )
         top.set_ylabel('tip z (mm)')
-        top.set_title(title)
+        figure.suptitle(title)
         bottom.plot(t[keep], residual.residual[keep] * 1e3, lw=0.6, color='tab:red')
         bottom.set_ylabel('measured - predicted (mm)')
         bottom.set_xlabel('time (s, header stamp)')
@@ -131,7 +131,8 @@ def plot_measured_vs_predicted(
             axis.grid(alpha=0.3)
             if release_time_s is not None and t[keep][0] <= release_time_s <= t[keep][-1]:
                 axis.axvline(release_time_s, color='gray', lw=0.8, ls=':')
-        top.legend(loc='lower right')
+        # Above the axes: the oscillation fills the whole plot area.
+        top.legend(loc='lower center', bbox_to_anchor=(0.5, 1.0), ncol=2, frameon=False)
         rms = float(np.sqrt(np.mean(residual.residual[keep] ** 2)))
         bottom.text(0.01, 0.9, f'RMS {rms * 1e3:.3f} mm', transform=bottom.transAxes, va='top')
         path = Path(path)
