@@ -60,7 +60,10 @@ def test_an_error_in_the_block_stops_children_and_grandchildren(tmp_path):
 
 
 def test_children_get_the_private_domain_and_local_discovery(tmp_path):
-    code = "import os; print(os.environ['ROS_DOMAIN_ID'], os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'])"
+    code = (
+        'import os; env = os.environ; '
+        "print(env['ROS_DOMAIN_ID'], env['ROS_AUTOMATIC_DISCOVERY_RANGE'])"
+    )
     with ProcessGraph(tmp_path, domain_id=42) as graph:
         graph.start('env', _python(code))
         assert graph.wait('env', 10.0) == 0
@@ -74,7 +77,14 @@ def test_interrupt_stops_with_sigint_and_kills_what_ignores_it(tmp_path, monkeyp
         "print('ready', flush=True)\n"
         'time.sleep(60)\n'
     )
-    polite = "import time\nprint('ready', flush=True)\ntry:\n    time.sleep(60)\nexcept KeyboardInterrupt:\n    pass\n"
+    polite = (
+        'import time\n'
+        "print('ready', flush=True)\n"
+        'try:\n'
+        '    time.sleep(60)\n'
+        'except KeyboardInterrupt:\n'
+        '    pass\n'
+    )
     with ProcessGraph(tmp_path) as graph:
         good = graph.start('polite', _python(polite))
         bad = graph.start('stubborn', _python(stubborn))
