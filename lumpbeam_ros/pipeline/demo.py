@@ -236,10 +236,14 @@ def replay(run: DemoRun) -> None:
         others = [name for name in graph.children if name != 'player']
         graph.wait('player', run.options.duration_s * 2 + 30.0, watch=others)
         time.sleep(0.5)  # the last messages travel to the recorder before it stops
-        graph.interrupt('recorder')
+        graph.interrupt('recorder')  # must stop cleanly: it closes the bag
         for name in others:
             if name != 'recorder':
-                graph.interrupt(name)
+                try:
+                    graph.interrupt(name)
+                except LumpbeamError as exc:
+                    # The recording is complete; a node's untidy exit only deserves a note.
+                    run.echo(f'  warning: {exc}')
     run.echo(f'  recorded {run.recorded_bag} with {", ".join(run.nodes)}')
 
 
@@ -348,22 +352,23 @@ def summarize(run: DemoRun) -> None:
 
 
 def summary_lines(summary: dict[str, Any]) -> list[str]:
-    """The human summary table of :func:`summarize`."""
+    """The human summary table of :func:`summarize` (also of its JSON read back)."""
     labels = {
         'natural_frequency_hz': ('natural frequency', 'Hz', '{:.4f}'),
         'damping_ratio': ('damping ratio', '', '{:.5f}'),
         'stiffness_total_nm_per_rad': ('k_tE (B.12)', 'N m/rad', '{:.1f}'),
     }
     lines = [
-        f'{"quantity":<20}{"identified (offline)":>24}{"live node":>12}{"truth":>12}{"paper":>10}',
+        f'{"quantity":<24}{"identified (offline)":>26}{"live node":>12}{"truth":>12}{"paper":>10}',
     ]
     for key, (label, unit, fmt) in labels.items():
         row = summary['quantities'][key]
-        ident = f'{fmt.format(row["identified"])} +- {fmt.format(row["identified_std"])}'
-        live = fmt.format(row['live']) if math.isfinite(row['live']) else '-'
+        ident = f'{fmt.format(row["identified"])} +- {row["identified_std"]:.2g}'
+        live = row['live']  # NaN in a run, None when read back from summary.json
+        live = fmt.format(live) if live is not None and math.isfinite(live) else '-'
         name = f'{label} ({unit})' if unit else label
         lines.append(
-            f'{name:<20}{ident:>24}{live:>12}{fmt.format(row["truth"]):>12}'
+            f'{name:<24}{ident:>26}{live:>12}{fmt.format(row["truth"]):>12}'
             f'{fmt.format(row["paper"]):>10}'
         )
     lines.append(

@@ -54,3 +54,26 @@ def test_demo_never_deletes_a_folder_it_did_not_make(tmp_path, capsys):
     assert (tmp_path / 'bags' / 'mine').is_dir()
     (tmp_path / 'file').write_text('x')
     assert main(['demo', '--out', str(tmp_path / 'file')]) == 2
+
+
+def test_summary_table_reads_back_from_json():
+    from lumpbeam_ros.pipeline.demo import summary_lines
+
+    row = {'identified': 3.0588, 'identified_std': 1e-6, 'live': None, 'truth': 3.0588}
+    summary = {
+        'quantities': {
+            key: {**row, 'paper': 1.0}
+            for key in ('natural_frequency_hz', 'damping_ratio', 'stiffness_total_nm_per_rad')
+        },
+        'prediction_rms_m': 2e-5,
+        'prediction_rms_after_release_m': 2e-5,
+        'prediction_max_m': 6e-5,
+        'measured_samples': 10,
+        'diagnosis': {'missing_effect': 'none'},
+    }
+    lines = summary_lines(summary)
+    assert lines[1].split() == [
+        *('natural', 'frequency', '(Hz)'),
+        *('3.0588', '+-', '1e-06', '-', '3.0588', '1.0000'),
+    ]
+    assert 'RMS 0.020 mm' in lines[4] and lines[-1] == 'diagnosis: missing effect none'
