@@ -1,0 +1,395 @@
+"""The simulator node: the lumped beam in step with the node's clock, on ``/tip_pose_predicted``.
+
+Subscribes ``/tip_load`` (std_msgs/Float64, kg; reliable, transient local, depth 1 as
+:mod:`lumpbeam_ros.bagio.qos` says) and ``/beam_params`` (diagnostic_msgs/DiagnosticArray);
+publishes ``/tip_pose_predicted`` (geometry_msgs/PoseStamped in ``beam_base``). A steady
+timer advances a :class:`~lumpbeam_ros.model.stream.PredictionStream` to the node's clock
+(wall time, or ``/clock`` with ``use_sim_time``) and publishes the samples due since the last
+tick, each stamped with its model time. Parameters: ``config/simulator.yaml``, where each is
+documented; its values are the node's defaults.
+
+Run it::
+
+    simulator_node --ros-args --params-file config/simulator.yaml -p use_sim_time:=true
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import rclpy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from geometry_msgs.msg import PoseStamped
+from rcl_interfaces.msg import (
+    FloatingPointRange,
+    ParameterDescriptor,
+    ParameterType,
+    SetParametersResult,
+)
+from rclpy.clock import Clock, ClockType
+from rclpy.context import Context
+from rclpy.exceptions import ParameterException
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from std_msgs.msg import Float64
+
+from lumpbeam_ros.bagio.convert import NS_PER_S, pitch_to_quaternion, seconds_to_ns
+from lumpbeam_ros.bagio.qos import default_profile
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.model.adopt import adopt_identified
+from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
+from lumpbeam_ros.model.stream import PredictionStream
+from lumpbeam_ros.model.trajectory import TipTrajectory
+from lumpbeam_ros.nodes.msgtypes import from_bag_qos
+from lumpbeam_ros.paramfile import read_parameter_file
+from lumpbeam_ros.resources import config_path
+
+FRAME_ID = 'beam_base'
+IDENTIFIER_STATUS = 'lumpbeam/identifier'
+#: DiagnosticStatus.OK as a number (rclpy gives levels as one byte).
+OK_LEVEL = 0
+#: A throttled warning repeats at most this often, s.
+WARN_PERIOD_S = 5.0
+#: Publisher depth: a late tick publishes several periods' samples in one burst.
+PREDICTION_DEPTH = 100
+
+
+@dataclass(frozen=True)
+class _Spec:
+    """A parameter's type, description and range (``None``: no range)."""
+
+    kind: int
+    description: str
+    low: float | None = None
+    high: float | None = None
+
+    def descriptor(self, name: str) -> ParameterDescriptor:
+        descriptor = ParameterDescriptor(name=name, type=self.kind, description=self.description)
+        if self.low is not None and self.high is not None:
+            descriptor.floating_point_range = [
+                FloatingPointRange(from_value=self.low, to_value=self.high, step=0.0)
+            ]
+        return descriptor
+
+
+#: The parameters (their defaults are in config/simulator.yaml, documented there).
+PARAMETERS: dict[str, _Spec] = {
+    'beam_config': _Spec(
+        ParameterType.PARAMETER_STRING,
+        "beam parameter file; empty: the package's paper_beam.yaml",
+    ),
+    'rate_hz': _Spec(
+        ParameterType.PARAMETER_DOUBLE, 'rate of /tip_pose_predicted, Hz', 1.0, 2000.0
+    ),
+    'tick_rate_hz': _Spec(
+        ParameterType.PARAMETER_DOUBLE,
+        'how often the model is advanced and published, Hz',
+        1.0,
+        1000.0,
+    ),
+    'initial_load_kg': _Spec(
+        ParameterType.PARAMETER_DOUBLE, 'load assumed until the first /tip_load, kg', 0.0, 1000.0
+    ),
+    'adopt_identified': _Spec(
+        ParameterType.PARAMETER_BOOL, 'adopt k_tE and the damping ratio from /beam_params'
+    ),
+    'reset_jump_back_s': _Spec(
+        ParameterType.PARAMETER_DOUBLE,
+        'a clock step back beyond this restarts at rest, s',
+        0.0,
+        3600.0,
+    ),
+    'max_catch_up_s': _Spec(
+        ParameterType.PARAMETER_DOUBLE,
+        'a clock jump ahead beyond this restarts at rest, s',
+        0.01,
+        3600.0,
+    ),
+}
+
+
+def default_parameters() -> dict[str, Any]:
+    """The node's defaults: the values of the package's ``config/simulator.yaml``.
+
+    Raises:
+        ConfigError: The file is missing or malformed.
+    """
+    return read_parameter_file(config_path('simulator.yaml'))
+
+
+def check_parameter(name: str, value: Any) -> str | None:
+    """Checks one parameter's value beyond what its descriptor's range enforces.
+
+    Args:
+        name: The parameter.
+        value: The value to set.
+
+    Returns:
+        ``None`` when acceptable, else the reason it is refused (one line).
+    """
+    spec = PARAMETERS.get(name)
+    if spec is None:
+        return None  # rclpy's own (use_sim_time) and undeclared ones are rclpy's business
+    if spec.low is not None and spec.high is not None:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            return f'{name} must be a number, got {value!r}'
+        if not math.isfinite(value) or not spec.low <= value <= spec.high:
+            return f'{name} must be in [{spec.low}, {spec.high}], got {value!r}'
+    return None
+
+
+def load_beam(path: str) -> BeamParameters:
+    """Reads the beam of ``beam_config`` (empty: the package's ``paper_beam.yaml``).
+
+    Raises:
+        ConfigError: The file is missing or malformed.
+    """
+    beam, _ = load_beam_config(Path(path) if path else None)
+    return beam
+
+
+class SimulatorNode(Node):
+    """Publishes the predicted tip pose of the lumped beam under the live tip load.
+
+    Args:
+        context: The rclpy context (``None``: the default one).
+        parameter_overrides: Parameter values that replace the defaults (as ``-p`` would).
+
+    Raises:
+        ConfigError: The beam file or ``config/simulator.yaml`` is missing or malformed.
+        rclpy.exceptions.ParameterException: A parameter outside its range.
+    """
+
+    def __init__(
+        self,
+        context: Context | None = None,
+        parameter_overrides: Sequence[Parameter] | None = None,
+    ):
+        super().__init__(
+            'simulator_node', context=context, parameter_overrides=list(parameter_overrides or [])
+        )
+        defaults = default_parameters()
+        for name, spec in PARAMETERS.items():
+            self.declare_parameter(name, defaults[name], spec.descriptor(name))
+        values = {name: self.get_parameter(name).value for name in PARAMETERS}
+        for name, value in values.items():
+            reason = check_parameter(name, value)
+            if reason is not None:
+                raise LumpbeamError(reason)
+        self._settings = values
+        self._base_beam = load_beam(values['beam_config'])
+        self._stream: PredictionStream | None = None
+        self._load_kg = float(values['initial_load_kg'])
+        self._load_seen = False
+        self._adopted: tuple[float, float] | None = None
+        self._adopted_beam: BeamParameters | None = None
+        self._warned_at: dict[str, float] = {}
+        self.add_on_set_parameters_callback(self._on_set_parameters)
+
+        load_qos = from_bag_qos(default_profile('/tip_load', 'std_msgs/msg/Float64'))
+        self._pose_out = self.create_publisher(
+            PoseStamped, '/tip_pose_predicted', PREDICTION_DEPTH
+        )
+        self.create_subscription(Float64, '/tip_load', self._on_load, load_qos)
+        self.create_subscription(DiagnosticArray, '/beam_params', self._on_beam_params, 10)
+        # A steady timer: under use_sim_time the node must notice a stalled or jumping /clock,
+        # which a timer on that clock would not fire to see.
+        self._steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self._timer = self._make_timer(values['tick_rate_hz'])
+        sim = self.get_parameter('use_sim_time').value
+        self.get_logger().info(
+            f'simulator ready: n_s={self._base_beam.n_segments}, '
+            f'{values["rate_hz"]:g} Hz, {"sim" if sim else "wall"} time'
+        )
+
+    # -- public state, for tests and tools ----------------------------------------------------
+
+    @property
+    def beam(self) -> BeamParameters:
+        """The beam being simulated now (the adopted one when adopting)."""
+        return self._adopted_beam or self._base_beam
+
+    @property
+    def stream(self) -> PredictionStream | None:
+        """The running simulation; ``None`` until the clock has started."""
+        return self._stream
+
+    # -- callbacks ----------------------------------------------------------------------------
+
+    def _tick(self) -> None:
+        now = self._now()
+        stream = self._stream
+        if stream is None:
+            if now > 0.0:  # zero: under use_sim_time, no /clock yet
+                self._start(now)
+            return
+        if now < stream.time - self._settings['reset_jump_back_s']:
+            self.get_logger().info(
+                f'clock jumped back from {stream.time:.3f} s to {now:.3f} s: '
+                f'restarting at rest with {stream.load_kg:g} kg'
+            )
+            stream.reset(now)
+            return
+        if now - stream.time > self._settings['max_catch_up_s']:
+            self.get_logger().warning(
+                f'clock jumped ahead by {now - stream.time:.3f} s: restarting at rest'
+            )
+            stream.reset(now)
+            return
+        self._publish(stream.advance_to(now))
+
+    def _on_load(self, msg: Float64) -> None:
+        kg = float(msg.data)
+        if not math.isfinite(kg) or kg < 0.0:
+            self._warn_throttled('load', f'ignoring /tip_load of {kg!r} kg: not a mass')
+            return
+        first = not self._load_seen
+        self._load_seen = True
+        changed = kg != self._load_kg
+        self._load_kg = kg
+        if self._stream is None:
+            return  # the stream starts with it
+        if first:
+            # The first reading says what has been hanging there all along, not a change.
+            self._stream.reset(max(self._now(), self._stream.time), kg)
+        elif changed:
+            self._stream.set_load(self._now(), kg)
+
+    def _on_beam_params(self, msg: DiagnosticArray) -> None:
+        if not self._settings['adopt_identified']:
+            return
+        for status in msg.status:
+            if status.name != IDENTIFIER_STATUS or _level(status) != OK_LEVEL:
+                continue
+            values = {kv.key: kv.value for kv in status.values}
+            try:
+                k_total = float(values['stiffness_total_nm_per_rad'])
+                zeta = float(values['damping_ratio'])
+            except (KeyError, ValueError) as exc:
+                self._warn_throttled('params', f'ignoring /beam_params: bad or missing {exc}')
+                return
+            if (k_total, zeta) == self._adopted:
+                return
+            try:
+                beam = adopt_identified(self._base_beam, k_total, zeta)
+            except LumpbeamError as exc:
+                self._warn_throttled('params', f'ignoring /beam_params: {exc}')
+                return
+            self._adopted, self._adopted_beam = (k_total, zeta), beam
+            if self._stream is not None:
+                self._stream.set_beam(beam)
+            self.get_logger().info(
+                f'adopted k_tE={k_total:.1f} N m/rad, zeta={zeta:.5f} (c_tE={beam.c_total:.4f})'
+            )
+
+    def _on_set_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
+        changes = {p.name: p.value for p in parameters if p.name in PARAMETERS}
+        for name, value in changes.items():
+            reason = check_parameter(name, value)
+            if reason is not None:
+                return SetParametersResult(successful=False, reason=reason)
+        new_beam = None
+        if 'beam_config' in changes:
+            try:
+                new_beam = load_beam(changes['beam_config'])
+            except LumpbeamError as exc:
+                return SetParametersResult(successful=False, reason=str(exc))
+        self._apply(changes, new_beam)
+        return SetParametersResult(successful=True)
+
+    # -- helpers ------------------------------------------------------------------------------
+
+    def _apply(self, changes: Mapping[str, Any], new_beam: BeamParameters | None) -> None:
+        self._settings.update(changes)
+        if 'tick_rate_hz' in changes:
+            self.destroy_timer(self._timer)
+            self._timer = self._make_timer(changes['tick_rate_hz'])
+        if 'adopt_identified' in changes and not changes['adopt_identified']:
+            self._adopted, self._adopted_beam = None, None
+            new_beam = new_beam or self._base_beam
+        if new_beam is not None:
+            self._base_beam = new_beam
+            self._adopted, self._adopted_beam = None, None
+        stream = self._stream
+        if stream is None:
+            return
+        if 'rate_hz' in changes:
+            stream.rate_hz = float(changes['rate_hz'])
+        if new_beam is not None:
+            if new_beam.n_segments == stream.beam.n_segments:
+                stream.set_beam(new_beam)
+            else:
+                self._stream = None  # restarts at rest on the next tick with the new chain
+        if not self._load_seen and 'initial_load_kg' in changes:
+            self._load_kg = float(changes['initial_load_kg'])
+            if self._stream is not None:
+                self._stream.reset(max(self._now(), self._stream.time), self._load_kg)
+
+    def _start(self, now: float) -> None:
+        self._stream = PredictionStream(self.beam, self._load_kg, now, self._settings['rate_hz'])
+        self.get_logger().info(f'simulation started at {now:.3f} s with {self._load_kg:g} kg')
+
+    def _make_timer(self, tick_rate_hz: float) -> Any:
+        return self.create_timer(1.0 / tick_rate_hz, self._tick, clock=self._steady)
+
+    def _now(self) -> float:
+        return self.get_clock().now().nanoseconds / NS_PER_S
+
+    def _publish(self, samples: TipTrajectory) -> None:
+        for i in range(len(samples)):
+            msg = PoseStamped()
+            msg.header.frame_id = FRAME_ID
+            sec, nanosec = divmod(seconds_to_ns(float(samples.t[i])), NS_PER_S)
+            msg.header.stamp.sec, msg.header.stamp.nanosec = sec, nanosec
+            msg.pose.position.x = float(samples.x[i])
+            msg.pose.position.z = float(samples.z[i])
+            q = msg.pose.orientation
+            q.x, q.y, q.z, q.w = pitch_to_quaternion(float(samples.pitch[i]))
+            self._pose_out.publish(msg)
+
+    def _warn_throttled(self, key: str, text: str) -> None:
+        now = self._steady.now().nanoseconds / NS_PER_S
+        if now - self._warned_at.get(key, -math.inf) >= WARN_PERIOD_S:
+            self._warned_at[key] = now
+            self.get_logger().warning(text)
+
+
+def _level(status: DiagnosticStatus) -> int:
+    level = status.level
+    return level[0] if isinstance(level, bytes) else int(level)
+
+
+def main(args: Sequence[str] | None = None) -> int:
+    """Runs the simulator node until Ctrl-C (console script ``simulator_node``).
+
+    Args:
+        args: Command-line arguments (``--ros-args ...``); ``sys.argv`` when ``None``.
+
+    Returns:
+        0 after a clean stop, 2 for a bad parameter or beam file.
+    """
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = SimulatorNode()
+        rclpy.spin(node)
+    except (LumpbeamError, ParameterException) as exc:
+        print(f'simulator_node: error: {exc}', file=sys.stderr)
+        return 2
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,189 @@
+"""Offline analysis of a bag recorded from the live graph (ROS-free).
+
+A recorder logs ``/tip_load`` (Float64, no header) at the wall time it arrived, while the
+poses carry the replayed bag's own time (``/clock``). Recording ``/clock`` as well gives the
+map between the two: :func:`normalize_recording` writes a copy in which every message is
+logged at its sim time (each load reading at the ``/clock`` the graph showed when it arrived,
+as a node with ``use_sim_time`` saw it), which every offline tool then reads as it reads a
+synthetic bag.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from lumpbeam_ros.bagio import BagReader, BagWriter, convert, read_diagnostics, read_tip_poses
+from lumpbeam_ros.bagio.series import PoseSeries, read_load_events
+from lumpbeam_ros.errors import BagError
+from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.identify import identify
+from lumpbeam_ros.ident.result import Identification
+from lumpbeam_ros.ident.samples import clean_loads, clean_window
+from lumpbeam_ros.model.parameters import BeamParameters
+from lumpbeam_ros.plots.demo import Residual, prediction_residual
+
+IDENTIFIER_STATUS = 'lumpbeam/identifier'
+#: Pose topics a normalized recording keeps.
+POSE_TOPICS = ('/tip_pose', '/tip_pose_predicted', '/tip_pose_truth')
+
+
+@dataclass(frozen=True)
+class RecordingAnalysis:
+    """What a recorded drop test shows.
+
+    Attributes:
+        measured: ``/tip_pose``.
+        predicted: ``/tip_pose_predicted``.
+        load_t: ``/tip_load`` readings in sim time, s.
+        load_kg: Their values, kg.
+        identification: The offline identification of ``/tip_pose`` and ``/tip_load``.
+        live: The last ``/beam_params`` values of the identifier node (empty if none).
+        live_level: Its DiagnosticStatus level (-1 if none).
+        residual: Measured against predicted, on the measured stamps.
+    """
+
+    measured: PoseSeries
+    predicted: PoseSeries
+    load_t: np.ndarray
+    load_kg: np.ndarray
+    identification: Identification
+    live: dict[str, str]
+    live_level: int
+    residual: Residual
+
+
+def clock_time(
+    log_s: np.ndarray, clock_log_s: np.ndarray, clock_value_s: np.ndarray
+) -> np.ndarray:
+    """Maps log times to the sim time the graph showed then (the latest ``/clock`` before).
+
+    Args:
+        log_s: Log times to map, s.
+        clock_log_s: Log times of the ``/clock`` messages, s, increasing.
+        clock_value_s: Their values, s.
+
+    Returns:
+        Sim times; NaN for log times before the first ``/clock``.
+    """
+    index = np.searchsorted(clock_log_s, np.asarray(log_s, float), side='right') - 1
+    out = np.full(index.shape, np.nan)
+    valid = index >= 0
+    out[valid] = np.asarray(clock_value_s, float)[index[valid]]
+    return out
+
+
+def read_clock(bag: str | Path) -> tuple[np.ndarray, np.ndarray]:
+    """Reads ``/clock`` as ``(log time s, clock value s)``, in log order.
+
+    Raises:
+        BagError: No ``/clock`` in the bag, or corrupt messages.
+    """
+    rows = [
+        (convert.ns_to_seconds(ns), convert.ns_to_seconds(convert.time_ns(msg.clock)))
+        for ns, msg in BagReader(bag).messages('/clock', 'rosgraph_msgs/msg/Clock')
+    ]
+    if not rows:
+        raise BagError(f'{bag}: /clock has no message, so /tip_load cannot be put in sim time')
+    log_s, value_s = np.array(rows).T
+    return log_s, value_s
+
+
+def normalize_recording(recorded: str | Path, out: str | Path) -> Path:
+    """Copies a recording with every message logged at its sim time.
+
+    Poses and ``/beam_params`` are logged at their header stamps; ``/tip_load`` readings at
+    the ``/clock`` shown when they were recorded (readings before the first ``/clock`` are
+    dropped: they have no sim time).
+
+    Args:
+        recorded: The bag the recorder wrote (with ``/clock``).
+        out: The bag folder to create.
+
+    Returns:
+        ``out``.
+
+    Raises:
+        BagError: ``/clock`` or ``/tip_load`` is missing, or ``out`` exists.
+    """
+    reader = BagReader(recorded)
+    clock_log, clock_value = read_clock(recorded)
+    loads = read_load_events(recorded)
+    load_t = clock_time(loads.t, clock_log, clock_value)
+    with BagWriter(out) as bag:
+        for topic in POSE_TOPICS:
+            if topic in reader.topics:
+                bag.add_topic(topic, 'geometry_msgs/msg/PoseStamped')
+                for _, msg in reader.messages(topic, 'geometry_msgs/msg/PoseStamped'):
+                    bag.write_message(topic, msg, convert.time_ns(msg.header.stamp))
+        bag.add_topic('/tip_load', 'std_msgs/msg/Float64')
+        for t, kg in zip(load_t, loads.kg, strict=True):
+            if np.isfinite(t):
+                bag.write_float('/tip_load', float(t), float(kg))
+        if '/beam_params' in reader.topics:
+            for _, msg in reader.messages('/beam_params', 'diagnostic_msgs/msg/DiagnosticArray'):
+                bag.write_message('/beam_params', msg, convert.time_ns(msg.header.stamp))
+    return Path(out)
+
+
+def last_live_status(bag: str | Path) -> tuple[dict[str, str], int]:
+    """The last ``lumpbeam/identifier`` status on ``/beam_params`` (``({}, -1)`` if none)."""
+    if '/beam_params' not in BagReader(bag).topics:
+        return {}, -1
+    for _, statuses in reversed(read_diagnostics(bag)):
+        for status in statuses:
+            if status.name == IDENTIFIER_STATUS:
+                return dict(status.values), status.level
+    return {}, -1
+
+
+def analyze_recording(
+    bag: str | Path, beam: BeamParameters, config: IdentifierConfig | None = None
+) -> RecordingAnalysis:
+    """Identifies the drop test in a normalized recording and compares it with the prediction.
+
+    Args:
+        bag: A bag from :func:`normalize_recording` (or any bag whose ``/tip_load`` is logged
+            in the poses' time) with ``/tip_pose``, ``/tip_pose_predicted`` and ``/tip_load``.
+        beam: The beam the identification assumes (L, g, masses; B.12).
+        config: Identifier settings (defaults when ``None``).
+
+    Returns:
+        The analysis.
+
+    Raises:
+        BagError: A topic is missing or empty.
+        LumpbeamError: The poses do not hold a usable drop test.
+    """
+    measured = read_tip_poses(bag, '/tip_pose')
+    predicted = read_tip_poses(bag, '/tip_pose_predicted')
+    for name, series in (('/tip_pose', measured), ('/tip_pose_predicted', predicted)):
+        if series.t.size == 0:
+            raise BagError(f'{bag}: {name} has no message')
+    loads = read_load_events(bag)
+    readings = clean_loads(loads.t, loads.kg)
+    window = clean_window(measured.t, measured.z, measured.pitch, readings)
+    identification = identify(window, beam, config, strict=True)
+    live, level = last_live_status(bag)
+    residual = prediction_residual(measured.t, measured.z, predicted.t, predicted.z)
+    return RecordingAnalysis(
+        measured=measured,
+        predicted=predicted,
+        load_t=readings.t,
+        load_kg=readings.kg,
+        identification=identification,
+        live=live,
+        live_level=level,
+        residual=residual,
+    )
+
+
+def live_value(analysis: RecordingAnalysis, key: str) -> float:
+    """A float from the live ``/beam_params`` (NaN when absent or not a number)."""
+    try:
+        return float(analysis.live[key])
+    except (KeyError, ValueError):
+        return math.nan

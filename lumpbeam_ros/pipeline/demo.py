@@ -1,0 +1,450 @@
+"""``lumpbeam demo``: the whole pipeline on the built-in synthetic drop test, as a list of steps.
+
+1. ``synthesize``: a drop-test bag (``/tip_pose`` with noise, ``/tip_pose_truth``,
+   ``/tip_load``; images once the synthetic camera writes them).
+2. ``replay``: the live graph as separate processes on a private ROS domain: the player
+   (``lumpbeam play``, with ``/clock``), the simulator node (``use_sim_time``), the identifier
+   node and the camera node when they are installed (the camera only for a bag with images;
+   it then makes ``/tip_pose`` from the images instead of the player), and the recorder
+   (``lumpbeam record``), stopped with SIGINT once the replay is over.
+3. ``normalize``: the recording with every message logged at its sim time.
+4. ``analyze``: offline identification of the recorded ``/tip_pose`` and ``/tip_load``, and
+   the prediction residual.
+5. ``diagnose`` (when ``lumpbeam diagnose`` is installed): the model-discrepancy workflow on
+   the recording.
+6. ``figures`` and ``summary``: measured against predicted (Figs. B.8-B.10), the table.
+
+Each step is a function of the :class:`DemoRun` it fills in; :func:`default_steps` lists them,
+so a step can be added or swapped without touching the others.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import math
+import shutil
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from lumpbeam_ros.bagio import BagReader, read_tip_poses
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.model.adopt import first_mode
+from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, load_beam_config
+from lumpbeam_ros.pipeline.analysis import (
+    RecordingAnalysis,
+    analyze_recording,
+    live_value,
+    normalize_recording,
+)
+from lumpbeam_ros.pipeline.graph import (
+    ProcessGraph,
+    node_command,
+    python_command,
+    wait_for_graph,
+)
+
+SIMULATOR_MODULE = 'lumpbeam_ros.nodes.simulator_node'
+IDENTIFIER_MODULE = 'lumpbeam_ros.nodes.identifier_node'
+CAMERA_MODULE = 'lumpbeam_ros.nodes.camera_node'
+DIAGNOSE_MODULE = 'lumpbeam_ros.cli.diagnose'
+CLI_MODULE = 'lumpbeam_ros.cli.main'
+IMAGE_TOPIC = '/camera/image_raw'
+CAMERA_INFO_TOPIC = '/camera/camera_info'
+#: What the recorder records, with the types the probe announces them with.
+RECORDED_TOPICS = {
+    '/tip_pose': 'geometry_msgs/msg/PoseStamped',
+    '/tip_load': 'std_msgs/msg/Float64',
+    '/tip_pose_predicted': 'geometry_msgs/msg/PoseStamped',
+    '/beam_params': 'diagnostic_msgs/msg/DiagnosticArray',
+    '/clock': 'rosgraph_msgs/msg/Clock',
+}
+#: The player waits this long before its first message: its publishers must be discovered
+#: by the recorder's subscriptions first (a new process takes 1-3 s on a busy machine).
+PLAYER_DELAY_S = 4.0
+#: The folder under ``out`` that holds the demo's bags; its marker file lets a new run
+#: replace it without ever deleting a folder the demo did not make.
+BAGS_DIR = 'bags'
+MARKER = '.lumpbeam-demo'
+
+#: The paper's figures for its beam (section B.3.2): f_E = 3.24 Hz, k_tE = 3899.1 N m/rad and
+#: c_tE = 0.08, whose damping ratio by B.22 is c_tE / (2 omega_d).
+PAPER = {
+    'natural_frequency_hz': 3.24,
+    'damping_ratio': 0.08 / (2.0 * 2.0 * math.pi * 3.24),
+    'stiffness_total_nm_per_rad': 3899.1,
+}
+
+
+@dataclass(frozen=True)
+class DemoOptions:
+    """What ``lumpbeam demo`` varies.
+
+    Attributes:
+        out: Output folder (bags, logs, figures, summary).
+        duration_s: Length of the synthetic record, s (the load drops at 2 s).
+        seed: Seed of the pose noise.
+        adopt_identified: Let the simulator adopt the identifier's live estimates.
+        domain_id: ROS domain of the graph; a random private one when ``None``.
+        beam_config: Beam parameter file (the package's paper_beam.yaml when ``None``).
+        ready_timeout_s: Longest wait for the nodes to join the graph, s.
+    """
+
+    out: Path = Path('results')
+    duration_s: float = 12.0
+    seed: int = 0
+    adopt_identified: bool = False
+    domain_id: int | None = None
+    beam_config: Path | None = None
+    ready_timeout_s: float = 60.0
+
+
+@dataclass
+class DemoRun:
+    """The state the steps share and fill in.
+
+    Attributes:
+        options: The options.
+        beam: The beam of the synthetic experiment.
+        drop: Its load and release time.
+        echo: Where progress lines go.
+        input_bag: The synthetic bag.
+        recorded_bag: What the recorder wrote.
+        normalized_bag: The recording in sim time.
+        with_camera: Whether the camera node made ``/tip_pose`` from images.
+        nodes: The node modules that ran in the graph.
+        analysis: The offline analysis.
+        diagnosis: ``lumpbeam diagnose``'s JSON result, when it ran.
+        figures: Written figures.
+        summary: The machine-readable summary (also ``summary.json``).
+        step_seconds: Wall time of each step, s.
+    """
+
+    options: DemoOptions
+    beam: BeamParameters
+    drop: DropTestConfig
+    echo: Callable[[str], None] = print
+    input_bag: Path = Path()
+    recorded_bag: Path = Path()
+    normalized_bag: Path = Path()
+    with_camera: bool = False
+    nodes: list[str] = field(default_factory=list)
+    analysis: RecordingAnalysis | None = None
+    diagnosis: dict[str, Any] | None = None
+    figures: list[Path] = field(default_factory=list)
+    summary: dict[str, Any] = field(default_factory=dict)
+    step_seconds: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def out(self) -> Path:
+        """The output folder."""
+        return self.options.out
+
+    @property
+    def log_dir(self) -> Path:
+        """Where the child processes' logs go."""
+        return self.options.out / 'logs'
+
+
+Step = tuple[str, Callable[[DemoRun], None]]
+
+
+def module_available(name: str) -> bool:
+    """Whether a module of this package is installed (without importing it)."""
+    try:
+        return importlib.util.find_spec(name) is not None
+    except ModuleNotFoundError:
+        return False
+
+
+def synthesize(run: DemoRun) -> None:
+    """Writes the synthetic drop-test bag (``out/bags/input``)."""
+    from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+
+    bags = _fresh_bags_dir(run.out / BAGS_DIR)
+    run.input_bag = bags / 'input'
+    run.recorded_bag = bags / 'recorded'
+    run.normalized_bag = bags / 'recorded_sim_time'
+    options = SynthOptions(duration_s=run.options.duration_s, seed=run.options.seed)
+    write_drop_test_bag(run.input_bag, run.beam, run.drop, options)
+    run.echo(
+        f'  wrote {run.input_bag} ({run.options.duration_s:g} s, release at '
+        f'{run.drop.release_time_s:g} s)'
+    )
+
+
+def replay(run: DemoRun) -> None:
+    """Runs the live graph on the synthetic bag and records it (``out/bags/recorded``)."""
+    topics = BagReader(run.input_bag).topics
+    run.with_camera = IMAGE_TOPIC in topics and module_available(CAMERA_MODULE)
+    sim_time = ('-p', 'use_sim_time:=true')
+    simulator_args = [
+        *sim_time,
+        '-p',
+        f'adopt_identified:={str(run.options.adopt_identified).lower()}',
+    ]
+    if run.options.beam_config is not None:
+        simulator_args += ['-p', f'beam_config:={run.options.beam_config}']
+    # Readers each recorded topic must have before the replay: the probe's and the
+    # recorder's, plus the simulator's own inputs.
+    readers = dict.fromkeys(RECORDED_TOPICS, 2)
+    readers['/tip_load'] += 1
+    readers['/clock'] += 1
+    readers['/beam_params'] += 1
+    with ProcessGraph(run.log_dir, run.options.domain_id) as graph:
+        run.echo(f'  ROS_DOMAIN_ID={graph.domain_id}, logs in {run.log_dir}')
+        graph.start('simulator', node_command(SIMULATOR_MODULE, *simulator_args))
+        run.nodes = [SIMULATOR_MODULE]
+        if module_available(IDENTIFIER_MODULE):
+            graph.start('identifier', node_command(IDENTIFIER_MODULE, *sim_time))
+            run.nodes.append(IDENTIFIER_MODULE)
+            readers['/tip_pose'] += 1
+            readers['/tip_load'] += 1
+        if run.with_camera:
+            graph.start('camera', node_command(CAMERA_MODULE, *sim_time))
+            run.nodes.append(CAMERA_MODULE)
+            readers[IMAGE_TOPIC] = 1
+        graph.start(
+            'recorder',
+            python_command(CLI_MODULE, 'record', str(run.recorded_bag), *RECORDED_TOPICS),
+        )
+        wait_for_graph(
+            graph,
+            ['simulator_node', 'lumpbeam_recorder'],
+            readers,
+            run.options.ready_timeout_s,
+            announce=RECORDED_TOPICS,
+        )
+        played = [IMAGE_TOPIC, '/tip_load'] if run.with_camera else ['/tip_pose', '/tip_load']
+        if run.with_camera and CAMERA_INFO_TOPIC in topics:
+            played.append(CAMERA_INFO_TOPIC)
+        graph.start(
+            'player',
+            python_command(
+                CLI_MODULE,
+                'play',
+                str(run.input_bag),
+                '--topics',
+                *played,
+                '--delay',
+                str(PLAYER_DELAY_S),
+            ),
+        )
+        others = [name for name in graph.children if name != 'player']
+        graph.wait('player', run.options.duration_s * 2 + 30.0, watch=others)
+        time.sleep(0.5)  # the last messages travel to the recorder before it stops
+        graph.interrupt('recorder')  # must stop cleanly: it closes the bag
+        for name in others:
+            if name != 'recorder':
+                try:
+                    graph.interrupt(name)
+                except LumpbeamError as exc:
+                    # The recording is complete; a node's untidy exit only deserves a note.
+                    run.echo(f'  warning: {exc}')
+    run.echo(f'  recorded {run.recorded_bag} with {", ".join(run.nodes)}')
+
+
+def normalize(run: DemoRun) -> None:
+    """Writes the recording with every message logged at its sim time."""
+    normalize_recording(run.recorded_bag, run.normalized_bag)
+
+
+def analyze(run: DemoRun) -> None:
+    """Identifies the recorded drop test and compares the prediction with the measurement."""
+    run.analysis = analyze_recording(run.normalized_bag, run.beam)
+    if not run.with_camera:
+        played = len(read_tip_poses(run.input_bag).t)
+        recorded = len(run.analysis.measured.t)
+        if recorded < played:
+            run.echo(f'  warning: the recorder got {recorded} of {played} poses (slow discovery?)')
+
+
+def diagnose(run: DemoRun) -> None:
+    """Runs ``lumpbeam diagnose`` on the recording (a child process, its JSON kept)."""
+    import subprocess
+
+    out_json = run.out / 'diagnosis.json'
+    command = python_command(
+        CLI_MODULE,
+        'diagnose',
+        str(run.normalized_bag),
+        '--json',
+        str(out_json),
+        '--plots',
+        str(run.out / 'figures'),
+    )
+    log = run.log_dir / 'diagnose.log'
+    with log.open('wb') as handle:
+        code = subprocess.run(command, stdout=handle, stderr=subprocess.STDOUT, check=False)
+    if code.returncode != 0:
+        raise LumpbeamError(f'lumpbeam diagnose failed with code {code.returncode} (log: {log})')
+    run.diagnosis = json.loads(out_json.read_text(encoding='utf-8'))
+
+
+def figures(run: DemoRun) -> None:
+    """Draws measured against predicted (whole record, and the release) with the residual."""
+    from lumpbeam_ros.plots.demo import plot_measured_vs_predicted
+
+    analysis = _analysis(run)
+    release = run.drop.release_time_s
+    folder = run.out / 'figures'
+    run.figures = [
+        plot_measured_vs_predicted(
+            analysis.residual,
+            folder / 'tip_measured_vs_predicted.png',
+            release_time_s=release,
+        ),
+        plot_measured_vs_predicted(
+            analysis.residual,
+            folder / 'tip_release_zoom.png',
+            span=(release - 0.5, release + 3.0),
+            release_time_s=release,
+            title='Tip after the release: measured and predicted',
+        ),
+    ]
+
+
+def summarize(run: DemoRun) -> None:
+    """Builds the summary (identified, live, truth, paper), prints it, writes summary.json."""
+    analysis = _analysis(run)
+    ident = analysis.identification
+    f_n, _, zeta = first_mode(run.beam, 0.0)
+    truth = {
+        'natural_frequency_hz': f_n,
+        'damping_ratio': zeta,
+        'stiffness_total_nm_per_rad': run.beam.k_total_nm_per_rad,
+    }
+    rows = {}
+    for key in truth:
+        rows[key] = {
+            'identified': getattr(ident, key),
+            'identified_std': getattr(ident, f'{key}_std'),
+            'live': live_value(analysis, key),
+            'truth': truth[key],
+            'paper': PAPER[key],
+        }
+    residual = analysis.residual
+    after = run.drop.release_time_s
+    run.summary = {
+        'status': ident.status.name,
+        'release_time_s': ident.release_time_s,
+        'quantities': rows,
+        'prediction_rms_m': residual.rms(),
+        'prediction_rms_after_release_m': residual.rms(start=after),
+        'prediction_max_m': float(abs(residual.residual).max()),
+        'measured_samples': int(analysis.measured.t.size),
+        'predicted_samples': int(analysis.predicted.t.size),
+        'nodes': list(run.nodes),
+        'with_camera': run.with_camera,
+        'figures': [str(p) for p in run.figures],
+        'step_seconds': dict(run.step_seconds),
+    }
+    if run.diagnosis is not None:
+        run.summary['diagnosis'] = run.diagnosis
+    for line in summary_lines(run.summary):
+        run.echo(line)
+    from lumpbeam_ros.cli.output import write_json
+
+    write_json(run.out / 'summary.json', run.summary)
+
+
+def summary_lines(summary: dict[str, Any]) -> list[str]:
+    """The human summary table of :func:`summarize` (also of its JSON read back)."""
+    labels = {
+        'natural_frequency_hz': ('natural frequency', 'Hz', '{:.4f}'),
+        'damping_ratio': ('damping ratio', '', '{:.5f}'),
+        'stiffness_total_nm_per_rad': ('k_tE (B.12)', 'N m/rad', '{:.1f}'),
+    }
+    lines = [
+        f'{"quantity":<24}{"identified (offline)":>26}{"live node":>12}{"truth":>12}{"paper":>10}',
+    ]
+    for key, (label, unit, fmt) in labels.items():
+        row = summary['quantities'][key]
+        ident = f'{fmt.format(row["identified"])} +- {row["identified_std"]:.2g}'
+        live = row['live']  # NaN in a run, None when read back from summary.json
+        live = fmt.format(live) if live is not None and math.isfinite(live) else '-'
+        name = f'{label} ({unit})' if unit else label
+        lines.append(
+            f'{name:<24}{ident:>26}{live:>12}{fmt.format(row["truth"]):>12}'
+            f'{fmt.format(row["paper"]):>10}'
+        )
+    lines.append(
+        f'prediction vs measurement: RMS {summary["prediction_rms_m"] * 1e3:.3f} mm '
+        f'({summary["prediction_rms_after_release_m"] * 1e3:.3f} mm after the release), '
+        f'max {summary["prediction_max_m"] * 1e3:.3f} mm over {summary["measured_samples"]} '
+        f'samples'
+    )
+    if 'diagnosis' in summary:
+        lines.append(f'diagnosis: missing effect {summary["diagnosis"].get("missing_effect")}')
+    return lines
+
+
+def default_steps() -> list[Step]:
+    """The demo's steps, in order (``diagnose`` only when ``lumpbeam diagnose`` exists)."""
+    steps: list[Step] = [
+        ('synthesize', synthesize),
+        ('replay', replay),
+        ('normalize', normalize),
+        ('analyze', analyze),
+    ]
+    if module_available(DIAGNOSE_MODULE):
+        steps.append(('diagnose', diagnose))
+    steps += [('figures', figures), ('summary', summarize)]
+    return steps
+
+
+def run_demo(
+    options: DemoOptions,
+    steps: Sequence[Step] | None = None,
+    echo: Callable[[str], None] = print,
+) -> DemoRun:
+    """Runs the demo's steps in order.
+
+    Args:
+        options: Output folder, duration, seed...
+        steps: The steps (default: :func:`default_steps`).
+        echo: Where progress and the summary go.
+
+    Returns:
+        The filled-in run.
+
+    Raises:
+        LumpbeamError: A step failed (its child processes are stopped first).
+        ConfigError: The beam file is malformed.
+    """
+    beam, drop = load_beam_config(options.beam_config)
+    if options.duration_s <= drop.release_time_s + 1.0:
+        raise LumpbeamError(
+            f'--duration {options.duration_s:g} s leaves less than 1 s after the release at '
+            f'{drop.release_time_s:g} s'
+        )
+    run = DemoRun(options=options, beam=beam, drop=drop, echo=echo)
+    steps = list(default_steps() if steps is None else steps)
+    started = time.monotonic()
+    for index, (name, step) in enumerate(steps, start=1):
+        echo(f'[{index}/{len(steps)}] {name}')
+        t0 = time.monotonic()
+        step(run)
+        run.step_seconds[name] = round(time.monotonic() - t0, 2)
+    run.step_seconds['total'] = round(time.monotonic() - started, 2)
+    echo(f'demo finished in {run.step_seconds["total"]:.1f} s; results in {options.out}')
+    return run
+
+
+def _analysis(run: DemoRun) -> RecordingAnalysis:
+    if run.analysis is None:
+        raise LumpbeamError('the analyze step must run before this one')
+    return run.analysis
+
+
+def _fresh_bags_dir(path: Path) -> Path:
+    if path.exists():
+        if not (path / MARKER).exists():
+            raise LumpbeamError(f'{path} exists and was not made by lumpbeam demo; move it away')
+        shutil.rmtree(path)
+    path.mkdir(parents=True)
+    (path / MARKER).write_text('bags of the last `lumpbeam demo`; replaced by the next\n')
+    return path

@@ -1,0 +1,79 @@
+import json
+
+import pytest
+
+from lumpbeam_ros.cli.main import main
+
+
+def test_demo_runs_the_graph_end_to_end(tmp_path, capsys):
+    out = tmp_path / 'results'
+    assert (
+        main(['demo', '--out', str(out), '--duration', '5', '--json', str(tmp_path / 's.json')])
+        == 0
+    )
+    printed = capsys.readouterr().out
+    assert 'natural frequency (Hz)' in printed and 'demo finished' in printed
+    summary = json.loads((out / 'summary.json').read_text())
+    assert json.loads((tmp_path / 's.json').read_text()) == summary
+    rows = summary['quantities']
+    # The synthetic beam's first mode, identified from what the live graph recorded.
+    assert rows['natural_frequency_hz']['identified'] == pytest.approx(3.0588, rel=2e-3)
+    assert rows['natural_frequency_hz']['truth'] == pytest.approx(3.0588, rel=1e-3)
+    assert rows['damping_ratio']['identified'] == pytest.approx(0.00237, rel=0.25)
+    assert rows['stiffness_total_nm_per_rad']['identified'] == pytest.approx(3899.1, rel=0.02)
+    assert rows['stiffness_total_nm_per_rad']['paper'] == 3899.1
+    # The simulator predicted what the camera would see: the residual is the 20 um noise.
+    assert summary['prediction_rms_m'] < 40e-6
+    assert summary['measured_samples'] == 5 * 180 + 1  # nothing lost by the recorder
+    assert summary['predicted_samples'] > 4 * 180
+    for name in ('tip_measured_vs_predicted.png', 'tip_release_zoom.png'):
+        assert (out / 'figures' / name).stat().st_size > 10_000
+    for name in ('simulator', 'recorder', 'player'):
+        assert (out / 'logs' / f'{name}.log').stat().st_size > 0
+    assert (out / 'bags' / 'recorded' / 'metadata.yaml').is_file()
+
+
+@pytest.mark.parametrize(
+    ('args', 'message'),
+    [
+        (['--duration', '2.5'], 'less than 1 s after the release'),
+        (['--domain-id', '500'], '--domain-id must be in 1..101'),
+        (['--config', '/no/such.yaml'], 'no such file'),
+    ],
+)
+def test_demo_refuses_bad_options(tmp_path, capsys, args, message):
+    assert main(['demo', '--out', str(tmp_path / 'r'), *args]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_demo_never_deletes_a_folder_it_did_not_make(tmp_path, capsys):
+    (tmp_path / 'bags' / 'mine').mkdir(parents=True)
+    assert main(['demo', '--out', str(tmp_path)]) == 2
+    assert 'was not made by lumpbeam demo' in capsys.readouterr().err
+    assert (tmp_path / 'bags' / 'mine').is_dir()
+    (tmp_path / 'file').write_text('x')
+    assert main(['demo', '--out', str(tmp_path / 'file')]) == 2
+
+
+def test_summary_table_reads_back_from_json():
+    from lumpbeam_ros.pipeline.demo import summary_lines
+
+    row = {'identified': 3.0588, 'identified_std': 1e-6, 'live': None, 'truth': 3.0588}
+    summary = {
+        'quantities': {
+            key: {**row, 'paper': 1.0}
+            for key in ('natural_frequency_hz', 'damping_ratio', 'stiffness_total_nm_per_rad')
+        },
+        'prediction_rms_m': 2e-5,
+        'prediction_rms_after_release_m': 2e-5,
+        'prediction_max_m': 6e-5,
+        'measured_samples': 10,
+        'diagnosis': {'missing_effect': 'none'},
+    }
+    lines = summary_lines(summary)
+    assert lines[1].split() == [
+        *('natural', 'frequency', '(Hz)'),
+        *('3.0588', '+-', '1e-06', '-', '3.0588', '1.0000'),
+    ]
+    assert 'RMS 0.020 mm' in lines[4] and lines[-1] == 'diagnosis: missing effect none'

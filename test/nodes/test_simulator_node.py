@@ -1,0 +1,223 @@
+import math
+import re
+
+import numpy as np
+import pytest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import PoseStamped
+from rclpy.exceptions import ParameterException
+from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile
+from rosgraph_msgs.msg import Clock
+from std_msgs.msg import Float64
+
+from lumpbeam_ros.bagio.convert import quaternion_to_pitch
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.model.adopt import first_mode
+from lumpbeam_ros.model.simulate import simulate_loads
+from lumpbeam_ros.nodes import simulator_node
+from lumpbeam_ros.nodes.simulator_node import PARAMETERS, SimulatorNode
+from lumpbeam_ros.resources import config_path
+
+LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+def _start(ros_graph, **overrides):
+    params = [Parameter(name, value=value) for name, value in overrides.items()]
+    node = SimulatorNode(context=ros_graph.context, parameter_overrides=params)
+    ros_graph.add_node(node)
+    return node
+
+
+def _columns(poses):
+    t = np.array([p.header.stamp.sec + p.header.stamp.nanosec * 1e-9 for p in poses])
+    z = np.array([p.pose.position.z for p in poses])
+    q = [p.pose.orientation for p in poses]
+    pitch = np.array([quaternion_to_pitch(o.x, o.y, o.z, o.w) for o in q])
+    return t, z, pitch
+
+
+def _set_clock(ros_graph, node, seconds):
+    msg = Clock()
+    msg.clock.sec, msg.clock.nanosec = divmod(round(seconds * 1e9), 1_000_000_000)
+    ros_graph.publish('/clock', msg)
+    target = round(seconds * 1e9)
+    assert ros_graph.spin_until(lambda: node.get_clock().now().nanoseconds == target, 5.0)
+
+
+def test_publishes_at_the_rate_from_the_loaded_equilibrium(ros_graph):
+    got = ros_graph.collect('/tip_pose_predicted', PoseStamped, 500)
+    node = _start(ros_graph, initial_load_kg=4.5, rate_hz=180.0)
+    assert ros_graph.spin_until(lambda: len(got) >= 5, 5.0)
+    first = len(got)
+    ros_graph.spin_for(1.0)
+    t, z, pitch = _columns(got)
+    assert got[0].header.frame_id == 'beam_base'
+    np.testing.assert_allclose(np.diff(t), 1 / 180, atol=1e-6)  # every stamp, none twice
+    # In step with the wall clock: about 180 samples in the second (a loaded 2-core box
+    # publishes in bursts, not fewer).
+    assert 140 <= len(got) - first <= 220
+    assert z == pytest.approx(-0.0694, abs=5e-4)
+    assert np.ptp(z) < 1e-12
+    assert pitch == pytest.approx(node.stream.equilibrium_pose()[2], abs=1e-9)
+
+
+def test_drop_oscillates_about_the_unloaded_level_at_the_first_mode(ros_graph):
+    got = ros_graph.collect('/tip_pose_predicted', PoseStamped, 500)
+    node = _start(ros_graph)
+    ros_graph.publish('/tip_load', Float64(data=4.5), LATCHED)  # the first reading: at rest
+    assert ros_graph.spin_until(lambda: node.stream is not None and node.stream.load_kg == 4.5)
+    ros_graph.spin_for(0.3)
+    ros_graph.publish('/tip_load', Float64(data=0.0), LATCHED)
+    assert ros_graph.spin_until(lambda: node.stream.load_kg == 0.0, 5.0)
+    release = node.stream.time  # the load change is applied at the clock's time on arrival
+    ros_graph.spin_for(2.5)
+    t, z, _ = _columns(got)
+    before, after = z[t < release - 0.01], z[t > release + 0.5]
+    assert before[-1] == pytest.approx(-0.0694, abs=5e-4)
+    assert 0.5 * (after.max() + after.min()) == pytest.approx(-0.029, abs=1.5e-3)
+    crossings = t[t > release + 0.5][np.flatnonzero(np.diff(np.sign(after + 0.0286)) > 0)]
+    assert 1 / np.mean(np.diff(crossings)) == pytest.approx(3.06, abs=0.04)
+    # The same stamps through the batch simulation, released within one tick of `release`.
+    loaded = t[t > release - 0.6]
+    ref = simulate_loads(node.beam, loaded, [(release, 0.0)], 4.5)
+    assert np.max(np.abs(ref.z - z[t > release - 0.6])) < 0.04 * 2 * np.pi * 3.06 * 0.025
+
+
+def test_follows_clock_under_sim_time_and_matches_the_batch_simulation(ros_graph):
+    got = ros_graph.collect('/tip_pose_predicted', PoseStamped, 1000)
+    node = _start(ros_graph, use_sim_time=True)
+    ros_graph.publish('/tip_load', Float64(data=4.5), LATCHED)  # hanging all along
+    ros_graph.spin_for(0.3)
+    assert got == [] and node.stream is None  # no /clock yet: time stands at zero
+    _set_clock(ros_graph, node, 100.0)
+    assert ros_graph.spin_until(lambda: node.stream is not None)
+    for step in range(1, 91):  # 0.5 s of /clock at 180 Hz
+        _set_clock(ros_graph, node, 100.0 + step / 180)
+        if step == 45:
+            ros_graph.publish('/tip_load', Float64(data=0.0), LATCHED)
+            assert ros_graph.spin_until(lambda: node.stream.load_kg == 0.0)
+    assert ros_graph.spin_until(lambda: len(got) >= 91, 3.0)
+    ros_graph.spin_for(0.2)  # wall time passes, the clock does not: nothing more
+    t, z, _ = _columns(got)
+    np.testing.assert_allclose(t, 100.0 + np.arange(91) / 180, atol=1e-9)
+    # The drop is applied at the /clock time it arrived at, 100.25 s.
+    ref = simulate_loads(node.beam, t - 100.0, [(0.25, 0.0)], 4.5)
+    np.testing.assert_allclose(z, ref.z, atol=1e-6)
+    assert z[-1] - z[0] > 0.01  # it moved up after the drop
+    # A bag looping: the clock goes back, the beam restarts at rest under the current load.
+    _set_clock(ros_graph, node, 10.0)
+    assert ros_graph.spin_until(lambda: node.stream.time == 10.0)  # the next tick resets
+    _set_clock(ros_graph, node, 10.1)
+    assert ros_graph.spin_until(lambda: len(got) >= 91 + 18, 3.0)
+    t2, z2, _ = _columns(got[91:])
+    assert t2[0] == pytest.approx(10.0, abs=1e-9)
+    assert z2 == pytest.approx(node.stream.equilibrium_pose(0.0)[1], abs=1e-9)
+
+
+def test_bad_loads_are_ignored(ros_graph):
+    node = _start(ros_graph, initial_load_kg=4.5)
+    assert ros_graph.spin_until(lambda: node.stream is not None)
+    for bad in (math.nan, -1.0, math.inf):
+        ros_graph.publish('/tip_load', Float64(data=bad), LATCHED)
+    ros_graph.publish('/tip_load', Float64(data=2.0), LATCHED)
+    assert ros_graph.spin_until(lambda: node.stream.load_kg == 2.0)  # the good one arrived
+    ros_graph.spin_for(0.1)
+    assert node.stream.load_kg == 2.0
+
+
+@pytest.mark.parametrize(
+    ('name', 'value', 'reason'),
+    [
+        ('rate_hz', -5.0, 'rate_hz'),
+        ('rate_hz', math.nan, 'rate_hz'),
+        ('tick_rate_hz', 0.0, 'tick_rate_hz'),
+        ('initial_load_kg', -1.0, 'initial_load_kg'),
+        ('max_catch_up_s', 0.0, 'max_catch_up_s'),
+        ('beam_config', '/no/such/beam.yaml', 'no such file'),
+        ('rate_hz', 'fast', 'type'),
+    ],
+)
+def test_invalid_parameter_is_refused(ros_graph, name, value, reason):
+    node = _start(ros_graph)
+    before = node.get_parameter(name).value
+    (result,) = node.set_parameters([Parameter(name, value=value)])
+    assert not result.successful
+    assert re.search(reason, result.reason)
+    assert node.get_parameter(name).value == before
+
+
+def test_valid_parameter_changes_take_effect(ros_graph, tmp_path):
+    node = _start(ros_graph, initial_load_kg=4.5)
+    assert ros_graph.spin_until(lambda: node.stream is not None)
+    (result,) = node.set_parameters([Parameter('rate_hz', value=90.0)])
+    assert result.successful and node.stream.rate_hz == 90.0
+    stiff = tmp_path / 'stiff.yaml'
+    text = config_path('paper_beam.yaml').read_text()
+    stiff.write_text(text.replace('k_total_nm_per_rad: 3899.1', 'k_total_nm_per_rad: 7000.0'))
+    (result,) = node.set_parameters([Parameter('beam_config', value=str(stiff))])
+    assert result.successful and node.stream.beam.k_total_nm_per_rad == 7000.0
+
+
+def test_invalid_override_fails_at_start(ros_graph):
+    with pytest.raises(ParameterException):
+        SimulatorNode(
+            context=ros_graph.context, parameter_overrides=[Parameter('rate_hz', value=0.0)]
+        )
+    with pytest.raises(LumpbeamError, match='no such file'):
+        SimulatorNode(
+            context=ros_graph.context,
+            parameter_overrides=[Parameter('beam_config', value='/missing.yaml')],
+        )
+
+
+def _beam_params(level, **values):
+    status = DiagnosticStatus(name='lumpbeam/identifier', level=level, message='test')
+    status.values = [KeyValue(key=k, value=v) for k, v in values.items()]
+    return DiagnosticArray(status=[status])
+
+
+@pytest.mark.parametrize('adopt', [True, False])
+def test_adopts_identified_parameters_when_asked(ros_graph, adopt):
+    node = _start(ros_graph, adopt_identified=adopt, initial_load_kg=0.0)
+    assert ros_graph.spin_until(lambda: node.stream is not None)
+    ignored = [
+        _beam_params(
+            DiagnosticStatus.WARN, stiffness_total_nm_per_rad='3000.0', damping_ratio='0.01'
+        ),
+        _beam_params(DiagnosticStatus.OK, stiffness_total_nm_per_rad='abc', damping_ratio='0.01'),
+        _beam_params(DiagnosticStatus.OK, damping_ratio='0.01'),
+        _beam_params(DiagnosticStatus.OK, stiffness_total_nm_per_rad='-3.0', damping_ratio='0.01'),
+    ]
+    for msg in ignored:
+        ros_graph.publish('/beam_params', msg)
+    ros_graph.spin_for(0.3)
+    assert node.beam.k_total_nm_per_rad == 3899.1
+    ros_graph.publish(
+        '/beam_params',
+        _beam_params(
+            DiagnosticStatus.OK, stiffness_total_nm_per_rad='3000.0', damping_ratio='0.01'
+        ),
+    )
+    if adopt:
+        assert ros_graph.spin_until(lambda: node.stream.beam.k_total_nm_per_rad == 3000.0)
+        assert first_mode(node.stream.beam)[2] == pytest.approx(0.01, rel=1e-4)
+    else:
+        ros_graph.spin_for(0.3)
+        assert node.stream.beam.k_total_nm_per_rad == 3899.1
+
+
+def test_parameter_file_documents_every_parameter():
+    text = config_path('simulator.yaml').read_text()
+    defaults = simulator_node.default_parameters()
+    assert set(defaults) == set(PARAMETERS)
+    for name in PARAMETERS:
+        before = text.split(f'\n    {name}:')[0].splitlines()
+        assert before[-1].strip().startswith('#'), f'{name} has no comment'
+
+
+def test_main_exits_2_on_a_bad_parameter(monkeypatch, capsys):
+    monkeypatch.setenv('ROS_DOMAIN_ID', '230')
+    code = simulator_node.main(['simulator_node', '--ros-args', '-p', 'rate_hz:=-1.0'])
+    assert code == 2
+    assert 'rate_hz' in capsys.readouterr().err
