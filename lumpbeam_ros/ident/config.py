@@ -8,7 +8,13 @@ from pathlib import Path
 from typing import Any
 
 from lumpbeam_ros.errors import ConfigError
-from lumpbeam_ros.paramfile import check_known_keys, get_float, get_int, read_parameter_file
+from lumpbeam_ros.paramfile import (
+    check_known_keys,
+    get_choice,
+    get_float,
+    get_int,
+    read_parameter_file,
+)
 from lumpbeam_ros.resources import config_path
 
 
@@ -30,6 +36,9 @@ class IdentifierConfig:
     skip_after_release_s: float = 0.02
     max_modes: int = 2
     drift: bool = False
+    nonlinear: str = 'auto'
+    nonlinear_min_decay: float = 0.3
+    recheck_every_s: float = 5.0
     max_fit_s: float = 60.0
     min_frequency_hz: float = 0.2
     max_frequency_hz: float = 40.0
@@ -56,6 +65,9 @@ PARAMETER_KEYS: dict[str, str] = {
     'skip_after_release_s': 'fit.skip_after_release_s',
     'max_modes': 'fit.max_modes',
     'drift': 'fit.drift',
+    'nonlinear': 'fit.nonlinear',
+    'nonlinear_min_decay': 'fit.nonlinear_min_decay',
+    'recheck_every_s': 'fit.recheck_every_s',
     'max_fit_s': 'fit.max_duration_s',
     'min_frequency_hz': 'fit.min_frequency_hz',
     'max_frequency_hz': 'fit.max_frequency_hz',
@@ -69,6 +81,9 @@ PARAMETER_KEYS: dict[str, str] = {
     'warn_cross_check_damping': 'quality.warn_cross_check_damping',
     'min_release_confidence': 'quality.min_release_confidence',
 }
+
+#: Choices of ``fit.nonlinear``.
+NONLINEAR_CHOICES = ('auto', 'always', 'never')
 
 # Values that may be zero; every other float must be positive.
 _NON_NEGATIVE = frozenset({'skip_after_release_s', 'min_step_snr', 'min_amplitude_snr'})
@@ -96,7 +111,9 @@ def config_from_parameters(params: Mapping[str, Any], source: str | Path) -> Ide
     for f in fields(IdentifierConfig):
         key = PARAMETER_KEYS[f.name]
         default = getattr(defaults, f.name)
-        if isinstance(default, bool):
+        if isinstance(default, str):
+            value = get_choice(params, key, source, NONLINEAR_CHOICES, default)
+        elif isinstance(default, bool):
             value = params.get(key, default)
             if not isinstance(value, bool):
                 raise ConfigError(source, key, f'must be true or false, got {value!r}')

@@ -10,6 +10,7 @@ the paper's own log decrement (B.20, B.21) for comparison; grade the result.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -29,6 +30,23 @@ from lumpbeam_ros.model.parameters import BeamParameters
 
 NAN = float('nan')
 METHOD = 'nls_damped_sinusoid'
+
+
+@dataclass(frozen=True)
+class FitState:
+    """What the identification of a slightly later window can start from.
+
+    Attributes:
+        release_time_s: The release the fit started at (NaN: none in the window).
+        params: The fitted decay.
+        pencil: The matrix pencil's (f_n, zeta) cross-check of the first mode.
+        checked_at_s: Window end of the last full identification (pencil, model choice).
+    """
+
+    release_time_s: float
+    params: DampedSinusoidParams
+    pencil: tuple[float, float]
+    checked_at_s: float
 
 
 def identify(
@@ -55,13 +73,49 @@ def identify(
         LumpbeamError: Only with ``strict``: too few valid samples in the window or after
             the release.
     """
+    return identify_from(window, beam, config, strict=strict)[0]
+
+
+def identify_from(
+    window: PoseWindow,
+    beam: BeamParameters,
+    config: IdentifierConfig | None = None,
+    *,
+    strict: bool = False,
+    previous: FitState | None = None,
+) -> tuple[Identification, FitState | None]:
+    """:func:`identify`, started from the state of an earlier, overlapping window.
+
+    With a ``previous`` state for the same release, checked less than
+    ``fit.recheck_every_s`` ago, the least-squares fit starts from the previous solution
+    and keeps its model (modes, nonlinear terms), and the matrix pencil is not rerun: a
+    live window that moved by a few samples converges in one or two solver steps. Otherwise
+    (or when that fit fails) the full identification runs.
+
+    Args:
+        window: As for :func:`identify`.
+        beam: As for :func:`identify`.
+        config: As for :func:`identify`.
+        strict: As for :func:`identify`.
+        previous: The state the last call returned, or ``None``.
+
+    Returns:
+        The identification and the state for the next call (``None`` after an ERROR).
+
+    Raises:
+        LumpbeamError: As for :func:`identify`.
+    """
     with single_threaded_blas():
-        return _identify(window, beam, config or IdentifierConfig(), strict)
+        return _identify(window, beam, config or IdentifierConfig(), strict, previous)
 
 
 def _identify(
-    window: PoseWindow, beam: BeamParameters, config: IdentifierConfig, strict: bool
-) -> Identification:
+    window: PoseWindow,
+    beam: BeamParameters,
+    config: IdentifierConfig,
+    strict: bool,
+    previous: FitState | None,
+) -> tuple[Identification, FitState | None]:
     base = {
         'window_start_s': window.start_s,
         'window_end_s': window.end_s,
@@ -69,10 +123,10 @@ def _identify(
         'n_rejected': window.counts.non_finite + window.counts.duplicates,
     }
 
-    def fail(message: str, unusable: bool = False, **extra: object) -> Identification:
+    def fail(message: str, unusable: bool = False, **extra: object) -> tuple[Identification, None]:
         if strict and unusable:
             raise LumpbeamError(message)
-        return Identification(Status.ERROR, message, **base, **extra)  # type: ignore[arg-type]
+        return Identification(Status.ERROR, message, **base, **extra), None  # type: ignore[arg-type]
 
     if len(window) < config.min_samples:
         return fail(
@@ -97,19 +151,52 @@ def _identify(
             unusable=True,
             **release_keys,
         )
-    noise = difference_noise_std(z)
-    guesses = _initial_modes(t, z, noise, config)
-    if not guesses:
-        return fail('no oscillation in the window', **release_keys)
-    try:
-        params = _fit_decay(t, z, guesses, start, config)
-    except LumpbeamError as exc:
-        return fail(f'no oscillation in the window ({exc})', **release_keys)
-    mode = params.mode(0)
-    rejection = _reject_mode(mode, params, config)
+    state = _warm_fit(t, z, start, release, previous, config)
+    if state is None:
+        noise = difference_noise_std(z)
+        guesses = _initial_modes(t, z, noise, config)
+        if not guesses:
+            return fail('no oscillation in the window', **release_keys)
+        try:
+            params = _fit_decay(t, z, guesses, start, config)
+        except LumpbeamError as exc:
+            return fail(f'no oscillation in the window ({exc})', **release_keys)
+        state = FitState(release.time_s, params, _pencil_first(guesses), window.end_s)
+    mode = state.params.mode(0)
+    rejection = _reject_mode(mode, state.params, config)
     if rejection:
         return fail(rejection, **release_keys)
-    return _assemble(window, beam, config, release, t, z, params, mode, guesses, base)
+    result = _assemble(window, beam, config, release, t, z, state, mode, base)
+    return result, state
+
+
+def _same_release(a: float, b: float) -> bool:
+    """Whether two release times (NaN: none) are the same event, to a few milliseconds."""
+    if math.isnan(a) or math.isnan(b):
+        return math.isnan(a) and math.isnan(b)
+    return abs(a - b) < 0.02
+
+
+def _warm_fit(
+    t: np.ndarray,
+    z: np.ndarray,
+    start: float,
+    release: Release,
+    previous: FitState | None,
+    config: IdentifierConfig,
+) -> FitState | None:
+    """The fit restarted from ``previous``, or ``None`` when a full identification is due."""
+    if previous is None or not _same_release(previous.release_time_s, release.time_s):
+        return None
+    if t[-1] - previous.checked_at_s >= config.recheck_every_s:
+        return None
+    old = previous.params
+    fit = DampedSinusoidFit(n_modes=old.n_modes, drift=old.drift, nonlinear=old.nonlinear)
+    try:
+        params = fit.fit(t, z, t0=start, start=old)
+    except LumpbeamError:
+        return None
+    return FitState(release.time_s, params, previous.pencil, previous.checked_at_s)
 
 
 def _initial_modes(
@@ -150,7 +237,11 @@ def _initial_modes(
 def _fit_decay(
     t: np.ndarray, z: np.ndarray, guesses: list[ModeGuess], start: float, config: IdentifierConfig
 ) -> DampedSinusoidParams:
-    """The least-squares decay; a second mode that does not hold up is dropped."""
+    """The least-squares decay, with the modes and nonlinear terms the data support.
+
+    A second mode that does not hold up is dropped; the nonlinear terms are added when
+    ``fit.nonlinear`` asks for them (see :func:`_nonlinear`).
+    """
     fit = DampedSinusoidFit(n_modes=len(guesses), drift=config.drift)
     params = fit.fit(t, z, initial=guesses, t0=start)
     if params.n_modes == 2:
@@ -164,7 +255,31 @@ def _fit_decay(
             params = DampedSinusoidFit(n_modes=1, drift=config.drift).fit(
                 t, z, initial=guesses[:1], t0=start
             )
-    return params
+    if config.nonlinear == 'never':
+        return params
+    return _nonlinear(t, z, params, config)
+
+
+def _nonlinear(
+    t: np.ndarray, z: np.ndarray, linear: DampedSinusoidParams, config: IdentifierConfig
+) -> DampedSinusoidParams:
+    """The weakly nonlinear decay, if ``always``, or if ``auto`` and it is identifiable.
+
+    The shift terms decay as ``e^{-2 sigma tau}``; over a stretch T with ``2 sigma T``
+    small that is nearly ``1 - 2 sigma tau``, collinear with the level and the frequency,
+    so the fit could not separate them. A significance test of the terms would not do:
+    the linear fit's frequency is biased by many of its own (small) standard deviations
+    long before the terms are significant against the nonlinear fit's (large) ones.
+    """
+    if config.nonlinear == 'auto':
+        decay = 2.0 * linear.mode(0).decay_rate * (t[-1] - linear.t0)
+        if not decay >= config.nonlinear_min_decay:
+            return linear
+    fit = DampedSinusoidFit(n_modes=linear.n_modes, drift=linear.drift, nonlinear=True)
+    try:
+        return fit.fit(t, z, t0=linear.t0, start=linear)
+    except LumpbeamError:
+        return linear
 
 
 def _reject_mode(
@@ -201,11 +316,11 @@ def _assemble(
     release: Release,
     t: np.ndarray,
     z: np.ndarray,
-    params: DampedSinusoidParams,
+    state: FitState,
     mode: ModeEstimate,
-    guesses: list[ModeGuess],
     base: dict[str, float | int],
 ) -> Identification:
+    params = state.params
     warnings: list[str] = []
     cycles = float((t[-1] - t[0]) * mode.damped_frequency_hz)
     damping_total, damping_total_std = _damping_total(params, mode)
@@ -228,7 +343,7 @@ def _assemble(
     )
     k_pitch, k_pitch_std = _pitch_stiffness(window, release, params, float(t[-1]), load, beam)
     logdec = _log_decrement(t, z, params)
-    pencil = _pencil_first(guesses)
+    pencil = state.pencil
 
     if not release.found:
         warnings.append(f'{release.message}; stiffness needs a release in the window')
@@ -270,6 +385,8 @@ def _assemble(
                 f'{mode.damping_ratio:.3g}'
             )
     method = METHOD if params.n_modes == 1 else f'{METHOD}_{params.n_modes}modes'
+    if params.nonlinear:
+        method += '_nonlinear'
     if warnings:
         status, message = Status.WARN, '; '.join(warnings)
     else:
@@ -323,6 +440,9 @@ def _assemble(
         residual_rms_m=params.residual_rms,
         covariance_inflation=params.covariance.inflation,
         second_mode_hz=params.mode(1).damped_frequency_hz if params.n_modes > 1 else NAN,
+        amplitude_frequency_shift_hz=params.frequency_shift_hz,
+        amplitude_level_shift_m=params.level_shift_m,
+        solver_evaluations=params.n_evaluations,
         **base,  # type: ignore[arg-type]
     )
 
