@@ -38,7 +38,7 @@ class IdentifierConfig:
     drift: bool = False
     nonlinear: str = 'auto'
     nonlinear_min_decay: float = 0.3
-    recheck_every_s: float = 5.0
+    recheck_every_s: float = 10.0
     max_fit_s: float = 60.0
     min_frequency_hz: float = 0.2
     max_frequency_hz: float = 40.0

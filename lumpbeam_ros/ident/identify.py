@@ -18,7 +18,7 @@ from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident import stiffness
 from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.logdec import LogDecrement, LogDecrementResult, difference_noise_std
-from lumpbeam_ros.ident.modes import ModeEstimate
+from lumpbeam_ros.ident.modes import TWO_PI, ModeEstimate
 from lumpbeam_ros.ident.pencil import MatrixPencil
 from lumpbeam_ros.ident.release import Release, detect_release
 from lumpbeam_ros.ident.result import Identification, Status
@@ -30,6 +30,23 @@ from lumpbeam_ros.model.parameters import BeamParameters
 
 NAN = float('nan')
 METHOD = 'nls_damped_sinusoid'
+#: Grid points (after block averaging) the matrix pencil sees at most: 45 s at 90 Hz.
+_PENCIL_MAX_POINTS = 4096
+
+
+@dataclass(frozen=True)
+class CrossChecks:
+    """The independent estimates the headline figures are compared with.
+
+    Attributes:
+        pencil: The matrix pencil's (f_n, zeta) of the first mode.
+        logdec: The paper's log decrement (B.20, B.21), ``None`` when it failed.
+        pitch_stiffness: k_tE and its std from the fall of the static pitch.
+    """
+
+    pencil: tuple[float, float]
+    logdec: LogDecrementResult | None
+    pitch_stiffness: tuple[float, float]
 
 
 @dataclass(frozen=True)
@@ -39,13 +56,13 @@ class FitState:
     Attributes:
         release_time_s: The release the fit started at (NaN: none in the window).
         params: The fitted decay.
-        pencil: The matrix pencil's (f_n, zeta) cross-check of the first mode.
-        checked_at_s: Window end of the last full identification (pencil, model choice).
+        checks: The cross-checks of the last full identification.
+        checked_at_s: Window end of the last full identification.
     """
 
     release_time_s: float
     params: DampedSinusoidParams
-    pencil: tuple[float, float]
+    checks: CrossChecks
     checked_at_s: float
 
 
@@ -88,9 +105,10 @@ def identify_from(
 
     With a ``previous`` state for the same release, checked less than
     ``fit.recheck_every_s`` ago, the least-squares fit starts from the previous solution
-    and keeps its model (modes, nonlinear terms), and the matrix pencil is not rerun: a
-    live window that moved by a few samples converges in one or two solver steps. Otherwise
-    (or when that fit fails) the full identification runs.
+    and keeps its model (modes, nonlinear terms), and the cross-checks (matrix pencil, log
+    decrement, pitch stiffness) are carried over instead of rerun: a live window that moved
+    by a few samples converges in one or two solver steps. Otherwise (or when that fit
+    fails) the full identification runs.
 
     Args:
         window: As for :func:`identify`.
@@ -161,13 +179,26 @@ def _identify(
             params = _fit_decay(t, z, guesses, start, config)
         except LumpbeamError as exc:
             return fail(f'no oscillation in the window ({exc})', **release_keys)
-        state = FitState(release.time_s, params, _pencil_first(guesses), window.end_s)
+        rejection = _reject_mode(params.mode(0), params, config)
+        if rejection:
+            return fail(rejection, **release_keys)
+        checks = CrossChecks(
+            _pencil_first(guesses),
+            _log_decrement(t, z, params),
+            _pitch_stiffness(window, release, params, float(t[-1]), _load(release, config), beam),
+        )
+        state = FitState(release.time_s, params, checks, window.end_s)
     mode = state.params.mode(0)
     rejection = _reject_mode(mode, state.params, config)
     if rejection:
         return fail(rejection, **release_keys)
-    result = _assemble(window, beam, config, release, t, z, state, mode, base)
+    result = _assemble(beam, config, release, t, state, mode, base)
     return result, state
+
+
+def _load(release: Release, config: IdentifierConfig) -> float:
+    """The released mass: from ``/tip_load``, else the configured one."""
+    return release.load_kg if math.isfinite(release.load_kg) else config.assumed_load_kg
 
 
 def _same_release(a: float, b: float) -> bool:
@@ -196,7 +227,7 @@ def _warm_fit(
         params = fit.fit(t, z, t0=start, start=old)
     except LumpbeamError:
         return None
-    return FitState(release.time_s, params, previous.pencil, previous.checked_at_s)
+    return FitState(release.time_s, params, previous.checks, previous.checked_at_s)
 
 
 def _initial_modes(
@@ -207,8 +238,12 @@ def _initial_modes(
     # Block means down to 2.25 samples per period of the highest frequency of interest:
     # below Nyquist with a margin, and a quarter of the pencil's cost at 180 Hz.
     decimation = max(1, int(rate / (2.25 * config.max_frequency_hz)))
+    # The pencil only starts the fit and cross-checks it: the head of a long record will do.
+    head = slice(0, _PENCIL_MAX_POINTS * decimation)
     try:
-        pencil = MatrixPencil(order=2 * config.max_modes + 3, decimation=decimation).fit(t, z)
+        pencil = MatrixPencil(order=2 * config.max_modes + 3, decimation=decimation).fit(
+            t[head], z[head]
+        )
     except LumpbeamError:
         return []
     in_band = [
@@ -239,10 +274,11 @@ def _fit_decay(
 ) -> DampedSinusoidParams:
     """The least-squares decay, with the modes and nonlinear terms the data support.
 
-    A second mode that does not hold up is dropped; the nonlinear terms are added when
-    ``fit.nonlinear`` asks for them (see :func:`_nonlinear`).
+    The nonlinear terms are fitted when :func:`_wants_nonlinear`; a second mode that does
+    not hold up is dropped.
     """
-    fit = DampedSinusoidFit(n_modes=len(guesses), drift=config.drift)
+    nonlinear = _wants_nonlinear(guesses[0], t[-1] - start, config)
+    fit = DampedSinusoidFit(n_modes=len(guesses), drift=config.drift, nonlinear=nonlinear)
     params = fit.fit(t, z, initial=guesses, t0=start)
     if params.n_modes == 2:
         second = params.mode(1)
@@ -252,34 +288,27 @@ def _fit_decay(
             and second.decay_rate > 0.0
         )
         if not sane:
-            params = DampedSinusoidFit(n_modes=1, drift=config.drift).fit(
+            params = DampedSinusoidFit(n_modes=1, drift=config.drift, nonlinear=nonlinear).fit(
                 t, z, initial=guesses[:1], t0=start
             )
-    if config.nonlinear == 'never':
-        return params
-    return _nonlinear(t, z, params, config)
+    return params
 
 
-def _nonlinear(
-    t: np.ndarray, z: np.ndarray, linear: DampedSinusoidParams, config: IdentifierConfig
-) -> DampedSinusoidParams:
-    """The weakly nonlinear decay, if ``always``, or if ``auto`` and it is identifiable.
+def _wants_nonlinear(first: ModeGuess, span_s: float, config: IdentifierConfig) -> bool:
+    """Whether to fit the first mode's amplitude-dependent level and frequency.
 
-    The shift terms decay as ``e^{-2 sigma tau}``; over a stretch T with ``2 sigma T``
-    small that is nearly ``1 - 2 sigma tau``, collinear with the level and the frequency,
-    so the fit could not separate them. A significance test of the terms would not do:
-    the linear fit's frequency is biased by many of its own (small) standard deviations
-    long before the terms are significant against the nonlinear fit's (large) ones.
+    ``auto`` fits them when they are identifiable: they decay as ``e^{-2 sigma tau}``, and
+    over a stretch T with ``2 sigma T`` small that is nearly ``1 - 2 sigma tau``, collinear
+    with the level and the frequency. A significance test of the terms would not do: a
+    linear fit's frequency is biased by many of its own (small) standard deviations long
+    before the terms are significant against the nonlinear fit's (large) ones. The decay
+    rate comes from the matrix pencil's start, so one fit suffices.
     """
-    if config.nonlinear == 'auto':
-        decay = 2.0 * linear.mode(0).decay_rate * (t[-1] - linear.t0)
-        if not decay >= config.nonlinear_min_decay:
-            return linear
-    fit = DampedSinusoidFit(n_modes=linear.n_modes, drift=linear.drift, nonlinear=True)
-    try:
-        return fit.fit(t, z, t0=linear.t0, start=linear)
-    except LumpbeamError:
-        return linear
+    if config.nonlinear != 'auto':
+        return config.nonlinear == 'always'
+    f_d, zeta = first
+    decay_rate = zeta * TWO_PI * f_d / math.sqrt(max(1.0 - zeta * zeta, 1e-12))
+    return 2.0 * decay_rate * span_s >= config.nonlinear_min_decay
 
 
 def _reject_mode(
@@ -310,21 +339,19 @@ def _damping_total(params: DampedSinusoidParams, mode: ModeEstimate) -> tuple[fl
 
 
 def _assemble(
-    window: PoseWindow,
     beam: BeamParameters,
     config: IdentifierConfig,
     release: Release,
     t: np.ndarray,
-    z: np.ndarray,
     state: FitState,
     mode: ModeEstimate,
     base: dict[str, float | int],
 ) -> Identification:
-    params = state.params
+    params, checks = state.params, state.checks
     warnings: list[str] = []
     cycles = float((t[-1] - t[0]) * mode.damped_frequency_hz)
     damping_total, damping_total_std = _damping_total(params, mode)
-    load = release.load_kg if math.isfinite(release.load_kg) else config.assumed_load_kg
+    load = _load(release, config)
     tip_mass = beam.tip_mass_kg + (
         release.load_after_kg if math.isfinite(release.load_after_kg) else 0.0
     )
@@ -341,9 +368,9 @@ def _assemble(
     static = stiffness.from_static_change(
         deflection, deflection_std, load, beam.length_m, beam.gravity_mps2
     )
-    k_pitch, k_pitch_std = _pitch_stiffness(window, release, params, float(t[-1]), load, beam)
-    logdec = _log_decrement(t, z, params)
-    pencil = state.pencil
+    k_pitch, k_pitch_std = checks.pitch_stiffness
+    logdec = checks.logdec
+    pencil = checks.pencil
 
     if not release.found:
         warnings.append(f'{release.message}; stiffness needs a release in the window')
