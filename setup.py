@@ -26,6 +26,7 @@ setup(
     entry_points={
         'console_scripts': [
             'lumpbeam = lumpbeam_ros.cli.main:main',
+            'identifier_node = lumpbeam_ros.nodes.identifier_node:main',
             'simulator_node = lumpbeam_ros.nodes.simulator_node:main',
         ],
     },

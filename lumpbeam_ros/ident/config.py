@@ -2,13 +2,20 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
 from lumpbeam_ros.errors import ConfigError
-from lumpbeam_ros.paramfile import check_known_keys, get_float, get_int, read_parameter_file
+from lumpbeam_ros.paramfile import (
+    check_known_keys,
+    get_choice,
+    get_float,
+    get_int,
+    read_parameter_file,
+)
 from lumpbeam_ros.resources import config_path
 
 
@@ -30,6 +37,9 @@ class IdentifierConfig:
     skip_after_release_s: float = 0.02
     max_modes: int = 2
     drift: bool = False
+    nonlinear: str = 'auto'
+    nonlinear_min_decay: float = 0.3
+    recheck_every_s: float = 10.0
     max_fit_s: float = 60.0
     min_frequency_hz: float = 0.2
     max_frequency_hz: float = 40.0
@@ -56,6 +66,9 @@ PARAMETER_KEYS: dict[str, str] = {
     'skip_after_release_s': 'fit.skip_after_release_s',
     'max_modes': 'fit.max_modes',
     'drift': 'fit.drift',
+    'nonlinear': 'fit.nonlinear',
+    'nonlinear_min_decay': 'fit.nonlinear_min_decay',
+    'recheck_every_s': 'fit.recheck_every_s',
     'max_fit_s': 'fit.max_duration_s',
     'min_frequency_hz': 'fit.min_frequency_hz',
     'max_frequency_hz': 'fit.max_frequency_hz',
@@ -69,6 +82,9 @@ PARAMETER_KEYS: dict[str, str] = {
     'warn_cross_check_damping': 'quality.warn_cross_check_damping',
     'min_release_confidence': 'quality.min_release_confidence',
 }
+
+#: Choices of ``fit.nonlinear``.
+NONLINEAR_CHOICES = ('auto', 'always', 'never')
 
 # Values that may be zero; every other float must be positive.
 _NON_NEGATIVE = frozenset({'skip_after_release_s', 'min_step_snr', 'min_amplitude_snr'})
@@ -96,7 +112,9 @@ def config_from_parameters(params: Mapping[str, Any], source: str | Path) -> Ide
     for f in fields(IdentifierConfig):
         key = PARAMETER_KEYS[f.name]
         default = getattr(defaults, f.name)
-        if isinstance(default, bool):
+        if isinstance(default, str):
+            value = get_choice(params, key, source, NONLINEAR_CHOICES, default)
+        elif isinstance(default, bool):
             value = params.get(key, default)
             if not isinstance(value, bool):
                 raise ConfigError(source, key, f'must be true or false, got {value!r}')
@@ -142,3 +160,48 @@ def load_identifier_config(path: str | Path | None = None) -> IdentifierConfig:
     """
     path = config_path('identifier.yaml') if path is None else Path(path)
     return config_from_parameters(read_parameter_file(path), path)
+
+
+def parameter_descriptions(path: str | Path | None = None) -> dict[str, str]:
+    """The comment above each key of an identifier parameter file, by dotted key.
+
+    The node declares its parameters with these as descriptions, so ``ros2 param describe``
+    shows the same text as the file; the file stays the one place they are written.
+
+    Args:
+        path: The YAML file (default: the package's ``config/identifier.yaml``).
+
+    Returns:
+        Dotted key -> its comment lines joined (keys without a comment are left out).
+
+    Raises:
+        ConfigError: The file cannot be read.
+    """
+    path = config_path('identifier.yaml') if path is None else Path(path)
+    try:
+        lines = path.read_text(encoding='utf-8').splitlines()
+    except OSError as exc:
+        raise ConfigError(path, '', f'cannot read: {exc.strerror}') from None
+    descriptions: dict[str, str] = {}
+    stack: list[tuple[int, str]] = []
+    comment: list[str] = []
+    for line in lines:
+        text = line.strip()
+        if text.startswith('#'):
+            comment.append(text.lstrip('#').strip())
+            continue
+        match = re.match(r'(\s*)([\w/*]+):\s*(\S.*)?$', line)
+        if not match:
+            comment = []
+            continue
+        indent, key, value = len(match[1]), match[2], match[3]
+        while stack and stack[-1][0] >= indent:
+            stack.pop()
+        if value is None:
+            stack.append((indent, key))
+        else:
+            dotted = '.'.join([k for _, k in stack if k not in ('/**', 'ros__parameters')] + [key])
+            if comment:
+                descriptions[dotted] = ' '.join(comment)
+        comment = []
+    return descriptions

@@ -16,6 +16,8 @@ from scipy.signal import fftconvolve
 
 #: Lags looked ahead when deciding that the residual autocorrelation has died out.
 _LOOKAHEAD = 16
+#: Up to this many lags the sandwich's middle is summed directly, beyond it by FFT.
+_DIRECT_MAX_LAG = 24
 
 
 @dataclass(frozen=True)
@@ -115,10 +117,17 @@ def sandwich_covariance(jacobian: np.ndarray, residuals: np.ndarray) -> Covarian
     white = s2 * bread
     lag, gamma = _lag_and_autocovariance(residuals)
     kernel = _bartlett(lag) * gamma[: lag + 1] * (n / dof)
-    kernel = np.concatenate([kernel[:0:-1], kernel])
-    # J^T Sigma J with Sigma the Toeplitz matrix of the tapered autocovariances: Sigma J is a
-    # convolution of each Jacobian column with the kernel, O(N log N) instead of O(N lag).
-    meat = jacobian.T @ fftconvolve(jacobian, kernel[:, None], mode='same', axes=0)
+    if lag <= _DIRECT_MAX_LAG:
+        # sum_k w_k gamma_k (C_k + C_k^T): a few small products beat the FFT's set-up.
+        meat = kernel[0] * (jacobian.T @ jacobian)
+        for k in range(1, lag + 1):
+            cross = jacobian[:-k].T @ jacobian[k:]
+            meat += kernel[k] * (cross + cross.T)
+    else:
+        # J^T Sigma J with Sigma the Toeplitz matrix of the tapered autocovariances: Sigma J
+        # is a convolution of each Jacobian column with the kernel, O(N log N), not O(N lag).
+        kernel = np.concatenate([kernel[:0:-1], kernel])
+        meat = jacobian.T @ fftconvolve(jacobian, kernel[:, None], mode='same', axes=0)
     matrix = bread @ meat @ bread
     # Bartlett-tapered biased autocovariances form a positive semi-definite Toeplitz matrix
     # (a Schur product of two), so the meat, and the result, are too; only rounding remains.

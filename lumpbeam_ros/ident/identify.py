@@ -10,6 +10,7 @@ the paper's own log decrement (B.20, B.21) for comparison; grade the result.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -17,7 +18,7 @@ from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident import stiffness
 from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.logdec import LogDecrement, LogDecrementResult, difference_noise_std
-from lumpbeam_ros.ident.modes import ModeEstimate
+from lumpbeam_ros.ident.modes import TWO_PI, ModeEstimate
 from lumpbeam_ros.ident.pencil import MatrixPencil
 from lumpbeam_ros.ident.release import Release, detect_release
 from lumpbeam_ros.ident.result import Identification, Status
@@ -29,6 +30,40 @@ from lumpbeam_ros.model.parameters import BeamParameters
 
 NAN = float('nan')
 METHOD = 'nls_damped_sinusoid'
+#: Grid points (after block averaging) the matrix pencil sees at most: 45 s at 90 Hz.
+_PENCIL_MAX_POINTS = 4096
+
+
+@dataclass(frozen=True)
+class CrossChecks:
+    """The independent estimates the headline figures are compared with.
+
+    Attributes:
+        pencil: The matrix pencil's (f_n, zeta) of the first mode.
+        logdec: The paper's log decrement (B.20, B.21), ``None`` when it failed.
+        pitch_stiffness: k_tE and its std from the fall of the static pitch.
+    """
+
+    pencil: tuple[float, float]
+    logdec: LogDecrementResult | None
+    pitch_stiffness: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class FitState:
+    """What the identification of a slightly later window can start from.
+
+    Attributes:
+        release_time_s: The release the fit started at (NaN: none in the window).
+        params: The fitted decay.
+        checks: The cross-checks of the last full identification.
+        checked_at_s: Window end of the last full identification.
+    """
+
+    release_time_s: float
+    params: DampedSinusoidParams
+    checks: CrossChecks
+    checked_at_s: float
 
 
 def identify(
@@ -55,13 +90,50 @@ def identify(
         LumpbeamError: Only with ``strict``: too few valid samples in the window or after
             the release.
     """
+    return identify_from(window, beam, config, strict=strict)[0]
+
+
+def identify_from(
+    window: PoseWindow,
+    beam: BeamParameters,
+    config: IdentifierConfig | None = None,
+    *,
+    strict: bool = False,
+    previous: FitState | None = None,
+) -> tuple[Identification, FitState | None]:
+    """:func:`identify`, started from the state of an earlier, overlapping window.
+
+    With a ``previous`` state for the same release, checked less than
+    ``fit.recheck_every_s`` ago, the least-squares fit starts from the previous solution
+    and keeps its model (modes, nonlinear terms), and the cross-checks (matrix pencil, log
+    decrement, pitch stiffness) are carried over instead of rerun: a live window that moved
+    by a few samples converges in one or two solver steps. Otherwise (or when that fit
+    fails) the full identification runs.
+
+    Args:
+        window: As for :func:`identify`.
+        beam: As for :func:`identify`.
+        config: As for :func:`identify`.
+        strict: As for :func:`identify`.
+        previous: The state the last call returned, or ``None``.
+
+    Returns:
+        The identification and the state for the next call (``None`` after an ERROR).
+
+    Raises:
+        LumpbeamError: As for :func:`identify`.
+    """
     with single_threaded_blas():
-        return _identify(window, beam, config or IdentifierConfig(), strict)
+        return _identify(window, beam, config or IdentifierConfig(), strict, previous)
 
 
 def _identify(
-    window: PoseWindow, beam: BeamParameters, config: IdentifierConfig, strict: bool
-) -> Identification:
+    window: PoseWindow,
+    beam: BeamParameters,
+    config: IdentifierConfig,
+    strict: bool,
+    previous: FitState | None,
+) -> tuple[Identification, FitState | None]:
     base = {
         'window_start_s': window.start_s,
         'window_end_s': window.end_s,
@@ -69,10 +141,10 @@ def _identify(
         'n_rejected': window.counts.non_finite + window.counts.duplicates,
     }
 
-    def fail(message: str, unusable: bool = False, **extra: object) -> Identification:
+    def fail(message: str, unusable: bool = False, **extra: object) -> tuple[Identification, None]:
         if strict and unusable:
             raise LumpbeamError(message)
-        return Identification(Status.ERROR, message, **base, **extra)  # type: ignore[arg-type]
+        return Identification(Status.ERROR, message, **base, **extra), None  # type: ignore[arg-type]
 
     if len(window) < config.min_samples:
         return fail(
@@ -97,19 +169,65 @@ def _identify(
             unusable=True,
             **release_keys,
         )
-    noise = difference_noise_std(z)
-    guesses = _initial_modes(t, z, noise, config)
-    if not guesses:
-        return fail('no oscillation in the window', **release_keys)
-    try:
-        params = _fit_decay(t, z, guesses, start, config)
-    except LumpbeamError as exc:
-        return fail(f'no oscillation in the window ({exc})', **release_keys)
-    mode = params.mode(0)
-    rejection = _reject_mode(mode, params, config)
+    state = _warm_fit(t, z, start, release, previous, config)
+    if state is None:
+        noise = difference_noise_std(z)
+        guesses = _initial_modes(t, z, noise, config)
+        if not guesses:
+            return fail('no oscillation in the window', **release_keys)
+        try:
+            params = _fit_decay(t, z, guesses, start, config)
+        except LumpbeamError as exc:
+            return fail(f'no oscillation in the window ({exc})', **release_keys)
+        rejection = _reject_mode(params.mode(0), params, config)
+        if rejection:
+            return fail(rejection, **release_keys)
+        checks = CrossChecks(
+            _pencil_first(guesses),
+            _log_decrement(t, z, params),
+            _pitch_stiffness(window, release, params, float(t[-1]), _load(release, config), beam),
+        )
+        state = FitState(release.time_s, params, checks, window.end_s)
+    mode = state.params.mode(0)
+    rejection = _reject_mode(mode, state.params, config)
     if rejection:
         return fail(rejection, **release_keys)
-    return _assemble(window, beam, config, release, t, z, params, mode, guesses, base)
+    result = _assemble(beam, config, release, t, state, mode, base)
+    return result, state
+
+
+def _load(release: Release, config: IdentifierConfig) -> float:
+    """The released mass: from ``/tip_load``, else the configured one."""
+    return release.load_kg if math.isfinite(release.load_kg) else config.assumed_load_kg
+
+
+def _same_release(a: float, b: float) -> bool:
+    """Whether two release times (NaN: none) are the same event, to a few milliseconds."""
+    if math.isnan(a) or math.isnan(b):
+        return math.isnan(a) and math.isnan(b)
+    return abs(a - b) < 0.02
+
+
+def _warm_fit(
+    t: np.ndarray,
+    z: np.ndarray,
+    start: float,
+    release: Release,
+    previous: FitState | None,
+    config: IdentifierConfig,
+) -> FitState | None:
+    """The fit restarted from ``previous``, or ``None`` when a full identification is due."""
+    if previous is None or not _same_release(previous.release_time_s, release.time_s):
+        return None
+    if t[-1] - previous.checked_at_s >= config.recheck_every_s:
+        return None
+    old = previous.params
+    fit = DampedSinusoidFit(n_modes=old.n_modes, drift=old.drift, nonlinear=old.nonlinear)
+    try:
+        params = fit.fit(t, z, t0=start, start=old)
+    except LumpbeamError:
+        return None
+    return FitState(release.time_s, params, previous.checks, previous.checked_at_s)
 
 
 def _initial_modes(
@@ -120,8 +238,12 @@ def _initial_modes(
     # Block means down to 2.25 samples per period of the highest frequency of interest:
     # below Nyquist with a margin, and a quarter of the pencil's cost at 180 Hz.
     decimation = max(1, int(rate / (2.25 * config.max_frequency_hz)))
+    # The pencil only starts the fit and cross-checks it: the head of a long record will do.
+    head = slice(0, _PENCIL_MAX_POINTS * decimation)
     try:
-        pencil = MatrixPencil(order=2 * config.max_modes + 3, decimation=decimation).fit(t, z)
+        pencil = MatrixPencil(order=2 * config.max_modes + 3, decimation=decimation).fit(
+            t[head], z[head]
+        )
     except LumpbeamError:
         return []
     in_band = [
@@ -150,8 +272,13 @@ def _initial_modes(
 def _fit_decay(
     t: np.ndarray, z: np.ndarray, guesses: list[ModeGuess], start: float, config: IdentifierConfig
 ) -> DampedSinusoidParams:
-    """The least-squares decay; a second mode that does not hold up is dropped."""
-    fit = DampedSinusoidFit(n_modes=len(guesses), drift=config.drift)
+    """The least-squares decay, with the modes and nonlinear terms the data support.
+
+    The nonlinear terms are fitted when :func:`_wants_nonlinear`; a second mode that does
+    not hold up is dropped.
+    """
+    nonlinear = _wants_nonlinear(guesses[0], t[-1] - start, config)
+    fit = DampedSinusoidFit(n_modes=len(guesses), drift=config.drift, nonlinear=nonlinear)
     params = fit.fit(t, z, initial=guesses, t0=start)
     if params.n_modes == 2:
         second = params.mode(1)
@@ -161,10 +288,27 @@ def _fit_decay(
             and second.decay_rate > 0.0
         )
         if not sane:
-            params = DampedSinusoidFit(n_modes=1, drift=config.drift).fit(
+            params = DampedSinusoidFit(n_modes=1, drift=config.drift, nonlinear=nonlinear).fit(
                 t, z, initial=guesses[:1], t0=start
             )
     return params
+
+
+def _wants_nonlinear(first: ModeGuess, span_s: float, config: IdentifierConfig) -> bool:
+    """Whether to fit the first mode's amplitude-dependent level and frequency.
+
+    ``auto`` fits them when they are identifiable: they decay as ``e^{-2 sigma tau}``, and
+    over a stretch T with ``2 sigma T`` small that is nearly ``1 - 2 sigma tau``, collinear
+    with the level and the frequency. A significance test of the terms would not do: a
+    linear fit's frequency is biased by many of its own (small) standard deviations long
+    before the terms are significant against the nonlinear fit's (large) ones. The decay
+    rate comes from the matrix pencil's start, so one fit suffices.
+    """
+    if config.nonlinear != 'auto':
+        return config.nonlinear == 'always'
+    f_d, zeta = first
+    decay_rate = zeta * TWO_PI * f_d / math.sqrt(max(1.0 - zeta * zeta, 1e-12))
+    return 2.0 * decay_rate * span_s >= config.nonlinear_min_decay
 
 
 def _reject_mode(
@@ -195,21 +339,19 @@ def _damping_total(params: DampedSinusoidParams, mode: ModeEstimate) -> tuple[fl
 
 
 def _assemble(
-    window: PoseWindow,
     beam: BeamParameters,
     config: IdentifierConfig,
     release: Release,
     t: np.ndarray,
-    z: np.ndarray,
-    params: DampedSinusoidParams,
+    state: FitState,
     mode: ModeEstimate,
-    guesses: list[ModeGuess],
     base: dict[str, float | int],
 ) -> Identification:
+    params, checks = state.params, state.checks
     warnings: list[str] = []
     cycles = float((t[-1] - t[0]) * mode.damped_frequency_hz)
     damping_total, damping_total_std = _damping_total(params, mode)
-    load = release.load_kg if math.isfinite(release.load_kg) else config.assumed_load_kg
+    load = _load(release, config)
     tip_mass = beam.tip_mass_kg + (
         release.load_after_kg if math.isfinite(release.load_after_kg) else 0.0
     )
@@ -226,9 +368,9 @@ def _assemble(
     static = stiffness.from_static_change(
         deflection, deflection_std, load, beam.length_m, beam.gravity_mps2
     )
-    k_pitch, k_pitch_std = _pitch_stiffness(window, release, params, float(t[-1]), load, beam)
-    logdec = _log_decrement(t, z, params)
-    pencil = _pencil_first(guesses)
+    k_pitch, k_pitch_std = checks.pitch_stiffness
+    logdec = checks.logdec
+    pencil = checks.pencil
 
     if not release.found:
         warnings.append(f'{release.message}; stiffness needs a release in the window')
@@ -270,6 +412,8 @@ def _assemble(
                 f'{mode.damping_ratio:.3g}'
             )
     method = METHOD if params.n_modes == 1 else f'{METHOD}_{params.n_modes}modes'
+    if params.nonlinear:
+        method += '_nonlinear'
     if warnings:
         status, message = Status.WARN, '; '.join(warnings)
     else:
@@ -323,6 +467,9 @@ def _assemble(
         residual_rms_m=params.residual_rms,
         covariance_inflation=params.covariance.inflation,
         second_mode_hz=params.mode(1).damped_frequency_hz if params.n_modes > 1 else NAN,
+        amplitude_frequency_shift_hz=params.frequency_shift_hz,
+        amplitude_level_shift_m=params.level_shift_m,
+        solver_evaluations=params.n_evaluations,
         **base,  # type: ignore[arg-type]
     )
 

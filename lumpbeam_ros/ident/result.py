@@ -61,6 +61,11 @@ class Identification:
         residual_rms_m: RMS of the fit residuals.
         covariance_inflation: Robust over white-noise variance (>1: correlated residuals).
         second_mode_hz: Damped frequency of a fitted second mode (NaN when not fitted).
+        amplitude_frequency_shift_hz: How much faster the first mode ran at the start of the
+            fit than at small amplitude (0 when the nonlinear terms were not fitted).
+        amplitude_level_shift_m: How far the oscillation's centre was above the equilibrium
+            at the start of the fit (0 likewise).
+        solver_evaluations: Model evaluations of the least-squares solver.
         n_samples: Valid samples in the window.
         n_rejected: Samples dropped as non-finite or duplicate.
     """
@@ -111,6 +116,9 @@ class Identification:
     residual_rms_m: float = NAN
     covariance_inflation: float = NAN
     second_mode_hz: float = NAN
+    amplitude_frequency_shift_hz: float = NAN
+    amplitude_level_shift_m: float = NAN
+    solver_evaluations: int = 0
     n_samples: int = 0
     n_rejected: int = 0
 

@@ -8,13 +8,22 @@ with the drift ``d`` optional. It is the free response of a linear damped system
 the situation right after the paper's load drop (section B.3.2); it uses every sample instead
 of the two peaks of the log decrement (B.20), so its frequency and damping are much less
 noisy, and it returns a covariance (:mod:`lumpbeam_ros.ident.covariance`).
+
+The beam is not linear: at the drop's 4 cm amplitude its first mode runs about 5 ppm fast
+and oscillates about a level some micrometres off the static equilibrium, both in proportion
+to the squared amplitude, ``A^2 e^{-2 sigma_1 tau}``. Averaged over the window these biases
+exceed the statistical error several times over. The ``nonlinear`` model adds the two
+leading terms of a weakly nonlinear oscillator: a level shift ``e e^{-2 sigma_1 tau}`` and a
+frequency shift ``q e^{-2 sigma_1 tau}`` (rad/s) in the first mode's phase,
+``theta_1 = omega_1 tau + q (1 - e^{-2 sigma_1 tau}) / (2 sigma_1)``. Its ``omega_1`` and
+``c`` are then the small-amplitude frequency and the true equilibrium.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -39,6 +48,9 @@ class DampedSinusoidParams:
         drift: Whether ``d`` is in ``x``.
         n_samples: Samples fitted.
         residual_rms: RMS of the residuals.
+        nonlinear: Whether ``e`` and ``q`` (the amplitude-dependent level and frequency of
+            the first mode) end ``x``.
+        n_evaluations: Model evaluations the solver needed.
     """
 
     t0: float
@@ -48,6 +60,8 @@ class DampedSinusoidParams:
     drift: bool
     n_samples: int
     residual_rms: float
+    nonlinear: bool = False
+    n_evaluations: int = 0
 
     @property
     def _first_mode_index(self) -> int:
@@ -68,6 +82,39 @@ class DampedSinusoidParams:
         """d, m/s (0 when not fitted)."""
         return float(self.x[1]) if self.drift else 0.0
 
+    def shifted(self, t0: float) -> DampedSinusoidParams:
+        """The same curve with its time origin moved to ``t0`` (the covariance is kept).
+
+        Moving the origin by ``D`` scales each mode by ``e^{-sigma D}`` and turns its phase
+        by ``theta(D)``; the sweep of the first mode shrinks by ``e^{-2 sigma D}``, since
+        ``sweep(tau' + D) = sweep(D) + e^{-2 sigma D} sweep(tau')``.
+
+        Args:
+            t0: The new origin, s.
+
+        Returns:
+            Parameters describing the same curve on ``tau' = t - t0``.
+        """
+        shift = float(t0) - self.t0
+        if shift == 0.0:
+            return self
+        x = self.x.copy()
+        x[0] += self.drift_rate * shift
+        for m in range(self.n_modes):
+            k = self.mode_slice(m).start
+            a, b, s, w = x[k : k + 4]
+            phase = w * shift
+            if m == 0 and self.nonlinear:
+                square = math.exp(-2.0 * s * shift)
+                phase += x[-1] * float(_sweep(s, np.array([shift]))[0])
+                x[-2] *= square
+                x[-1] *= square
+            scale = math.exp(-s * shift)
+            cos, sin = math.cos(phase), math.sin(phase)
+            x[k] = scale * (a * cos + b * sin)
+            x[k + 1] = scale * (b * cos - a * sin)
+        return replace(self, t0=float(t0), x=x)
+
     def mode_slice(self, index: int) -> slice:
         """Where mode ``index`` (0-based) sits in :attr:`x`."""
         start = self._first_mode_index + 4 * index
@@ -80,7 +127,18 @@ class DampedSinusoidParams:
 
     def predict(self, t: np.ndarray) -> np.ndarray:
         """Evaluates the fitted model at stamps ``t``."""
-        return _model(self.x, np.asarray(t, dtype=float) - self.t0, self.n_modes, self.drift)
+        tau = np.asarray(t, dtype=float) - self.t0
+        return _Decay(tau, self.n_modes, self.drift, self.nonlinear).value(self.x)
+
+    @property
+    def frequency_shift_hz(self) -> float:
+        """q / 2 pi: how much faster the first mode runs at ``tau = 0`` (0 when linear)."""
+        return float(self.x[-1]) / TWO_PI if self.nonlinear else 0.0
+
+    @property
+    def level_shift_m(self) -> float:
+        """e: how far the first mode's centre is off ``c`` at ``tau = 0`` (0 when linear)."""
+        return float(self.x[-2]) if self.nonlinear else 0.0
 
     def offset_of(self, t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
         """The offset of another signal that shares this decay's poles, with its std.
@@ -97,93 +155,173 @@ class DampedSinusoidParams:
         """
         tau = np.asarray(t, dtype=float) - self.t0
         y = np.asarray(y, dtype=float)
-        decays = [self.x[self.mode_slice(m)][2] for m in range(self.n_modes)]
-        omegas = [self.x[self.mode_slice(m)][3] for m in range(self.n_modes)]
-        design = _design(tau, np.asarray(decays), np.asarray(omegas), self.drift)
+        design = _Decay(tau, self.n_modes, self.drift, self.nonlinear).design(self.x)
         coef, *_ = np.linalg.lstsq(design, y, rcond=None)
         cov = sandwich_covariance(design, y - design @ coef)
         return float(coef[0]), float(math.sqrt(cov.matrix[0, 0]))
 
 
 class _Decay:
-    """The model and its Jacobian on fixed stamps, sharing the exponentials between them.
+    """The model, its Jacobian and its linear design on fixed stamps, sharing the basis.
 
     The solver asks for the residuals and then the Jacobian at the same point; the decays,
     cosines and sines (the costly part) are computed once for both.
     """
 
-    def __init__(self, tau: np.ndarray, n_modes: int, drift: bool):
+    def __init__(self, tau: np.ndarray, n_modes: int, drift: bool, nonlinear: bool = False):
         self.tau = tau
         self.n_modes = n_modes
         self.drift = drift
+        self.nonlinear = nonlinear
+        self.first = 2 if drift else 1
         self._x: np.ndarray | None = None
-        self._basis: list[tuple[np.ndarray, np.ndarray]] = []
+        self._basis: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        self._square = np.empty(0)
+        self._sweep = np.empty(0)
 
     def _update(self, x: np.ndarray) -> None:
         if self._x is not None and np.array_equal(x, self._x):
             return
         self._x = x.copy()
-        first = 2 if self.drift else 1
+        tau = self.tau
         self._basis = []
         for m in range(self.n_modes):
-            s, w = x[first + 4 * m + 2 : first + 4 * m + 4]
-            decay = np.exp(-s * self.tau)
-            phase = w * self.tau
-            self._basis.append((decay * np.cos(phase), decay * np.sin(phase)))
+            s, w = x[self.first + 4 * m + 2 : self.first + 4 * m + 4]
+            decay = np.exp(-s * tau)
+            phase = w * tau
+            if m == 0 and self.nonlinear:
+                # e^{-2 sigma tau} is the squared envelope; the sweep is its integral.
+                self._square = decay * decay
+                self._sweep = _sweep(s, tau)
+                phase = phase + x[-1] * self._sweep
+            self._basis.append((decay, decay * np.cos(phase), decay * np.sin(phase)))
+
+    def design(self, x: np.ndarray) -> np.ndarray:
+        """The columns that enter linearly (``c, d, a_m, b_m, e``) at the poles of ``x``."""
+        self._update(x)
+        columns = [np.ones_like(self.tau)]
+        if self.drift:
+            columns.append(self.tau)
+        for _, cos, sin in self._basis:
+            columns += [cos, sin]
+        if self.nonlinear:
+            columns.append(self._square)
+        return np.column_stack(columns)
 
     def value(self, x: np.ndarray) -> np.ndarray:
         """The model at parameters ``x``."""
         self._update(x)
         y = np.full(self.tau.shape, x[0])
-        first = 1
         if self.drift:
             y += x[1] * self.tau
-            first = 2
-        for m, (cos, sin) in enumerate(self._basis):
-            a, b = x[first + 4 * m : first + 4 * m + 2]
+        for m, (_, cos, sin) in enumerate(self._basis):
+            a, b = x[self.first + 4 * m : self.first + 4 * m + 2]
             y += a * cos + b * sin
+        if self.nonlinear:
+            y += x[-2] * self._square
         return y
 
     def jacobian(self, x: np.ndarray) -> np.ndarray:
         """d model / d x at parameters ``x``."""
         self._update(x)
-        jac = np.empty((self.tau.size, x.size))
+        tau = self.tau
+        jac = np.empty((tau.size, x.size))
         jac[:, 0] = 1.0
-        first = 1
         if self.drift:
-            jac[:, 1] = self.tau
-            first = 2
-        for m, (cos, sin) in enumerate(self._basis):
-            k = first + 4 * m
+            jac[:, 1] = tau
+        for m, (_, cos, sin) in enumerate(self._basis):
+            k = self.first + 4 * m
             a, b = x[k : k + 2]
+            in_phase = a * cos + b * sin
+            quadrature = b * cos - a * sin  # d(mode)/d(phase)
             jac[:, k] = cos
             jac[:, k + 1] = sin
-            jac[:, k + 2] = -self.tau * (a * cos + b * sin)
-            jac[:, k + 3] = self.tau * (b * cos - a * sin)
+            jac[:, k + 2] = -tau * in_phase
+            jac[:, k + 3] = tau * quadrature
+            if m == 0 and self.nonlinear:
+                s, e, q = x[k + 2], x[-2], x[-1]
+                jac[:, k + 2] -= 2.0 * e * tau * self._square
+                jac[:, k + 2] += q * _sweep_rate(s, tau, self._square, self._sweep) * quadrature
+                jac[:, -2] = self._square
+                jac[:, -1] = self._sweep * quadrature
         return jac
 
 
-def _model(x: np.ndarray, tau: np.ndarray, n_modes: int, drift: bool) -> np.ndarray:
-    return _Decay(tau, n_modes, drift).value(x)
+def _gauss_newton(
+    decay: _Decay, y: np.ndarray, x0: np.ndarray, max_steps: int = 6
+) -> tuple[np.ndarray, int] | None:
+    """Plain Gauss-Newton from a start next to the solution (a live window's last fit).
+
+    Near the minimum it converges quadratically, and a step costs one Jacobian and one
+    small least-squares solve, without the trust-region bookkeeping of a general solver.
+    It stops when the next step would lower the linearised residual sum of squares by less
+    than a millionth of the noise variance: far less than the data can tell.
+
+    Returns:
+        The solution and the evaluations used, or ``None`` when a step does not lower the
+        residuals or it does not converge (the caller then runs the robust solver).
+    """
+    x = x0
+    residual = decay.value(x) - y
+    rss = float(residual @ residual)
+    tolerance = 1e-6 * rss / max(y.size - x.size, 1)
+    for step in range(1, max_steps + 1):
+        jac = decay.jacobian(x)
+        delta, *_ = np.linalg.lstsq(jac, -residual, rcond=None)
+        linearised = residual + jac @ delta
+        if rss - float(linearised @ linearised) < tolerance:
+            return x, step
+        trial = x + delta
+        trial_residual = decay.value(trial) - y
+        trial_rss = float(trial_residual @ trial_residual)
+        if not trial_rss < rss:
+            return None
+        x, residual, rss = trial, trial_residual, trial_rss
+    return None
 
 
-def _design(tau: np.ndarray, decays: np.ndarray, omegas: np.ndarray, drift: bool) -> np.ndarray:
-    """Columns of the model that is linear once decays and frequencies are fixed."""
-    columns = [np.ones_like(tau)]
-    if drift:
-        columns.append(tau)
+def _sweep(sigma: float, tau: np.ndarray) -> np.ndarray:
+    """``(1 - e^{-2 sigma tau}) / (2 sigma)``: the phase a unit frequency shift adds."""
+    if abs(sigma) * float(np.max(np.abs(tau), initial=0.0)) < 1e-8:
+        return tau - sigma * tau * tau
+    return -np.expm1(-2.0 * sigma * tau) / (2.0 * sigma)
+
+
+def _sweep_rate(
+    sigma: float, tau: np.ndarray, square: np.ndarray, sweep: np.ndarray
+) -> np.ndarray:
+    """d sweep / d sigma = (tau e^{-2 sigma tau} - sweep) / sigma."""
+    if abs(sigma) * float(np.max(np.abs(tau), initial=0.0)) < 1e-8:
+        return -tau * tau
+    return (tau * square - sweep) / sigma
+
+
+def _pole_vector(
+    decays: Sequence[float], omegas: Sequence[float], drift: bool, nonlinear: bool
+) -> np.ndarray:
+    """A parameter vector with the given poles and zero amplitudes (and no sweep)."""
+    x = [0.0] * (1 + int(drift))
     for s, w in zip(decays, omegas, strict=True):
-        decay = np.exp(-s * tau)
-        columns += [decay * np.cos(w * tau), decay * np.sin(w * tau)]
-    return np.column_stack(columns)
+        x += [0.0, 0.0, float(s), float(w)]
+    if nonlinear:
+        x += [0.0, 0.0]
+    return np.asarray(x)
 
 
 def _linear_amplitudes(
-    tau: np.ndarray, y: np.ndarray, decays: np.ndarray, omegas: np.ndarray, drift: bool
-) -> np.ndarray:
-    """The best ``c, d, a_m, b_m`` for fixed decays and frequencies (variable projection)."""
-    coef, *_ = np.linalg.lstsq(_design(tau, decays, omegas, drift), y, rcond=None)
-    return coef
+    tau: np.ndarray,
+    y: np.ndarray,
+    decays: Sequence[float],
+    omegas: Sequence[float],
+    drift: bool,
+    nonlinear: bool = False,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The best ``c, d, a_m, b_m, e`` for fixed poles (variable projection), and the fit."""
+    design = _Decay(tau, len(decays), drift, nonlinear).design(
+        _pole_vector(decays, omegas, drift, nonlinear)
+    )
+    coef, *_ = np.linalg.lstsq(design, y, rcond=None)
+    return coef, design @ coef
 
 
 def spectral_peak_hz(
@@ -231,12 +369,16 @@ class DampedSinusoidFit:
         params = DampedSinusoidFit(n_modes=1).fit(t, z)
         mode = params.mode(0)     # frequency, damping ratio, decrement with stds
         z_hat = params.predict(t)
+        # A few samples later, started from the last solution (a live window):
+        params = DampedSinusoidFit(n_modes=1).fit(t2, z2, start=params)
 
     Args:
         n_modes: Number of damped modes.
         drift: Also fit a linear drift.
         min_frequency_hz: Band for the automatic starting frequency.
         max_frequency_hz: Band for the automatic starting frequency.
+        nonlinear: Also fit the first mode's amplitude-dependent level and frequency (see
+            the module docstring).
     """
 
     def __init__(
@@ -245,14 +387,21 @@ class DampedSinusoidFit:
         drift: bool = False,
         min_frequency_hz: float = 0.05,
         max_frequency_hz: float = math.inf,
+        nonlinear: bool = False,
     ):
         if n_modes < 1:
             raise ValueError('n_modes must be at least 1')
         self.n_modes = n_modes
         self.drift = drift
+        self.nonlinear = nonlinear
         self.min_frequency_hz = min_frequency_hz
         self.max_frequency_hz = max_frequency_hz
         self.params_: DampedSinusoidParams | None = None
+
+    @property
+    def n_params(self) -> int:
+        """Length of the parameter vector."""
+        return 1 + int(self.drift) + 4 * self.n_modes + 2 * int(self.nonlinear)
 
     def fit(
         self,
@@ -260,6 +409,7 @@ class DampedSinusoidFit:
         y: np.ndarray,
         initial: Sequence[ModeGuess] | None = None,
         t0: float | None = None,
+        start: DampedSinusoidParams | None = None,
     ) -> DampedSinusoidParams:
         """Fits the model to samples.
 
@@ -269,57 +419,65 @@ class DampedSinusoidFit:
             initial: A (damped frequency Hz, damping ratio) start per mode. Missing ones
                 come from the spectrum of what the earlier modes leave.
             t0: Time origin of the decay (default ``t[0]``).
+            start: A previous solution with the same modes and drift to start from (moved
+                to ``t0``; a linear one may start a nonlinear fit and the reverse); it
+                replaces ``initial``. A sliding window then converges in a step or two.
 
         Returns:
             The fitted parameters, also kept as ``self.params_``.
 
         Raises:
-            LumpbeamError: Too few samples for the model, or the fit did not converge to
-                finite values.
+            LumpbeamError: Too few samples for the model, a ``start`` with other modes, or
+                the fit did not converge to finite values.
         """
         t = np.asarray(t, dtype=float)
         y = np.asarray(y, dtype=float)
-        n_params = 1 + int(self.drift) + 4 * self.n_modes
+        n_params = self.n_params
         if t.size != y.size or t.size < 2 * n_params:
             raise LumpbeamError(f'damped-sinusoid fit: {t.size} samples for {n_params} parameters')
         origin = float(t[0] if t0 is None else t0)
         tau = t - origin
-        guesses = list(initial or [])
-        decays: list[float] = []
-        omegas: list[float] = []
-        for m in range(self.n_modes):
-            if m < len(guesses):
-                f_d, zeta = guesses[m]
-            else:
-                f_d, zeta = self._next_guess(tau, y, decays, omegas)
-            w = TWO_PI * f_d
-            omegas.append(w)
-            decays.append(zeta * w / math.sqrt(max(1.0 - zeta * zeta, 1e-12)))
-        x0 = self._start(tau, y, np.asarray(decays), np.asarray(omegas))
-        n_modes, drift = self.n_modes, self.drift
-        decay = _Decay(tau, n_modes, drift)
-        solution = least_squares(
-            lambda x: decay.value(x) - y, x0, jac=decay.jacobian, method='lm', x_scale='jac'
-        )
-        x = solution.x
+        if start is not None:
+            if start.n_modes != self.n_modes or start.drift != self.drift:
+                raise LumpbeamError('damped-sinusoid fit: the start has other modes or drift')
+            x0 = start.shifted(origin).x
+            # A linear solution starts a nonlinear fit with no level or frequency shift.
+            if self.nonlinear and not start.nonlinear:
+                x0 = np.concatenate([x0, [0.0, 0.0]])
+            elif start.nonlinear and not self.nonlinear:
+                x0 = x0[:-2]
+        else:
+            x0 = self._start(tau, y, list(initial or []))
+        decay = _Decay(tau, self.n_modes, self.drift, self.nonlinear)
+        found = _gauss_newton(decay, y, x0) if start is not None else None
+        if found is None:
+            solution = least_squares(
+                lambda x: decay.value(x) - y, x0, jac=decay.jacobian, method='lm', x_scale='jac'
+            )
+            found = solution.x, int(solution.nfev)
+        x, evaluations = found
         if not np.all(np.isfinite(x)):
             raise LumpbeamError('damped-sinusoid fit did not converge')
-        # A negative omega is the same mode with b negated; keep omega positive.
-        for m in range(n_modes):
-            k = 1 + int(drift) + 4 * m
+        # A negative omega is the same mode with b (and the sweep) negated; keep it positive.
+        for m in range(self.n_modes):
+            k = 1 + int(self.drift) + 4 * m
             if x[k + 3] < 0.0:
                 x[k + 1] = -x[k + 1]
                 x[k + 3] = -x[k + 3]
+                if m == 0 and self.nonlinear:
+                    x[-1] = -x[-1]
         residuals = decay.value(x) - y
         cov = sandwich_covariance(decay.jacobian(x), residuals)
         self.params_ = DampedSinusoidParams(
             origin,
             x,
             cov,
-            n_modes,
-            drift,
+            self.n_modes,
+            self.drift,
             int(t.size),
             float(np.sqrt(np.mean(residuals**2))),
+            self.nonlinear,
+            evaluations,
         )
         return self.params_
 
@@ -333,15 +491,27 @@ class DampedSinusoidFit:
             raise LumpbeamError('damped-sinusoid fit: predict() before fit()')
         return self.params_.predict(t)
 
-    def _start(
-        self, tau: np.ndarray, y: np.ndarray, decays: np.ndarray, omegas: np.ndarray
-    ) -> np.ndarray:
-        coef = _linear_amplitudes(tau, y, decays, omegas, self.drift)
-        head = 1 + int(self.drift)
-        x0 = list(coef[:head])
+    def _start(self, tau: np.ndarray, y: np.ndarray, guesses: list[ModeGuess]) -> np.ndarray:
+        """Starting parameters: the guessed poles with their best amplitudes."""
+        decays: list[float] = []
+        omegas: list[float] = []
         for m in range(self.n_modes):
-            x0 += [coef[head + 2 * m], coef[head + 2 * m + 1], decays[m], omegas[m]]
-        return np.asarray(x0)
+            if m < len(guesses):
+                f_d, zeta = guesses[m]
+            else:
+                f_d, zeta = self._next_guess(tau, y, decays, omegas)
+            w = TWO_PI * f_d
+            omegas.append(w)
+            decays.append(zeta * w / math.sqrt(max(1.0 - zeta * zeta, 1e-12)))
+        x0 = _pole_vector(decays, omegas, self.drift, self.nonlinear)
+        coef, _ = _linear_amplitudes(tau, y, decays, omegas, self.drift, self.nonlinear)
+        head = 1 + int(self.drift)
+        x0[:head] = coef[:head]
+        for m in range(self.n_modes):
+            x0[head + 4 * m : head + 4 * m + 2] = coef[head + 2 * m : head + 2 * m + 2]
+        if self.nonlinear:
+            x0[-2] = coef[-1]
+        return x0
 
     def _next_guess(
         self, tau: np.ndarray, y: np.ndarray, decays: list[float], omegas: list[float]
@@ -350,8 +520,8 @@ class DampedSinusoidFit:
 
         Its decay comes from the amplitudes demodulated on the two halves of the record.
         """
-        coef = _linear_amplitudes(tau, y, np.asarray(decays), np.asarray(omegas), self.drift)
-        rest = y - _design_apply(tau, coef, decays, omegas, self.drift)
+        _, fitted = _linear_amplitudes(tau, y, decays, omegas, self.drift)
+        rest = y - fitted
         low = self.min_frequency_hz
         if omegas:
             low = max(low, 1.2 * max(omegas) / TWO_PI)
@@ -362,15 +532,9 @@ class DampedSinusoidFit:
         half = tau.size // 2
         amps = []
         for part in (slice(0, half), slice(half, None)):
-            c = _linear_amplitudes(tau[part], rest[part], np.zeros(1), np.array([w]), False)
+            c, _ = _linear_amplitudes(tau[part], rest[part], [0.0], [w], False)
             amps.append(math.hypot(c[1], c[2]))
         span = float(np.mean(tau[half:]) - np.mean(tau[:half]))
         sigma = math.log(amps[0] / amps[1]) / span if min(amps) > 0 and span > 0 else 0.0
         sigma = max(sigma, 0.0)
         return f_d, sigma / math.hypot(sigma, w)
-
-
-def _design_apply(
-    tau: np.ndarray, coef: np.ndarray, decays: list[float], omegas: list[float], drift: bool
-) -> np.ndarray:
-    return _design(tau, np.asarray(decays), np.asarray(omegas), drift) @ coef

@@ -7,6 +7,7 @@ rejected and counted, never raised: a live node logs the counts instead.
 
 from __future__ import annotations
 
+import bisect
 import math
 from dataclasses import dataclass
 
@@ -192,10 +193,7 @@ class SlidingWindow:
 
     def _prune_loads(self, start: float) -> None:
         """Drops readings before ``start`` but the last of them: it gives the load then."""
-        keep_from = 0
-        for i, stamp in enumerate(self._load_t):
-            if stamp < start:
-                keep_from = i
-        if keep_from:
+        keep_from = bisect.bisect_left(self._load_t, start) - 1
+        if keep_from > 0:
             del self._load_t[:keep_from]
             del self._load_kg[:keep_from]

@@ -38,6 +38,8 @@ def test_round_trip_through_parameters():
         ('fit.max_modes', 3, 'must be 1 or 2'),
         ('fit.max_modes', 0, 'at least 1'),
         ('fit.drift', 'yes', 'true or false'),
+        ('fit.nonlinear', 'sometimes', 'one of'),
+        ('fit.nonlinear_min_decay', 0.0, 'must be positive'),
         ('fit.min_frequency_hz', 50.0, 'must exceed'),
         ('quality.min_release_confidence', 2.0, 'at most 1'),
         ('window.lenght_s', 10.0, 'unknown key'),

@@ -19,7 +19,7 @@ def test_release_from_the_data(drop_case):
     release = detect_release(_window(trajectory), CONFIG)
     assert release.source == 'data' and release.confidence == 1.0
     assert abs(release.time_s - truth.release_time_s) < 1.0 / 180.0
-    assert release.level_before_m == pytest.approx(-0.05, abs=5e-6)
+    assert release.level_before_m == pytest.approx(truth.level_before_m, abs=5e-6)
     assert release.level_before_std_m == pytest.approx(20e-6 / math.sqrt(360), rel=0.3)
     assert release.step_snr > 1000 and math.isnan(release.load_kg)
 

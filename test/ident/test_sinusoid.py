@@ -83,3 +83,55 @@ def test_spectral_peak_on_uneven_stamps():
         4.2, rel=2e-3
     )
     assert math.isnan(spectral_peak_hz(t, np.sin(t), 500.0, 600.0))
+
+
+def _weakly_nonlinear(t, q_hz=2e-3, e=3e-5, f_d=F_D, zeta=ZETA, amp=AMP):
+    """A decay whose frequency and centre shift with the squared amplitude."""
+    w = 2 * math.pi * f_d
+    sigma = zeta * w / math.sqrt(1 - zeta**2)
+    square = np.exp(-2 * sigma * t)
+    phase = w * t + 2 * math.pi * q_hz * (1 - square) / (2 * sigma)
+    return OFFSET + e * square + amp * np.exp(-sigma * t) * np.cos(phase + 0.3)
+
+
+def test_nonlinear_terms_remove_the_amplitude_bias():
+    y = _weakly_nonlinear(T)
+    linear = DampedSinusoidFit().fit(T, y).mode(0)
+    params = DampedSinusoidFit(nonlinear=True).fit(T, y)
+    # The linear fit runs at a frequency averaged over the decay, off by ~q/2.
+    assert abs(linear.damped_frequency_hz - F_D) > 5e-4
+    assert params.mode(0).damped_frequency_hz == pytest.approx(F_D, rel=1e-9)
+    assert params.frequency_shift_hz == pytest.approx(2e-3, rel=1e-6)
+    assert params.level_shift_m == pytest.approx(3e-5, rel=1e-6)
+    assert params.offset == pytest.approx(OFFSET, abs=1e-12)
+    assert DampedSinusoidFit().fit(T, y).frequency_shift_hz == 0.0
+
+
+@pytest.mark.parametrize('nonlinear', [False, True])
+def test_shifted_origin_describes_the_same_curve(nonlinear):
+    y = _weakly_nonlinear(T) + 1e-4 * T
+    params = DampedSinusoidFit(n_modes=2, drift=True, nonlinear=nonlinear).fit(
+        T, y, initial=[(F_D, ZETA), (21.0, 0.02)]
+    )
+    for t0 in (2.5, -1.0):
+        moved = params.shifted(t0)
+        assert moved.t0 == t0
+        np.testing.assert_allclose(moved.predict(T), params.predict(T), atol=1e-14)
+        assert moved.mode(0).damped_frequency_hz == params.mode(0).damped_frequency_hz
+    assert params.shifted(params.t0) is params
+
+
+def test_warm_start_converges_quickly_to_the_cold_solution():
+    rng = np.random.default_rng(5)
+    y = _weakly_nonlinear(T) + rng.normal(0.0, 20e-6, T.size)
+    first = DampedSinusoidFit(nonlinear=True).fit(T[:-9], y[:-9])
+    cold = DampedSinusoidFit(nonlinear=True).fit(T[9:], y[9:])
+    warm = DampedSinusoidFit(nonlinear=True).fit(T[9:], y[9:], start=first)
+    np.testing.assert_allclose(warm.x, cold.x, rtol=1e-6, atol=1e-12)
+    assert warm.n_evaluations < cold.n_evaluations
+    # A linear start serves a nonlinear fit (and the reverse); other modes do not.
+    linear = DampedSinusoidFit().fit(T, y)
+    assert DampedSinusoidFit(nonlinear=True).fit(T, y, start=linear).nonlinear
+    assert not DampedSinusoidFit().fit(T, y, start=warm).nonlinear
+    with pytest.raises(LumpbeamError, match='other modes'):
+        DampedSinusoidFit(n_modes=2).fit(T, y, start=linear)

@@ -1,0 +1,253 @@
+"""The identifier node: live frequency, damping and stiffness on ``/beam_params``.
+
+Subscribes to ``/tip_pose`` (PoseStamped in ``beam_base``) and ``/tip_load`` (Float64, kg,
+reliable and transient local as :mod:`lumpbeam_ros.bagio.qos` gives it), keeps the last
+``window.length_s`` of poses in a :class:`~lumpbeam_ros.ident.window.SlidingWindow`, and on
+a timer at ``publish_rate_hz`` identifies the window
+(:func:`~lumpbeam_ros.ident.identify.identify_from`, warm-started from the last update) and
+publishes one DiagnosticStatus ``lumpbeam/identifier`` (SPEC section 3).
+
+Run it with the package's settings, on sim time when a bag is replayed::
+
+    identifier_node --ros-args --params-file config/identifier.yaml -p use_sim_time:=true
+
+Bad input never stops it: a pose in another frame is dropped with a throttled warning,
+NaN/inf and out-of-order or repeated stamps are dropped and counted, a clock that jumps
+back (a looping bag) empties the window.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import rclpy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import PoseStamped
+from rcl_interfaces.msg import (
+    FloatingPointRange,
+    IntegerRange,
+    ParameterDescriptor,
+    ParameterType,
+)
+from rclpy.context import Context
+from rclpy.exceptions import ParameterException
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from std_msgs.msg import Float64
+
+from lumpbeam_ros.bagio.convert import pose_values
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ident.config import (
+    NONLINEAR_CHOICES,
+    PARAMETER_KEYS,
+    IdentifierConfig,
+    config_from_parameters,
+    config_to_parameters,
+    parameter_descriptions,
+)
+from lumpbeam_ros.ident.identify import FitState, identify_from
+from lumpbeam_ros.ident.result import Identification, Status
+from lumpbeam_ros.ident.window import SlidingWindow
+from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
+from lumpbeam_ros.resources import config_path
+
+NODE_NAME = 'identifier'
+STATUS_NAME = 'lumpbeam/identifier'
+BASE_FRAME = 'beam_base'
+#: Seconds between repeated warnings about the same kind of bad input.
+WARN_PERIOD_S = 5.0
+
+# Ranges ROS shows and enforces; config_from_parameters checks the rest (positivity).
+_RANGES: dict[str, FloatingPointRange | IntegerRange] = {
+    'effective_mass.beam_fraction': FloatingPointRange(from_value=0.0, to_value=1.0),
+    'quality.min_release_confidence': FloatingPointRange(from_value=0.0, to_value=1.0),
+    'fit.max_modes': IntegerRange(from_value=1, to_value=2, step=1),
+    'publish_rate_hz': FloatingPointRange(from_value=0.01, to_value=100.0),
+}
+
+
+def _descriptor(name: str, default: Any, description: str) -> ParameterDescriptor:
+    descriptor = ParameterDescriptor(name=name, description=description, read_only=True)
+    bound = _RANGES.get(name)
+    if isinstance(bound, FloatingPointRange):
+        descriptor.floating_point_range = [bound]
+    elif isinstance(bound, IntegerRange):
+        descriptor.integer_range = [bound]
+    if name == PARAMETER_KEYS['nonlinear']:
+        descriptor.additional_constraints = f'one of {", ".join(NONLINEAR_CHOICES)}'
+    descriptor.type = {
+        bool: ParameterType.PARAMETER_BOOL,
+        int: ParameterType.PARAMETER_INTEGER,
+        float: ParameterType.PARAMETER_DOUBLE,
+        str: ParameterType.PARAMETER_STRING,
+    }[type(default)]
+    return descriptor
+
+
+class IdentifierNode(Node):
+    """Publishes ``/beam_params`` from ``/tip_pose`` and ``/tip_load``.
+
+    Args:
+        context: The rclpy context (default: the global one).
+        parameter_overrides: Parameter values by name (e.g. ``{'publish_rate_hz': 5.0}``),
+            on top of any ``--params-file``.
+
+    Raises:
+        ConfigError: A parameter or the beam configuration is invalid.
+    """
+
+    def __init__(
+        self,
+        context: Context | None = None,
+        parameter_overrides: Mapping[str, Any] | None = None,
+    ):
+        overrides = [Parameter(k, value=v) for k, v in (parameter_overrides or {}).items()]
+        super().__init__(NODE_NAME, context=context, parameter_overrides=overrides)
+        self.config = self._declare_config()
+        beam_file = self._declare('beam_config', str(config_path('paper_beam.yaml')), '')
+        self.beam: BeamParameters = load_beam_config(beam_file)[0]
+        self.hardware_id = self._declare('hardware_id', 'beam', 'DiagnosticStatus.hardware_id.')
+        self.window = SlidingWindow.from_config(self.config)
+        self._state: FitState | None = None
+        self._resets = 0
+        self.wrong_frame = 0
+        self.updates = 0
+        self._output = self.create_publisher(DiagnosticArray, '/beam_params', 10)
+        self.create_subscription(PoseStamped, '/tip_pose', self._on_pose, 200)
+        latched = QoSProfile(
+            depth=1,
+            reliability=ReliabilityPolicy.RELIABLE,
+            durability=DurabilityPolicy.TRANSIENT_LOCAL,
+        )
+        self.create_subscription(Float64, '/tip_load', self._on_load, latched)
+        self.create_timer(1.0 / self.config.publish_rate_hz, self._on_timer)
+
+    def _declare(self, name: str, default: Any, description: str) -> Any:
+        try:
+            parameter = self.declare_parameter(
+                name, default, _descriptor(name, default, description)
+            )
+        except ParameterException as exc:
+            raise LumpbeamError(f'parameter {name}: {exc}') from None
+        return parameter.value
+
+    def _declare_config(self) -> IdentifierConfig:
+        """Declares the identifier's parameters (defaults: the dataclass) and reads them."""
+        descriptions = parameter_descriptions()
+        values = {
+            name: self._declare(name, default, descriptions.get(name, ''))
+            for name, default in config_to_parameters(IdentifierConfig()).items()
+        }
+        return config_from_parameters(values, f'node {self.get_name()} parameters')
+
+    def _on_pose(self, msg: PoseStamped) -> None:
+        if msg.header.frame_id != BASE_FRAME:
+            self.wrong_frame += 1
+            self.get_logger().warning(
+                f'/tip_pose in frame {msg.header.frame_id!r}, expected {BASE_FRAME!r}: '
+                f'dropped ({self.wrong_frame} so far)',
+                throttle_duration_sec=WARN_PERIOD_S,
+            )
+            return
+        try:
+            stamp_ns, _, z, pitch, _ = pose_values(msg)
+        except LumpbeamError:
+            # An invalid quaternion: the window counts it with the other non-finite samples.
+            stamp_ns, z, pitch = 0, math.nan, math.nan
+        self.window.push(stamp_ns * 1e-9, z, pitch)
+        counts = self.window.counts
+        if counts.resets != self._resets:
+            self._resets = counts.resets
+            self._state = None
+            self.get_logger().warning(
+                'tip pose stamps jumped back (a looping bag?): window emptied',
+                throttle_duration_sec=WARN_PERIOD_S,
+            )
+
+    def _on_load(self, msg: Float64) -> None:
+        # Float64 has no stamp: the reading holds from now, on the node's (sim) clock.
+        now = self.get_clock().now().nanoseconds * 1e-9
+        if not self.window.push_load(now, msg.data):
+            self.get_logger().warning(
+                f'/tip_load {msg.data!r} at {now:.3f} s rejected (not a finite mass >= 0, or '
+                'older than the last reading)',
+                throttle_duration_sec=WARN_PERIOD_S,
+            )
+
+    def _on_timer(self) -> None:
+        self.updates += 1
+        snapshot = self.window.snapshot()
+        try:
+            result, self._state = identify_from(
+                snapshot, self.beam, self.config, previous=self._state
+            )
+        except (LumpbeamError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
+            # Numerically hopeless windows (e.g. a constant signal) give no estimate.
+            self._state = None
+            result = Identification(Status.ERROR, f'identification failed: {exc}')
+        self._output.publish(self.diagnostics(result))
+
+    def diagnostics(self, result: Identification) -> DiagnosticArray:
+        """The ``/beam_params`` message of one identification (SPEC section 3).
+
+        Args:
+            result: The identification.
+
+        Returns:
+            A DiagnosticArray with one status, stamped now.
+        """
+        counts = self.window.counts
+        pairs: Sequence[tuple[str, str]] = [
+            *result.key_values(),
+            ('samples_wrong_frame', str(self.wrong_frame)),
+            ('samples_non_finite', str(counts.non_finite)),
+            ('samples_out_of_order', str(counts.out_of_order + counts.duplicates)),
+            ('window_resets', str(counts.resets)),
+        ]
+        status = DiagnosticStatus(
+            level=bytes([int(result.status)]),
+            name=STATUS_NAME,
+            message=result.message,
+            hardware_id=self.hardware_id,
+            values=[KeyValue(key=k, value=v) for k, v in pairs],
+        )
+        msg = DiagnosticArray(status=[status])
+        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.header.frame_id = BASE_FRAME
+        return msg
+
+
+def main(args: list[str] | None = None) -> int:
+    """Runs the node until Ctrl-C.
+
+    Args:
+        args: Command-line arguments (default ``sys.argv``), incl. ``--ros-args``.
+
+    Returns:
+        0, or 2 when the configuration is invalid (one line on stderr).
+    """
+    rclpy.init(args=args)
+    try:
+        node = IdentifierNode()
+    except LumpbeamError as exc:
+        print(f'identifier_node: {exc}', file=sys.stderr)
+        rclpy.try_shutdown()
+        return 2
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,138 @@
+import io
+import json
+import shutil
+
+import pytest
+
+from lumpbeam_ros.bagio import BagWriter
+from lumpbeam_ros.cli.analyze import SPEC_KEYS, Progress
+from lumpbeam_ros.cli.main import main
+from lumpbeam_ros.model.chain import LumpedChain
+from lumpbeam_ros.model.modes import chain_modes
+from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
+from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+
+
+@pytest.fixture(scope='module')
+def drop_bag(tmp_path_factory):
+    bag = tmp_path_factory.mktemp('analyze') / 'drop'
+    write_drop_test_bag(bag, BeamParameters(), DropTestConfig(), SynthOptions())
+    return bag
+
+
+def test_analyze_prints_writes_json_and_plots(drop_bag, tmp_path, capsys):
+    out = tmp_path / 'result.json'
+    plots = tmp_path / 'plots'
+    assert main(['analyze', str(drop_bag), '--json', str(out), '--plots', str(plots)]) == 0
+    text = capsys.readouterr().out
+    assert 'status: OK' in text and 'natural frequency: 3.0588 +-' in text
+    data = json.loads(out.read_text())
+    truth = chain_modes(LumpedChain.from_beam(BeamParameters(), 0.0))
+    for key in SPEC_KEYS:
+        assert data[key] > 0 and data[f'{key}_std'] > 0
+    assert abs(data['natural_frequency_hz'] - truth.natural_frequency_hz[0]) < (
+        3 * data['natural_frequency_hz_std']
+    )
+    assert data['release_time_s'] == 2.0 and data['status'] == 'OK'
+    assert data['static_deflection_m'] == pytest.approx(0.04044, rel=1e-3)
+    assert sorted(p.name for p in plots.iterdir()) == [
+        'estimates.png',
+        'spectrum.png',
+        'trajectory.png',
+    ]
+
+
+def _bag(path, poses=(), frame='beam_base', loads=()):
+    with BagWriter(path) as bag:
+        for t, z in poses:
+            bag.write_pose('/tip_pose', t, 2.3, z, 0.0, frame=frame)
+        for t, kg in loads:
+            bag.write_float('/tip_load', t, kg)
+    return path
+
+
+def _error_line(capsys):
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith('lumpbeam analyze: error: ')
+    return err[0]
+
+
+def test_bag_without_tip_pose(tmp_path, capsys):
+    bag = _bag(tmp_path / 'b', loads=[(0.0, 4.5)])
+    assert main(['analyze', str(bag)]) == 2
+    assert 'no /tip_pose in the bag (it has /tip_load)' in _error_line(capsys)
+
+
+def test_poses_in_another_frame(tmp_path, capsys):
+    bag = _bag(tmp_path / 'b', poses=[(i / 180, -0.03) for i in range(100)], frame='camera')
+    assert main(['analyze', str(bag)]) == 2
+    assert "frame 'camera', expected 'beam_base'" in _error_line(capsys)
+
+
+def test_folder_that_is_not_a_bag_and_missing_bag(tmp_path, capsys):
+    (tmp_path / 'plain').mkdir()
+    assert main(['analyze', str(tmp_path / 'plain')]) == 2
+    assert 'not a rosbag2 bag' in _error_line(capsys)
+    assert main(['analyze', str(tmp_path / 'nope')]) == 2
+    assert 'no such bag' in _error_line(capsys)
+
+
+def test_empty_and_too_short_bags(tmp_path, capsys):
+    with BagWriter(tmp_path / 'empty') as bag:
+        bag.write_float('/tip_load', 0.0, 4.5)
+        bag.add_topic('/tip_pose', 'geometry_msgs/msg/PoseStamped')
+    assert main(['analyze', str(tmp_path / 'empty')]) == 2
+    assert '/tip_pose holds no messages' in _error_line(capsys)
+    short = _bag(tmp_path / 'short', poses=[(i / 180, -0.03) for i in range(20)])
+    assert main(['analyze', str(short)]) == 2
+    assert '20 valid pose samples, need at least 50' in _error_line(capsys)
+
+
+@pytest.mark.parametrize('fraction', [0.5, 0.8])
+def test_truncated_bag_is_one_line_or_a_kept_partial_result(drop_bag, tmp_path, capsys, fraction):
+    cut = tmp_path / 'cut'
+    shutil.copytree(drop_bag, cut)
+    data = next(cut.glob('*.mcap'))
+    data.write_bytes(data.read_bytes()[: int(data.stat().st_size * fraction)])
+    out = tmp_path / 'r.json'
+    code = main(['analyze', str(cut), '--json', str(out)])
+    captured = capsys.readouterr()
+    # What survives depends on where the cut falls among the writer's chunks.
+    if code == 2:
+        last = captured.err.strip().splitlines()[-1]
+        assert last.startswith('lumpbeam analyze: error: ') and '/tip_pose' in last
+        assert 'Traceback' not in captured.err
+    else:
+        assert code in (0, 1) and 'status: ' in captured.out
+        result = json.loads(out.read_text())
+        assert 0 < result['n_samples'] < 2161 and result['window_end_s'] < 12.0
+
+
+def test_no_oscillation_keeps_partial_results(tmp_path, capsys):
+    bag = _bag(tmp_path / 'b', poses=[(i / 180, -0.03) for i in range(500)])
+    out = tmp_path / 'r.json'
+    assert main(['analyze', str(bag), '--json', str(out)]) == 1
+    assert 'status: ERROR no oscillation' in capsys.readouterr().out
+    data = json.loads(out.read_text())
+    assert data['status'] == 'ERROR' and data['natural_frequency_hz'] is None
+    assert data['n_samples'] == 500
+
+
+def test_bad_identifier_config_is_one_line(drop_bag, tmp_path, capsys):
+    bad = tmp_path / 'ident.yaml'
+    bad.write_text('/**:\n  ros__parameters:\n    fit:\n      max_modes: 7\n')
+    assert main(['analyze', str(drop_bag), '--identifier-config', str(bad)]) == 2
+    assert 'fit.max_modes: must be 1 or 2' in _error_line(capsys)
+
+
+@pytest.mark.parametrize(('total', 'shown'), [(10, False), (300_000, True)])
+def test_progress_bar_only_for_a_tty_or_a_long_job(total, shown):
+    stream = io.StringIO()
+    bar = Progress(total, 'reading', stream=stream, width=10)
+    for _ in range(total // 2):
+        bar.tick()
+    bar.close()
+    text = stream.getvalue()
+    assert bool(text) == shown
+    if shown:
+        assert text.endswith(' 50%\n') and '#####.....' in text
