@@ -42,7 +42,9 @@ def test_matches_the_batch_simulation_on_the_same_stamps(latency, t0):
     # noise); epoch stamps also carry ~0.2 us of float rounding.
     tol = 1e-6 if t0 == 0.0 else 2e-5
     np.testing.assert_allclose(z, ref.z, atol=tol)
-    np.testing.assert_allclose(pitch, ref.pitch, atol=tol)
+    # Right after a load change the pitch carries the 35 Hz second mode, which cubic
+    # interpolation on a 1/180 s grid renders to ~1e-5 rad: a fifth of the camera's 0.05 mrad.
+    np.testing.assert_allclose(pitch, ref.pitch, atol=max(tol, 2e-5))
 
 
 def test_starts_at_the_loaded_equilibrium_and_settles_after_the_drop():
