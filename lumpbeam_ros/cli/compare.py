@@ -92,7 +92,8 @@ def summary(comparison: Comparison) -> str:
         f'time offset: tracker_stamp = camera_stamp + {alignment.offset_s * 1e3:.4f} '
         f'+- {alignment.offset_std_s * 1e3:.4f} ms '
         f'(cross-correlation {aligned.coarse.offset_s * 1e3:.3f} ms, r = '
-        f'{aligned.coarse.correlation:+.4f})',
+        f'{aligned.coarse.correlation:+.4f}; segments agree to '
+        f'{alignment.offset_consistency:.2f} x their noise)',
         'tracker -> beam_base: translation '
         + _vector(transform.translation, alignment.translation_std_m, 1e3, 'mm')
         + ', rotation xyz '

@@ -74,6 +74,8 @@ class Comparison:
         return {
             'time_offset_s': alignment.offset_s,
             'time_offset_s_std': alignment.offset_std_s,
+            'time_offset_s_std_white': alignment.offset_std_white_s,
+            'time_offset_consistency': alignment.offset_consistency,
             'time_offset_convention': 'tracker_stamp = camera_stamp + time_offset_s',
             'rms_difference_m': self.rms_difference_m,
             'max_difference_m': self.max_difference_m,

@@ -39,6 +39,9 @@ MAX_ITERATIONS = 30
 #: Largest condition number of the parameters' correlation matrix still called determined.
 MAX_CONDITION = 1e12
 
+#: Stretches of the record whose separate offsets test the offset's consistency.
+SEGMENTS = 8
+
 #: Floor of the residual RMS used as a weight, m (noise-free synthetic data).
 _MIN_RMS = 1e-9
 
@@ -49,7 +52,13 @@ class Alignment:
 
     Attributes:
         offset_s: ``tracker_stamp - camera_stamp`` for the same instant, s.
-        offset_std_s: Its standard deviation, s.
+        offset_std_s: Its standard deviation, s: the white-noise one times
+            ``max(1, offset_consistency)``.
+        offset_std_white_s: The standard deviation from ``(J^T J)^-1``, which holds for
+            white noise only.
+        offset_consistency: Birge ratio of the offsets fitted to :data:`SEGMENTS` stretches
+            of the record: about 1 when they agree within their own noise, larger when the
+            offset wanders (clock drift, stamp jitter, correlated errors).
         transform: Tracker frame to ``beam_base``.
         rotation_std_rad: Standard deviation of the rotation about the ``beam_base`` x, y, z
             axes, rad.
@@ -63,6 +72,8 @@ class Alignment:
 
     offset_s: float
     offset_std_s: float
+    offset_std_white_s: float
+    offset_consistency: float
     transform: RigidTransform
     rotation_std_rad: np.ndarray
     translation_std_m: np.ndarray
@@ -125,9 +136,14 @@ def refine_alignment(
             'determined by the data (no motion where the streams overlap)'
         )
     std = np.sqrt(np.diag(np.linalg.inv(normal)))
+    consistency = _offset_consistency(
+        camera, reference, RigidTransform(rotation, translation), tau, pairs, margin_s
+    )
     return Alignment(
         offset_s=tau,
-        offset_std_s=float(std[6]),
+        offset_std_s=float(std[6]) * max(1.0, consistency),
+        offset_std_white_s=float(std[6]),
+        offset_consistency=consistency,
         transform=RigidTransform(rotation, translation),
         rotation_std_rad=std[:3],
         translation_std_m=std[3:6],
@@ -178,3 +194,37 @@ def _linearize(
     jacobian = np.vstack([pair_jac.reshape(-1, 7) * pair_w, plane_jac * plane_w])
     residual = np.concatenate([pair_res.ravel() * pair_w, plane_res * plane_w])
     return jacobian, residual, (pairs, pair_rms, plane_rms)
+
+
+def _offset_consistency(
+    camera: Track,
+    reference: GapInterpolator,
+    transform: RigidTransform,
+    tau: float,
+    pairs: np.ndarray,
+    margin_s: float,
+) -> float:
+    """Birge ratio ``sqrt(chi^2 / (K - 1))`` of the offsets of :data:`SEGMENTS` stretches.
+
+    Each stretch gets one Gauss-Newton step in the offset alone, from the joint solution
+    with the transform held; its variance is the white-noise one, ``s^2 / sum(J^2)``. A
+    stretch at rest says nothing about the offset and drops out by its huge variance.
+    """
+    query = camera.t[pairs] + tau
+    moved = transform.apply(reference(query))
+    residual = (camera.points[pairs] - moved)[:, [0, 2]]
+    slope = -(reference.velocity(query, margin_s) @ transform.rotation.T)[:, [0, 2]]
+    noise_var = float(np.mean(residual**2))
+    steps, variances = [], []
+    for chunk in np.array_split(np.arange(query.size), SEGMENTS):
+        information = float(np.sum(slope[chunk] ** 2))
+        if chunk.size < MIN_PAIRS or information <= 0.0:
+            continue
+        steps.append(-float(np.sum(slope[chunk] * residual[chunk])) / information)
+        variances.append(noise_var / information)
+    if len(steps) < 2:
+        return 1.0
+    step, weight = np.array(steps), 1.0 / np.array(variances)
+    mean = float(np.sum(weight * step) / np.sum(weight))
+    chi2 = float(np.sum(weight * (step - mean) ** 2))
+    return float(np.sqrt(chi2 / (len(steps) - 1)))

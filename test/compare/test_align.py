@@ -104,3 +104,20 @@ def test_bad_options():
         AlignOptions(max_offset_s=0.0)
     with pytest.raises(LumpbeamError, match='max gap'):
         AlignOptions(max_gap_s=-1.0)
+
+
+def test_clock_drift_inflates_the_offset_std(pair):
+    # The tracker clock runs 100 ppm fast: the offset wanders by 0.6 ms over the record.
+    ref = pair.reference
+    drifting = clean_track(ref.t * (1.0 + 1e-4), ref.points, ref.frame_id, ref.source)
+    alignment = align_streams(pair.camera, drifting).alignment
+    assert alignment.offset_consistency > 5.0
+    assert alignment.offset_std_s > 5.0 * alignment.offset_std_white_s
+    # The offset where the tip moves (after the release at 2 s): the drift at 3..5 s.
+    assert 7.3e-3 + 3e-4 < alignment.offset_s < 7.3e-3 + 5e-4
+
+
+def test_white_noise_segments_agree(pair):
+    alignment = align_streams(pair.camera, pair.reference).alignment
+    assert 0.3 < alignment.offset_consistency < 2.0
+    assert alignment.offset_std_s >= alignment.offset_std_white_s

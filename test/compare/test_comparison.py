@@ -48,7 +48,8 @@ def test_both_sensors_identify_the_same_beam(comparison):
 
 def test_json_keys(comparison):
     result = comparison.as_dict()
-    for key in ('time_offset_s', 'time_offset_s_std', 'rms_difference_m', 'max_difference_m'):
+    keys = ('time_offset_s', 'time_offset_s_std', 'time_offset_s_std_white')
+    for key in (*keys, 'time_offset_consistency', 'rms_difference_m', 'max_difference_m'):
         assert math.isfinite(result[key])
     assert result['time_offset_s'] == pytest.approx(7.3e-3, abs=0.2e-3)
     assert set(result['per_sensor']) == {'camera', 'tracker'}
