@@ -10,4 +10,33 @@ Modules, in the order they run: :mod:`~.streams` (cleaning, gap-aware interpolat
 :mod:`~.offset` (cross-correlation), :mod:`~.rigid` (Kabsch fit, observability),
 :mod:`~.refine` (joint least squares), :mod:`~.align` (the three together),
 :mod:`~.comparison` (differences and identification), :mod:`~.bag` (reading a bag).
+
+Use::
+
+    streams = read_comparison_input('bags/validation')
+    result = compare_sensors(streams.camera, streams.reference, beam, streams.loads)
+    result.as_dict()['time_offset_s']
 """
+
+from lumpbeam_ros.compare.align import AlignedStreams, AlignOptions, align_streams
+from lumpbeam_ros.compare.bag import ComparisonInput, read_comparison_input
+from lumpbeam_ros.compare.comparison import Comparison, compare_sensors
+from lumpbeam_ros.compare.refine import Alignment
+from lumpbeam_ros.compare.rigid import RigidTransform, fit_rigid
+from lumpbeam_ros.compare.streams import GapInterpolator, Track, clean_track
+
+__all__ = [
+    'AlignOptions',
+    'AlignedStreams',
+    'Alignment',
+    'Comparison',
+    'ComparisonInput',
+    'GapInterpolator',
+    'RigidTransform',
+    'Track',
+    'align_streams',
+    'clean_track',
+    'compare_sensors',
+    'fit_rigid',
+    'read_comparison_input',
+]
