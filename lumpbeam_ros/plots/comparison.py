@@ -53,7 +53,9 @@ def plot_comparison(comparison: Comparison, folder: str | Path) -> Path:
             f'camera vs reference: tracker clock = camera clock + {offset * 1e3:.4f} ms, '
             f'RMS difference {comparison.rms_difference_m * 1e6:.1f} um'
         )
-        top.legend(loc='upper left')
+        low, high = top.get_ylim()
+        top.set_ylim(low, high + 0.25 * (high - low))  # room for the legend above the traces
+        top.legend(loc='upper center', ncol=2)
         bottom.plot(comparison.t, comparison.difference[:, 2] * 1e6, color='tab:red', lw=0.6)
         bottom.axhline(0.0, color='k', lw=0.5)
         bottom.set_ylabel('camera - tracker z [um]')
