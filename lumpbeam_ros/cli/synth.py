@@ -7,6 +7,7 @@ import argparse
 from lumpbeam_ros.cli.output import non_negative_float, positive_float
 from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, parse_effect, write_drop_test_bag
+from lumpbeam_ros.synthetic.tracker import TrackerOptions
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -27,7 +28,62 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar='NAME=VALUE',
         help='hide a physical effect of SPEC section 6 in the data (repeatable)',
     )
+    tracker = parser.add_argument_group('reference sensor (/tracker/point)')
+    tracker.add_argument(
+        '--tracker', action='store_true', help='add a simulated laser tracker at the tip'
+    )
+    defaults = TrackerOptions()
+    tracker.add_argument(
+        '--tracker-rate', type=positive_float, default=defaults.rate_hz, help='Hz (1000)'
+    )
+    tracker.add_argument(
+        '--tracker-noise',
+        type=non_negative_float,
+        default=defaults.noise_m,
+        help='noise sigma per axis, m (15e-6)',
+    )
+    tracker.add_argument(
+        '--tracker-offset',
+        type=float,
+        default=defaults.clock_offset_s,
+        help='tracker clock minus true time, s (7.3e-3)',
+    )
+    tracker.add_argument(
+        '--tracker-pose',
+        type=_tracker_pose,
+        default=(*defaults.position_m, *defaults.rotation_deg),
+        metavar='X,Y,Z,ROLL,PITCH,YAW',
+        help='tracker frame in beam_base: m and extrinsic xyz degrees (1.2,-3,0.35,4,-8,100)',
+    )
+    tracker.add_argument(
+        '--tracker-lever', type=float, default=0.0, help='reflector beyond the tip, m (0)'
+    )
     parser.set_defaults(handler=run)
+
+
+def _tracker_pose(text: str) -> tuple[float, ...]:
+    try:
+        values = tuple(float(v) for v in text.split(','))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'expected 6 numbers, got {text!r}') from None
+    if len(values) != 6:
+        raise argparse.ArgumentTypeError(f'expected 6 comma-separated numbers, got {text!r}')
+    return values
+
+
+def _tracker_options(args: argparse.Namespace) -> TrackerOptions | None:
+    if not args.tracker:
+        return None
+    pose = args.tracker_pose
+    return TrackerOptions(
+        rate_hz=args.tracker_rate,
+        noise_m=args.tracker_noise,
+        clock_offset_s=args.tracker_offset,
+        position_m=pose[:3],
+        rotation_deg=pose[3:],
+        lever_m=args.tracker_lever,
+        seed=args.seed + 1,
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -41,11 +97,17 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
         effects=effects,
     )
-    measured, _ = write_drop_test_bag(args.out, beam, drop, options)
+    tracker = _tracker_options(args)
+    measured, _ = write_drop_test_bag(args.out, beam, drop, options, tracker)
     hidden = ', '.join(f'{k}={v:g}' for k, v in effects.items()) or 'none'
     print(
         f'wrote {args.out}: {len(measured)} poses at {args.rate:g} Hz over {args.duration:g} s, '
         f'{drop.load_kg:g} kg released at {drop.release_time_s:g} s, '
         f'noise {args.noise * 1e6:g} um, hidden effects: {hidden}'
     )
+    if tracker is not None:
+        print(
+            f'  with /tracker/point at {tracker.rate_hz:g} Hz in frame {tracker.frame_id!r}, '
+            f'noise {tracker.noise_m * 1e6:g} um, clock offset {tracker.clock_offset_s:g} s'
+        )
     return 0

@@ -19,6 +19,7 @@ from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters, DropTestConfig
 from lumpbeam_ros.model.simulate import drop_test_events, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
+from lumpbeam_ros.synthetic.tracker import TrackerOptions, simulate_tracker, write_tracker_points
 
 #: Pitch noise per metre of position noise: the camera sees the board about 1 m away.
 PITCH_NOISE_PER_M = 1.0
@@ -121,7 +122,11 @@ def load_messages(drop: DropTestConfig, duration_s: float) -> list[tuple[float, 
 
 
 def write_drop_test_bag(
-    out: str | Path, beam: BeamParameters, drop: DropTestConfig, options: SynthOptions
+    out: str | Path,
+    beam: BeamParameters,
+    drop: DropTestConfig,
+    options: SynthOptions,
+    tracker: TrackerOptions | None = None,
 ) -> tuple[TipTrajectory, TipTrajectory]:
     """Simulates the drop test and writes it as a bag.
 
@@ -130,6 +135,8 @@ def write_drop_test_bag(
         beam: The nominal beam.
         drop: The load and its release time.
         options: What to vary.
+        tracker: Also write ``/tracker/point`` from a simulated laser tracker
+            (:mod:`~lumpbeam_ros.synthetic.tracker`).
 
     Returns:
         ``(measured, truth)`` as :func:`simulate_experiment` returns them.
@@ -145,6 +152,11 @@ def write_drop_test_bag(
     rng = np.random.default_rng(options.seed)
     noise = options.noise_m * rng.standard_normal((3, len(measured)))
     noise[2] *= PITCH_NOISE_PER_M
+    points = None
+    if tracker is not None:
+        hidden = with_effects(beam, options.effects)
+        points = simulate_tracker(hidden, drop, options.duration_s, tracker)
+    written = 0
     with BagWriter(out) as bag:
         loads = iter(load_messages(drop, options.duration_s))
         pending = next(loads, None)
@@ -152,6 +164,8 @@ def write_drop_test_bag(
             while pending is not None and pending[0] <= stamp:
                 bag.write_float('/tip_load', pending[0], pending[1])
                 pending = next(loads, None)
+            if points is not None:
+                written = write_tracker_points(bag, points, written, stamp)
             bag.write_pose(
                 '/tip_pose',
                 stamp,
@@ -160,4 +174,6 @@ def write_drop_test_bag(
                 measured.pitch[i] + noise[2, i],
             )
             bag.write_pose('/tip_pose_truth', stamp, truth.x[i], truth.z[i], truth.pitch[i])
+        if points is not None:
+            write_tracker_points(bag, points, written, math.inf)
     return measured, truth
