@@ -4,13 +4,14 @@ import cv2
 import numpy as np
 import pytest
 
-from lumpbeam_ros.vision.accuracy import render_frames, stand_in_drop_trajectory
+from lumpbeam_ros.vision.accuracy import render_frames
 from lumpbeam_ros.vision.tracker import TipTracker, TrackStatus
 
 
 @pytest.fixture(scope='module')
-def frames(config):
-    return render_frames(config, stand_in_drop_trajectory(duration_s=0.2), 30)
+def frames(config, drop_test):
+    # Across the release, where the tip starts moving fastest.
+    return render_frames(config, drop_test.slice_time(1.95, 2.3), 30)
 
 
 @pytest.fixture
