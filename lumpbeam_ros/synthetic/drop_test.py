@@ -19,6 +19,7 @@ from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters, DropTestConfig
 from lumpbeam_ros.model.simulate import drop_test_events, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
+from lumpbeam_ros.synthetic.images import ImageOptions, ImageStream
 
 #: Pitch noise per metre of position noise: the camera sees the board about 1 m away.
 PITCH_NOISE_PER_M = 1.0
@@ -121,7 +122,11 @@ def load_messages(drop: DropTestConfig, duration_s: float) -> list[tuple[float, 
 
 
 def write_drop_test_bag(
-    out: str | Path, beam: BeamParameters, drop: DropTestConfig, options: SynthOptions
+    out: str | Path,
+    beam: BeamParameters,
+    drop: DropTestConfig,
+    options: SynthOptions,
+    images: ImageOptions | None = None,
 ) -> tuple[TipTrajectory, TipTrajectory]:
     """Simulates the drop test and writes it as a bag.
 
@@ -130,6 +135,9 @@ def write_drop_test_bag(
         beam: The nominal beam.
         drop: The load and its release time.
         options: What to vary.
+        images: When given, also ``/camera/image_raw`` and ``/camera/camera_info``: the
+            camera films the measured motion (hidden effects included, no pose noise), one
+            frame per pose stamp (see :mod:`lumpbeam_ros.synthetic.images`).
 
     Returns:
         ``(measured, truth)`` as :func:`simulate_experiment` returns them.
@@ -145,6 +153,7 @@ def write_drop_test_bag(
     rng = np.random.default_rng(options.seed)
     noise = options.noise_m * rng.standard_normal((3, len(measured)))
     noise[2] *= PITCH_NOISE_PER_M
+    camera = None if images is None else ImageStream(measured, images)
     with BagWriter(out) as bag:
         loads = iter(load_messages(drop, options.duration_s))
         pending = next(loads, None)
@@ -160,4 +169,6 @@ def write_drop_test_bag(
                 measured.pitch[i] + noise[2, i],
             )
             bag.write_pose('/tip_pose_truth', stamp, truth.x[i], truth.z[i], truth.pitch[i])
+            if camera is not None:
+                camera.write_next(bag)
     return measured, truth

@@ -52,6 +52,7 @@ class TrackStatus(str, Enum):
     BOARD_NOT_FOUND = 'board_not_found'
     CORNERS_REJECTED = 'corners_rejected'
     POSE_REJECTED = 'pose_rejected'
+    NO_CAMERA_INFO = 'no_camera_info'
 
 
 @dataclass(frozen=True)
