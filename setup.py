@@ -26,6 +26,7 @@ setup(
     entry_points={
         'console_scripts': [
             'lumpbeam = lumpbeam_ros.cli.main:main',
+            'camera_node = lumpbeam_ros.nodes.camera_node:main',
         ],
     },
 )

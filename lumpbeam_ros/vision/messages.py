@@ -9,14 +9,37 @@ line each, for the caller to turn into a warning.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
-from lumpbeam_ros.bagio import CameraInfoData, ImageFrame, convert
+from lumpbeam_ros.bagio import CameraInfoData, convert
 from lumpbeam_ros.bagio.typestore import deserialize
 from lumpbeam_ros.vision.camera_model import CameraInfo
 
 IMAGE_TYPE = 'sensor_msgs/msg/Image'
 CAMERA_INFO_TYPE = 'sensor_msgs/msg/CameraInfo'
+
+
+class CameraFrame(NamedTuple):
+    """One decoded image.
+
+    Attributes:
+        stamp_ns: Header stamp, ns (exact: a pose carries it unchanged).
+        pixels: ``(h, w)`` for mono8, ``(h, w, 3)`` for bgr8/rgb8, uint8.
+        encoding: ``'mono8'``, ``'bgr8'`` or ``'rgb8'``.
+        frame_id: The camera's optical frame.
+    """
+
+    stamp_ns: int
+    pixels: np.ndarray
+    encoding: str
+    frame_id: str
+
+    @property
+    def stamp(self) -> float:
+        """The stamp in seconds (what the tracker works with)."""
+        return convert.ns_to_seconds(self.stamp_ns)
 
 
 def camera_info_from_data(data: CameraInfoData) -> CameraInfo:
@@ -61,14 +84,14 @@ def camera_info_to_data(info: CameraInfo, frame_id: str = 'camera') -> CameraInf
     )
 
 
-def decode_image(data: bytes | memoryview) -> ImageFrame:
-    """Decodes a serialized ``sensor_msgs/msg/Image``; the pixels are a view of ``data``.
+def decode_image(data: bytes | memoryview) -> CameraFrame:
+    """Decodes a serialized ``sensor_msgs/msg/Image``.
 
     Args:
         data: CDR bytes (a raw subscription's message, or a bag record).
 
     Returns:
-        The frame: stamp (s), pixels ``(h, w)`` or ``(h, w, 3)``, encoding, frame id.
+        The frame.
 
     Raises:
         BagError: Corrupt bytes, an unsupported encoding, or a data size that does not
@@ -76,8 +99,9 @@ def decode_image(data: bytes | memoryview) -> ImageFrame:
     """
     msg = deserialize(data, IMAGE_TYPE)
     pixels = convert.image_array(msg)
-    stamp = convert.ns_to_seconds(convert.time_ns(msg.header.stamp))
-    return ImageFrame(stamp, pixels, msg.encoding, msg.header.frame_id)
+    return CameraFrame(
+        convert.time_ns(msg.header.stamp), pixels, msg.encoding, msg.header.frame_id
+    )
 
 
 def decode_camera_info(data: bytes | memoryview) -> CameraInfo:

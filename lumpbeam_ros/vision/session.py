@@ -17,7 +17,7 @@ import numpy as np
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import CameraConfig
-from lumpbeam_ros.vision.messages import decode_image
+from lumpbeam_ros.vision.messages import CameraFrame, decode_image
 from lumpbeam_ros.vision.tracker import TipTracker, TrackResult, TrackStatus
 
 
@@ -124,20 +124,22 @@ class TrackingSession:
             result = self._tracker.process(pixels, stamp, encoding)
         return self._count(result)
 
-    def process_message(self, data: bytes | memoryview) -> TrackResult:
+    def process_message(self, data: bytes | memoryview) -> tuple[CameraFrame | None, TrackResult]:
         """Decodes a serialized ``sensor_msgs/msg/Image`` and tracks it.
 
         Args:
             data: CDR bytes.
 
         Returns:
-            The result; a corrupt or unsupported message is a ``BAD_IMAGE`` result.
+            The decoded frame (``None`` when undecodable; its ``stamp_ns`` is what a pose
+            message carries) and the result; a corrupt or unsupported message is a
+            ``BAD_IMAGE`` result.
         """
         try:
             frame = decode_image(data)
         except LumpbeamError as exc:
-            return self._count(TrackResult(math.nan, TrackStatus.BAD_IMAGE, str(exc)))
-        return self.process(frame.pixels, frame.t, frame.encoding)
+            return None, self._count(TrackResult(math.nan, TrackStatus.BAD_IMAGE, str(exc)))
+        return frame, self.process(frame.pixels, frame.stamp, frame.encoding)
 
     def _count(self, result: TrackResult) -> TrackResult:
         stats = self.stats
