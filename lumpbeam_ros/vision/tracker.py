@@ -329,7 +329,7 @@ class TipTracker:
     ) -> TrackResult:
         calibrated = self._is_calibrated()
         self._history = [*self._history[-1:], (stamp, corners, fit.pose)]
-        if not calibrated:
+        if not calibrated and self._moved_since_last_pending(fit.pose):
             self._pending.append((ideal, fit.pose))
             if len(self._pending) >= self.settings.calibration_frames:
                 self._calibrate()
@@ -343,6 +343,12 @@ class TipTracker:
             detected=detected,
             calibrated=calibrated,
         )
+
+    def _moved_since_last_pending(self, pose: np.ndarray) -> bool:
+        if not self._pending:
+            return True
+        step = np.max(np.abs(pose[:2] - self._pending[-1][1][:2]))
+        return bool(step >= self.settings.calibration_min_step_m)
 
     def _is_calibrated(self) -> bool:
         return self._calibration is not None or self.settings.calibration_frames == 0
