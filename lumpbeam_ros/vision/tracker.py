@@ -128,9 +128,10 @@ class TipTracker:
         self._expected_axes = camera_board.rotation[:2, :2].T.copy()
         corners = self._model.project(reference)
         spacing = np.median(np.linalg.norm(np.diff(corners, axis=0), axis=1))
-        # Beyond 8 px the window costs time without measurable gain (the corner error is then
+        # Beyond 5 px the window costs time without a gain worth it: 8 px gave 0.86 um z RMS
+        # at 2048 x 2048, 5 px 1.06 um, at 60 % of the refinement time (the corner error is
         # dominated by the image, not the window).
-        self._half_window = int(np.clip(round(self.settings.window_fraction * spacing), 3, 8))
+        self._half_window = int(np.clip(round(self.settings.window_fraction * spacing), 3, 5))
 
     @property
     def calibration(self) -> RigCalibration | None:
