@@ -15,7 +15,7 @@ setup(
         (f'share/{PACKAGE}', ['package.xml']),
         (f'share/{PACKAGE}/config', glob('config/*.yaml')),
     ],
-    package_data={PACKAGE: ['data/*.csv']},
+    package_data={PACKAGE: ['data/*.csv', 'bench/*.xml']},
     install_requires=['setuptools', 'numpy', 'scipy', 'pyyaml', 'threadpoolctl'],
     zip_safe=True,
     maintainer='lumpbeam_ros maintainers',
@@ -28,6 +28,7 @@ setup(
             'lumpbeam = lumpbeam_ros.cli.main:main',
             'identifier_node = lumpbeam_ros.nodes.identifier_node:main',
             'simulator_node = lumpbeam_ros.nodes.simulator_node:main',
+            'camera_node = lumpbeam_ros.nodes.camera_node:main',
         ],
     },
 )

@@ -20,6 +20,7 @@ from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters, Dro
 from lumpbeam_ros.model.simulate import drop_test_events, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.synthetic.tracker import TrackerOptions, simulate_tracker, write_tracker_points
+from lumpbeam_ros.synthetic.images import ImageOptions, ImageStream
 
 #: Pitch noise per metre of position noise: the camera sees the board about 1 m away.
 PITCH_NOISE_PER_M = 1.0
@@ -127,6 +128,7 @@ def write_drop_test_bag(
     drop: DropTestConfig,
     options: SynthOptions,
     tracker: TrackerOptions | None = None,
+    images: ImageOptions | None = None,
 ) -> tuple[TipTrajectory, TipTrajectory]:
     """Simulates the drop test and writes it as a bag.
 
@@ -137,6 +139,9 @@ def write_drop_test_bag(
         options: What to vary.
         tracker: Also write ``/tracker/point`` from a simulated laser tracker
             (:mod:`~lumpbeam_ros.synthetic.tracker`).
+        images: When given, also ``/camera/image_raw`` and ``/camera/camera_info``: the
+            camera films the measured motion (hidden effects included, no pose noise), one
+            frame per pose stamp (see :mod:`lumpbeam_ros.synthetic.images`).
 
     Returns:
         ``(measured, truth)`` as :func:`simulate_experiment` returns them.
@@ -157,6 +162,7 @@ def write_drop_test_bag(
         hidden = with_effects(beam, options.effects)
         points = simulate_tracker(hidden, drop, options.duration_s, tracker)
     written = 0
+    camera = None if images is None else ImageStream(measured, images)
     with BagWriter(out) as bag:
         loads = iter(load_messages(drop, options.duration_s))
         pending = next(loads, None)
@@ -174,6 +180,8 @@ def write_drop_test_bag(
                 measured.pitch[i] + noise[2, i],
             )
             bag.write_pose('/tip_pose_truth', stamp, truth.x[i], truth.z[i], truth.pitch[i])
+            if camera is not None:
+                camera.write_next(bag)
         if points is not None:
             write_tracker_points(bag, points, written, math.inf)
     return measured, truth

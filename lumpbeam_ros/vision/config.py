@@ -59,6 +59,7 @@ class TrackerSettings:
     min_contrast_dn: float = 20.0
     max_saturated_fraction: float = 0.2
     calibration_frames: int = 30
+    calibration_min_step_m: float = 0.001
 
 
 @dataclass(frozen=True)
@@ -217,6 +218,13 @@ def camera_config_from_parameters(params: Mapping[str, Any], source: str | Path)
         ),
         calibration_frames=get_int(
             params, 'tracker.calibration_frames', source, t.calibration_frames, minimum=0
+        ),
+        calibration_min_step_m=get_float(
+            params,
+            'tracker.calibration_min_step_m',
+            source,
+            t.calibration_min_step_m,
+            non_negative=True,
         ),
     )
     if tracker.window_fraction >= 0.5:

@@ -115,9 +115,11 @@ class PlaneModel:
             jtj = j.T @ j
             step = np.linalg.solve(jtj, -(j.T @ r))
             pose += step
-            # After a step below 0.1 um (or urad) the next would be below 1e-13: the model
-            # is that close to linear, so the last Jacobian serves for the covariance.
-            if np.max(np.abs(step)) < 1e-7:
+            # The tip moves parallel to the image plane (constant depth) and the pitch turns
+            # the image about the optical axis, so the model's curvature is about 1 per m or
+            # rad: after a step below 10 um (or urad) the next would be below 1e-10, far
+            # under the 1 um noise, and the last Jacobian serves for the covariance.
+            if np.max(np.abs(step)) < 1e-5:
                 converged = True
                 break
         residual = (r + j @ step).reshape(-1, 2)

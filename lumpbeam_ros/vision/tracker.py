@@ -52,6 +52,7 @@ class TrackStatus(str, Enum):
     BOARD_NOT_FOUND = 'board_not_found'
     CORNERS_REJECTED = 'corners_rejected'
     POSE_REJECTED = 'pose_rejected'
+    NO_CAMERA_INFO = 'no_camera_info'
 
 
 @dataclass(frozen=True)
@@ -127,9 +128,10 @@ class TipTracker:
         self._expected_axes = camera_board.rotation[:2, :2].T.copy()
         corners = self._model.project(reference)
         spacing = np.median(np.linalg.norm(np.diff(corners, axis=0), axis=1))
-        # Beyond 8 px the window costs time without measurable gain (the corner error is then
+        # Beyond 5 px the window costs time without a gain worth it: 8 px gave 0.86 um z RMS
+        # at 2048 x 2048, 5 px 1.06 um, at 60 % of the refinement time (the corner error is
         # dominated by the image, not the window).
-        self._half_window = int(np.clip(round(self.settings.window_fraction * spacing), 3, 8))
+        self._half_window = int(np.clip(round(self.settings.window_fraction * spacing), 3, 5))
 
     @property
     def calibration(self) -> RigCalibration | None:
@@ -328,7 +330,7 @@ class TipTracker:
     ) -> TrackResult:
         calibrated = self._is_calibrated()
         self._history = [*self._history[-1:], (stamp, corners, fit.pose)]
-        if not calibrated:
+        if not calibrated and self._moved_since_last_pending(fit.pose):
             self._pending.append((ideal, fit.pose))
             if len(self._pending) >= self.settings.calibration_frames:
                 self._calibrate()
@@ -342,6 +344,12 @@ class TipTracker:
             detected=detected,
             calibrated=calibrated,
         )
+
+    def _moved_since_last_pending(self, pose: np.ndarray) -> bool:
+        if not self._pending:
+            return True
+        step = np.max(np.abs(pose[:2] - self._pending[-1][1][:2]))
+        return bool(step >= self.settings.calibration_min_step_m)
 
     def _is_calibrated(self) -> bool:
         return self._calibration is not None or self.settings.calibration_frames == 0

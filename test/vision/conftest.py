@@ -7,6 +7,8 @@ import dataclasses
 import numpy as np
 import pytest
 
+from lumpbeam_ros.model.trajectory import TipTrajectory
+from lumpbeam_ros.vision.accuracy import drop_test_trajectory
 from lumpbeam_ros.vision.config import CameraConfig, load_camera_config
 
 
@@ -28,3 +30,9 @@ def no_calibration(config: CameraConfig) -> CameraConfig:
     return dataclasses.replace(
         config, tracker=dataclasses.replace(config.tracker, calibration_frames=0)
     )
+
+
+@pytest.fixture(scope='session')
+def drop_test() -> TipTrajectory:
+    """The model's 12 s drop test (the identified beam, 4.5 kg released at 2 s)."""
+    return drop_test_trajectory()

@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.vision.accuracy import stand_in_drop_trajectory
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.detect import detect_board
 from lumpbeam_ros.vision.pose import PlaneModel, camera_board_transform
@@ -63,8 +62,8 @@ def test_motion_blur_samples_follow_the_image_motion(config):
     assert camera.motion_samples(start, start + [0.0, 1.0, 0.0]) == 16
 
 
-def test_trajectory_frames_carry_truth_at_mid_exposure(config):
-    trajectory = stand_in_drop_trajectory(duration_s=0.1)
+def test_trajectory_frames_carry_truth_at_mid_exposure(config, drop_test):
+    trajectory = drop_test.slice_time(2.0, 2.1)
     frames = list(
         SyntheticCamera(config).render_trajectory(
             trajectory.t, trajectory.x, trajectory.z, trajectory.pitch, trajectory.t[[0, 14]]

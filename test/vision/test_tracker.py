@@ -4,13 +4,14 @@ import cv2
 import numpy as np
 import pytest
 
-from lumpbeam_ros.vision.accuracy import render_frames, stand_in_drop_trajectory
+from lumpbeam_ros.vision.accuracy import render_frames
 from lumpbeam_ros.vision.tracker import TipTracker, TrackStatus
 
 
 @pytest.fixture(scope='module')
-def frames(config):
-    return render_frames(config, stand_in_drop_trajectory(duration_s=0.2), 30)
+def frames(config, drop_test):
+    # Across the release, where the tip starts moving fastest.
+    return render_frames(config, drop_test.slice_time(1.95, 2.3), 30)
 
 
 @pytest.fixture
@@ -93,10 +94,28 @@ def test_stamp_going_backwards_redetects(tracker, frames):
 
 
 def test_calibration_phase_then_calibrated(config, frames):
+    """Only frames that moved 1 mm since the last one joined calibrate (not the beam at rest)."""
     believed = dataclasses.replace(
         config, tracker=dataclasses.replace(config.tracker, calibration_frames=10)
     )
     tracker = TipTracker(config.camera_info, believed)
-    results = [tracker.process(f.image, f.stamp) for f in frames[:14]]
-    assert [r.calibrated for r in results] == [False] * 10 + [True] * 4
+    results = [tracker.process(f.image, f.stamp) for f in frames]
+    joined, last = [], None
+    for i, f in enumerate(frames):
+        if last is None or np.max(np.abs(f.truth[:2] - last)) >= 0.001:
+            joined.append(i)
+            last = f.truth[:2]
+    done = joined[9]  # the 10th joining frame completes the calibration
+    assert done > 15  # the 9 frames at rest before the release count once
+    assert [r.calibrated for r in results] == [i > done for i in range(len(frames))]
     assert tracker.calibration is not None and tracker.calibration.frames == 10
+
+
+def test_a_beam_at_rest_never_calibrates(config, frames):
+    believed = dataclasses.replace(
+        config, tracker=dataclasses.replace(config.tracker, calibration_frames=3)
+    )
+    tracker = TipTracker(config.camera_info, believed)
+    for i in range(8):
+        assert tracker.process(frames[0].image, frames[0].stamp + i).ok
+    assert tracker.calibration is None

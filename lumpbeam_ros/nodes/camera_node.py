@@ -1,0 +1,319 @@
+"""The camera node: camera frames in, the tip pose out (SPEC section 3).
+
+Subscribes to ``/camera/image_raw`` and ``/camera/camera_info`` (sensor-data QoS: best
+effort, a late frame is worth less than the next) and publishes, stamped with each image's
+own stamp:
+
+- ``/tip_pose`` (``geometry_msgs/PoseStamped`` in ``beam_base``),
+- ``/tip_pose_covariance`` (``geometry_msgs/PoseWithCovarianceStamped``, the same pose with
+  the fit's covariance),
+- ``/diagnostics`` at 1 Hz: status ``lumpbeam/camera`` with frames in and out, frames lost
+  by reason and the last reason.
+
+Images are taken as serialized bytes and decoded with the bag code
+(:mod:`lumpbeam_ros.vision.messages`), so a live frame and a recorded one go through the
+same lines. A frame that gives no pose (board lost, bad encoding, wrong size, black,
+saturated, corrupt, no camera info yet) gives no message, a throttled warning and a count
+in the diagnostics; never a stale pose, never an exception out of a callback.
+
+With parameter ``bag_path`` the node reads the frames of a bag in-process instead
+(:meth:`CameraNode.run_bag`): as fast as it tracks, for rates a topic cannot carry.
+
+Parameters: the keys of ``config/camera.yaml`` (read-only), plus the node's own (see
+:data:`NODE_PARAMETERS`). Run it with ``camera_node --ros-args --params-file camera.yaml``.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+import rclpy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.context import Context
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile, qos_profile_sensor_data
+from sensor_msgs.msg import CameraInfo as CameraInfoMsg
+from sensor_msgs.msg import Image
+
+from lumpbeam_ros.bagio import BagReader
+from lumpbeam_ros.bagio.convert import NS_PER_S, pitch_to_quaternion
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.paramfile import read_parameter_file
+from lumpbeam_ros.resources import config_path
+from lumpbeam_ros.vision.config import camera_config_from_parameters
+from lumpbeam_ros.vision.messages import decode_camera_info
+from lumpbeam_ros.vision.session import TrackingSession
+from lumpbeam_ros.vision.tracker import TrackResult
+
+#: The node's own parameters: name -> (default, description).
+NODE_PARAMETERS: dict[str, tuple[Any, str]] = {
+    'frame_id': ('beam_base', 'header.frame_id of the published poses'),
+    'bag_path': ('', 'read frames from this bag in-process instead of subscribing (empty: off)'),
+    'bag_image_topic': ('/camera/image_raw', 'image topic read from bag_path'),
+    'bag_camera_info_topic': ('/camera/camera_info', 'camera info topic read from bag_path'),
+    'use_config_camera_info': (
+        False,
+        'track with the intrinsics of the camera.* parameters, without waiting for camera_info',
+    ),
+    'diagnostics_period_s': (1.0, 'period of /diagnostics, s'),
+    'warning_period_s': (2.0, 'at most one warning per kind of problem in this period, s'),
+}
+
+_GROUPS = {
+    'camera': 'camera intrinsics and mount',
+    'board': 'the checkerboard and its pose in beam_base',
+    'synthetic': 'synthetic camera rendering (not used by the node)',
+    'tracker': 'tracker settings',
+}
+
+#: ``/tip_pose`` keeps a few poses for a slow reliable subscriber; a pose is small.
+POSE_QOS = QoSProfile(depth=100)
+
+# PoseWithCovariance is row-major 6 x 6 over (x, y, z, rot x, rot y, rot z); the tracker
+# measures x, z and the rotation about y (the pitch).
+_COVARIANCE_INDEX = np.array([0, 2, 4])
+
+
+def _stamp(msg: Any, stamp_ns: int) -> None:
+    msg.sec, msg.nanosec = divmod(int(stamp_ns), NS_PER_S)
+
+
+class CameraNode(Node):
+    """Tracks the tip in camera frames and publishes its pose.
+
+    Args:
+        context: The rclpy context (``None``: the default one).
+        parameter_overrides: Parameters instead of a params file (tests).
+
+    Raises:
+        ConfigError: A camera parameter is invalid.
+        LumpbeamError: The configured board is not in view of the configured camera.
+    """
+
+    def __init__(
+        self,
+        context: Context | None = None,
+        parameter_overrides: Sequence[Parameter] | None = None,
+    ):
+        super().__init__(
+            'camera_node', context=context, parameter_overrides=list(parameter_overrides or [])
+        )
+        config_keys = self._declare_parameters()
+        values = {key: self.get_parameter(key).value for key in config_keys}
+        self.config = camera_config_from_parameters(values, 'camera_node parameters')
+        self.frame_id = str(self._param('frame_id'))
+        known = self.config.camera_info if self._param('use_config_camera_info') else None
+        self.session = TrackingSession(self.config, known)
+        self._warning_period = float(self._param('warning_period_s'))
+        self._last_warning: dict[str, float] = {}
+        self._period_counts = (0, 0)
+        self._period_start = time.monotonic()
+
+        self.pose_publisher = self.create_publisher(PoseStamped, '/tip_pose', POSE_QOS)
+        self.covariance_publisher = self.create_publisher(
+            PoseWithCovarianceStamped, '/tip_pose_covariance', POSE_QOS
+        )
+        self.diagnostics_publisher = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self.bag_path = str(self._param('bag_path'))
+        if not self.bag_path:
+            # Raw: the bytes go to the same decoder as a bag's, without rclpy's copy.
+            self.create_subscription(
+                Image, '/camera/image_raw', self.on_image, qos_profile_sensor_data, raw=True
+            )
+            self.create_subscription(
+                CameraInfoMsg,
+                '/camera/camera_info',
+                self.on_camera_info,
+                qos_profile_sensor_data,
+                raw=True,
+            )
+        period = float(self._param('diagnostics_period_s'))
+        self.create_timer(period if period > 0 else 1.0, self.publish_diagnostics)
+
+    # -- parameters -------------------------------------------------------------------------
+
+    def _declare_parameters(self) -> list[str]:
+        """Declares the camera file's keys (defaults from the package's file) and the node's.
+
+        Returns:
+            The camera configuration keys.
+        """
+        defaults = read_parameter_file(config_path('camera.yaml'))
+        for key, value in sorted(defaults.items()):
+            group = _GROUPS.get(key.split('.')[0], 'camera configuration')
+            # Typed loosely: the configuration's own checks give the clearer error.
+            descriptor = ParameterDescriptor(
+                description=f'{group} (documented in config/camera.yaml)',
+                read_only=True,
+                dynamic_typing=True,
+            )
+            self.declare_parameter(key, value, descriptor)
+        for key, (value, description) in NODE_PARAMETERS.items():
+            self.declare_parameter(
+                key, value, ParameterDescriptor(description=description, read_only=True)
+            )
+        return sorted(defaults)
+
+    def _param(self, name: str) -> Any:
+        return self.get_parameter(name).value
+
+    # -- input ------------------------------------------------------------------------------
+
+    def on_camera_info(self, data: bytes) -> None:
+        """Takes the camera's intrinsics (published beside every frame)."""
+        try:
+            if self.session.set_camera_info(decode_camera_info(data)):
+                info = self.session.camera_info
+                self.get_logger().info(f'camera info: {info.width} x {info.height} px')
+        except LumpbeamError as exc:
+            self.warn('camera_info', f'camera_info ignored: {exc}')
+
+    def on_image(self, data: bytes) -> None:
+        """Tracks one serialized image and publishes its pose."""
+        frame, result = self.session.process_message(data)
+        if frame is not None and result.ok:
+            self.publish_pose(frame.stamp_ns, result)
+        else:
+            self.warn(result.status.value, f'no pose: {result.reason}')
+
+    def run_bag(self, should_stop: Callable[[], bool] = lambda: False) -> None:
+        """Tracks every frame of ``bag_path`` in recording order, publishing the poses.
+
+        A corrupt message is a lost frame, not the end of the bag.
+
+        Args:
+            should_stop: Polled between frames; ``True`` ends early.
+
+        Raises:
+            BagError: Not a bag, or it lacks the image topic.
+        """
+        reader = BagReader(self.bag_path)
+        image_topic = str(self._param('bag_image_topic'))
+        info_topic = str(self._param('bag_camera_info_topic'))
+        reader.require(image_topic, 'sensor_msgs/msg/Image')
+        for raw in reader.iter_raw([image_topic, info_topic]):
+            if should_stop():
+                break
+            if raw.topic == info_topic:
+                self.on_camera_info(raw.data)
+            else:
+                self.on_image(raw.data)
+
+    # -- output -----------------------------------------------------------------------------
+
+    def publish_pose(self, stamp_ns: int, result: TrackResult) -> None:
+        """Publishes a tracked pose and its covariance with the image's stamp."""
+        x, z, pitch = (float(v) for v in result.pose)
+        msg = PoseStamped()
+        _stamp(msg.header.stamp, stamp_ns)
+        msg.header.frame_id = self.frame_id
+        msg.pose.position.x, msg.pose.position.z = x, z
+        q = msg.pose.orientation
+        q.x, q.y, q.z, q.w = pitch_to_quaternion(pitch)
+        self.pose_publisher.publish(msg)
+        with_covariance = PoseWithCovarianceStamped(header=msg.header)
+        with_covariance.pose.pose = msg.pose
+        # y, roll and yaw are fixed by the planar model (zero variance): not free guesses.
+        covariance = np.zeros((6, 6))
+        covariance[np.ix_(_COVARIANCE_INDEX, _COVARIANCE_INDEX)] = result.covariance
+        with_covariance.pose.covariance = covariance.ravel().tolist()
+        self.covariance_publisher.publish(with_covariance)
+
+    def warn(self, kind: str, text: str) -> None:
+        """Logs a warning at most once per ``warning_period_s`` for each kind of problem."""
+        now = time.monotonic()
+        if now - self._last_warning.get(kind, -math.inf) >= self._warning_period:
+            self._last_warning[kind] = now
+            self.get_logger().warning(text)
+
+    def diagnostic_status(self) -> DiagnosticStatus:
+        """Builds the ``lumpbeam/camera`` status: counts since start and over the last period.
+
+        Level: OK when every frame of the period gave a pose, WARN when some were lost or
+        none arrived, ERROR when frames arrived and none gave a pose.
+        """
+        stats = self.session.stats
+        now = time.monotonic()
+        elapsed = max(now - self._period_start, 1e-9)
+        frames = stats.frames_in - self._period_counts[0]
+        poses = stats.poses_out - self._period_counts[1]
+        self._period_counts = (stats.frames_in, stats.poses_out)
+        self._period_start = now
+        if frames == 0:
+            level, message = DiagnosticStatus.WARN, 'no images'
+            if self.session.camera_info is None:
+                message = 'no images, no camera_info'
+        elif poses == 0:
+            level, message = DiagnosticStatus.ERROR, f'no pose: {stats.last_reason}'
+        elif poses < frames:
+            level, message = DiagnosticStatus.WARN, f'{frames - poses} of {frames} frames lost'
+        else:
+            level, message = DiagnosticStatus.OK, 'tracking'
+        tracker = self.session.tracker
+        values = {
+            'frames_in': stats.frames_in,
+            'poses_out': stats.poses_out,
+            'frames_lost': stats.frames_lost,
+            'frames_per_s': frames / elapsed,
+            'poses_per_s': poses / elapsed,
+            'last_reason': stats.last_reason,
+            'camera_info': 'received' if self.session.camera_info is not None else 'waiting',
+            'calibrated': bool(tracker is not None and tracker.calibration is not None),
+        }
+        values.update({f'lost_{k}': v for k, v in sorted(stats.lost.items())})
+        return DiagnosticStatus(
+            level=level,
+            name='lumpbeam/camera',
+            message=message,
+            hardware_id='camera',
+            values=[KeyValue(key=k, value=repr(v) if isinstance(v, float) else str(v))
+                    for k, v in values.items()],
+        )  # fmt: skip
+
+    def publish_diagnostics(self) -> None:
+        """Publishes ``/diagnostics`` (the timer's callback)."""
+        array = DiagnosticArray(status=[self.diagnostic_status()])
+        array.header.stamp = self.get_clock().now().to_msg()
+        self.diagnostics_publisher.publish(array)
+
+
+def main(args: Sequence[str] | None = None) -> int:
+    """Runs the node (``camera_node [--ros-args ...]``).
+
+    Returns:
+        0, or 2 for a configuration or bag error (one line on stderr).
+    """
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = CameraNode()
+        if node.bag_path:
+            node.run_bag(lambda: not rclpy.ok())
+            s = node.session.stats
+            print(f'camera_node: {node.bag_path}: {s.frames_in} frames, {s.poses_out} poses')
+        else:
+            rclpy.spin(node)
+    except LumpbeamError as exc:
+        print(f'camera_node: error: {exc}', file=sys.stderr)
+        return 2
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        if rclpy.ok():
+            rclpy.shutdown()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

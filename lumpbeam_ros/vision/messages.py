@@ -1,0 +1,114 @@
+"""Camera messages to tracker inputs: the one place where bagio's types meet the vision core.
+
+Images and camera infos arrive as CDR bytes, from a live topic (a raw subscription) or from
+a bag; both are decoded here with bagio's typestore and converters, so the node, ``lumpbeam
+track`` and the synthetic bags agree on every field. Decoding failures are
+:class:`~lumpbeam_ros.errors.BagError` / :class:`~lumpbeam_ros.errors.LumpbeamError`, one
+line each, for the caller to turn into a warning.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from lumpbeam_ros.bagio import CameraInfoData, convert
+from lumpbeam_ros.bagio.typestore import deserialize
+from lumpbeam_ros.vision.camera_model import CameraInfo
+
+IMAGE_TYPE = 'sensor_msgs/msg/Image'
+CAMERA_INFO_TYPE = 'sensor_msgs/msg/CameraInfo'
+
+
+class CameraFrame(NamedTuple):
+    """One decoded image.
+
+    Attributes:
+        stamp_ns: Header stamp, ns (exact: a pose carries it unchanged).
+        pixels: ``(h, w)`` for mono8, ``(h, w, 3)`` for bgr8/rgb8, uint8.
+        encoding: ``'mono8'``, ``'bgr8'`` or ``'rgb8'``.
+        frame_id: The camera's optical frame.
+    """
+
+    stamp_ns: int
+    pixels: np.ndarray
+    encoding: str
+    frame_id: str
+
+    @property
+    def stamp(self) -> float:
+        """The stamp in seconds (what the tracker works with)."""
+        return convert.ns_to_seconds(self.stamp_ns)
+
+
+def camera_info_from_data(data: CameraInfoData) -> CameraInfo:
+    """Converts bagio's calibration record into the tracker's camera model.
+
+    Args:
+        data: From :func:`~lumpbeam_ros.bagio.read_camera_info` or :func:`decode_camera_info`.
+
+    Returns:
+        The camera model.
+
+    Raises:
+        LumpbeamError: An unusable calibration: zero focal length (an uncalibrated camera
+            publishes K = 0), a distortion model other than plumb_bob, a bad size.
+    """
+    return CameraInfo(
+        int(data.width),
+        int(data.height),
+        np.asarray(data.k, dtype=float),
+        np.asarray(data.d, dtype=float),
+        data.distortion_model,
+    )
+
+
+def camera_info_to_data(info: CameraInfo, frame_id: str = 'camera') -> CameraInfoData:
+    """Converts the camera model into bagio's record (for writing ``/camera/camera_info``).
+
+    Args:
+        info: The camera model.
+        frame_id: The camera's optical frame.
+
+    Returns:
+        The record (R identity, P = [K | 0]: a monocular camera).
+    """
+    return CameraInfoData(
+        width=info.width,
+        height=info.height,
+        k=info.k.copy(),
+        d=info.d.copy(),
+        distortion_model=info.distortion_model,
+        frame_id=frame_id,
+    )
+
+
+def decode_image(data: bytes | memoryview) -> CameraFrame:
+    """Decodes a serialized ``sensor_msgs/msg/Image``.
+
+    Args:
+        data: CDR bytes (a raw subscription's message, or a bag record).
+
+    Returns:
+        The frame.
+
+    Raises:
+        BagError: Corrupt bytes, an unsupported encoding, or a data size that does not
+            match ``step * height``.
+    """
+    msg = deserialize(data, IMAGE_TYPE)
+    pixels = convert.image_array(msg)
+    return CameraFrame(
+        convert.time_ns(msg.header.stamp), pixels, msg.encoding, msg.header.frame_id
+    )
+
+
+def decode_camera_info(data: bytes | memoryview) -> CameraInfo:
+    """Decodes a serialized ``sensor_msgs/msg/CameraInfo`` into the camera model.
+
+    Raises:
+        BagError: Corrupt bytes.
+        LumpbeamError: An unusable calibration (see :func:`camera_info_from_data`).
+    """
+    return camera_info_from_data(convert.camera_info_data(deserialize(data, CAMERA_INFO_TYPE)))

@@ -1,0 +1,153 @@
+"""A camera stream through the tracker: camera info, frames in, poses out, and the tally.
+
+The camera node and ``lumpbeam track`` both drive a :class:`TrackingSession`; it owns the
+tracker (rebuilt when the camera info changes), turns undecodable messages into a failed
+:class:`~lumpbeam_ros.vision.tracker.TrackResult` like any other bad frame, and counts what
+happened for the node's diagnostics and the command's summary.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.vision.camera_model import CameraInfo
+from lumpbeam_ros.vision.config import CameraConfig
+from lumpbeam_ros.vision.messages import CameraFrame, decode_image
+from lumpbeam_ros.vision.tracker import TipTracker, TrackResult, TrackStatus
+
+
+@dataclass
+class SessionStats:
+    """What a session has seen.
+
+    Attributes:
+        frames_in: Frames offered (decodable or not).
+        poses_out: Frames that gave a pose.
+        lost: Frames without a pose, by :class:`TrackStatus` value.
+        last_reason: Why the latest frame without a pose had none.
+        last_stamp: Stamp of the latest frame, s (NaN before the first).
+    """
+
+    frames_in: int = 0
+    poses_out: int = 0
+    lost: Counter[str] = field(default_factory=Counter)
+    last_reason: str = ''
+    last_stamp: float = math.nan
+
+    @property
+    def frames_lost(self) -> int:
+        """Frames without a pose."""
+        return self.frames_in - self.poses_out
+
+
+def _same_camera(a: CameraInfo, b: CameraInfo) -> bool:
+    return (
+        a.width == b.width
+        and a.height == b.height
+        and np.array_equal(a.k, b.k)
+        and np.array_equal(a.d, b.d)
+    )
+
+
+class TrackingSession:
+    """Tracks one camera's frames.
+
+    Args:
+        config: Rig geometry and tracker settings.
+        camera_info: The intrinsics if known now; otherwise frames are refused (status
+            ``NO_CAMERA_INFO``) until :meth:`set_camera_info` is called.
+
+    Raises:
+        LumpbeamError: ``camera_info`` and ``config`` cannot work together (see
+            :class:`~lumpbeam_ros.vision.tracker.TipTracker`).
+    """
+
+    def __init__(self, config: CameraConfig, camera_info: CameraInfo | None = None):
+        self.config = config
+        self.stats = SessionStats()
+        self._tracker: TipTracker | None = None
+        if camera_info is not None:
+            self.set_camera_info(camera_info)
+
+    @property
+    def camera_info(self) -> CameraInfo | None:
+        """The intrinsics in use, or ``None`` while waiting for them."""
+        return None if self._tracker is None else self._tracker.camera_info
+
+    @property
+    def tracker(self) -> TipTracker | None:
+        """The tracker, once the intrinsics are known."""
+        return self._tracker
+
+    def set_camera_info(self, info: CameraInfo) -> bool:
+        """Takes the camera's intrinsics; a change starts a fresh tracker.
+
+        A camera publishes its info with every frame, so an unchanged one is a no-op and the
+        tracking (and its rig calibration) carries on.
+
+        Args:
+            info: The intrinsics.
+
+        Returns:
+            Whether the tracker was (re)built.
+
+        Raises:
+            LumpbeamError: The board is not in view with these intrinsics; the previous
+                tracker, if any, is kept.
+        """
+        if self._tracker is not None and _same_camera(self._tracker.camera_info, info):
+            return False
+        self._tracker = TipTracker(info, self.config)
+        return True
+
+    def process(self, pixels: object, stamp: float, encoding: str = 'mono8') -> TrackResult:
+        """Tracks one frame and counts it.
+
+        Args:
+            pixels: H x W or H x W x 3 uint8 array.
+            stamp: Exposure time, s.
+            encoding: ``'mono8'``, ``'bgr8'`` or ``'rgb8'``.
+
+        Returns:
+            The result; never raises for bad pixels.
+        """
+        if self._tracker is None:
+            result = TrackResult(
+                float(stamp), TrackStatus.NO_CAMERA_INFO, 'no camera_info received yet'
+            )
+        else:
+            result = self._tracker.process(pixels, stamp, encoding)
+        return self._count(result)
+
+    def process_message(self, data: bytes | memoryview) -> tuple[CameraFrame | None, TrackResult]:
+        """Decodes a serialized ``sensor_msgs/msg/Image`` and tracks it.
+
+        Args:
+            data: CDR bytes.
+
+        Returns:
+            The decoded frame (``None`` when undecodable; its ``stamp_ns`` is what a pose
+            message carries) and the result; a corrupt or unsupported message is a
+            ``BAD_IMAGE`` result.
+        """
+        try:
+            frame = decode_image(data)
+        except LumpbeamError as exc:
+            return None, self._count(TrackResult(math.nan, TrackStatus.BAD_IMAGE, str(exc)))
+        return frame, self.process(frame.pixels, frame.stamp, frame.encoding)
+
+    def _count(self, result: TrackResult) -> TrackResult:
+        stats = self.stats
+        stats.frames_in += 1
+        stats.last_stamp = result.stamp
+        if result.ok:
+            stats.poses_out += 1
+        else:
+            stats.lost[result.status.value] += 1
+            stats.last_reason = result.reason or result.status.value
+        return result

@@ -1,0 +1,227 @@
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
+from harness import SENSOR_QOS, ros_env
+from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile
+from sensor_msgs.msg import CameraInfo as CameraInfoMsg
+from sensor_msgs.msg import Image
+
+from lumpbeam_ros.bagio import BagWriter, convert
+from lumpbeam_ros.bagio.typestore import serialize
+from lumpbeam_ros.errors import ConfigError
+from lumpbeam_ros.nodes.camera_node import CameraNode
+from lumpbeam_ros.vision.accuracy import drop_test_trajectory, render_frames
+from lumpbeam_ros.vision.config import load_camera_config
+from lumpbeam_ros.vision.messages import camera_info_to_data
+
+WIDTH, HEIGHT = 640, 480
+#: Image stamps far from zero: a float second there cannot carry every nanosecond.
+EPOCH_NS = 1_732_000_000_123_456_789
+
+
+@pytest.fixture(scope='module')
+def frames():
+    config = load_camera_config().with_resolution(WIDTH, HEIGHT)
+    return render_frames(config, drop_test_trajectory().slice_time(1.95, 2.2), 12)
+
+
+@pytest.fixture(scope='module')
+def info_bytes():
+    info = load_camera_config().with_resolution(WIDTH, HEIGHT).camera_info
+    return serialize(convert.camera_info(EPOCH_NS, camera_info_to_data(info)))
+
+
+def _image_bytes(pixels, index, encoding='mono8'):
+    return serialize(convert.image(EPOCH_NS + index * 5_555_556, pixels, 'camera', encoding))
+
+
+class Feed:
+    """Publishes serialized camera messages into the graph, one frame at a time."""
+
+    def __init__(self, graph, node):
+        self.graph, self.node = graph, node
+        self.images = graph.node.create_publisher(Image, '/camera/image_raw', SENSOR_QOS)
+        self.infos = graph.node.create_publisher(CameraInfoMsg, '/camera/camera_info', SENSOR_QOS)
+        assert graph.spin_until(lambda: self.images.get_subscription_count() >= 1, 10.0)
+        assert graph.spin_until(lambda: self.infos.get_subscription_count() >= 1, 10.0)
+
+    def info(self, data):
+        before = self.node.session.camera_info
+        self.infos.publish(data)
+        self.graph.spin_until(lambda: self.node.session.camera_info is not before, 1.0)
+
+    def image(self, data):
+        """Publishes until the node has taken the frame (best effort may drop one)."""
+        count = self.node.session.stats.frames_in
+        for _ in range(5):
+            self.images.publish(data)
+            if self.graph.spin_until(lambda: self.node.session.stats.frames_in > count, 2.0):
+                return
+        raise AssertionError('the node never received the frame')
+
+
+@pytest.fixture
+def node(ros_graph):
+    node = CameraNode(context=ros_graph.context)
+    ros_graph.add_node(node)
+    return node
+
+
+def test_images_in_poses_out_matching_the_truth(ros_graph, node, frames, info_bytes):
+    poses = ros_graph.collect('/tip_pose', PoseStamped, QoSProfile(depth=100))
+    covariances = ros_graph.collect(
+        '/tip_pose_covariance', PoseWithCovarianceStamped, QoSProfile(depth=100)
+    )
+    feed = Feed(ros_graph, node)
+    feed.info(info_bytes)
+    for i, frame in enumerate(frames):
+        feed.image(_image_bytes(frame.image, i))
+    assert ros_graph.spin_until(lambda: len(poses) == len(covariances) == len(frames), 5.0)
+    for i, (pose, with_cov, frame) in enumerate(zip(poses, covariances, frames, strict=True)):
+        stamp_ns = pose.header.stamp.sec * 1_000_000_000 + pose.header.stamp.nanosec
+        assert stamp_ns == EPOCH_NS + i * 5_555_556
+        assert pose.header.frame_id == 'beam_base'
+        _, x, z, pitch, _ = convert.pose_values(pose)
+        assert abs(z - frame.truth[1]) < 20e-6
+        assert abs(x - frame.truth[0]) < 50e-6
+        assert abs(pitch - frame.truth[2]) < 1e-4
+        assert with_cov.header == pose.header and with_cov.pose.pose == pose.pose
+        cov = np.reshape(with_cov.pose.covariance, (6, 6))
+        assert np.all(np.diag(cov)[[0, 2, 4]] > 0) and np.diag(cov)[[1, 3, 5]].sum() == 0
+        # A few micrometres of claimed standard deviation, as the fit's residuals say.
+        assert 1e-7 < np.sqrt(cov[2, 2]) < 2e-5
+    assert node.session.stats.frames_lost == 0
+    assert node.diagnostic_status().level == DiagnosticStatus.OK
+
+
+def _bad_images(pixels):
+    occluded = pixels.copy()
+    occluded[:, WIDTH // 2 - 40 : WIDTH // 2 + 40] = 110
+    short = convert.image(EPOCH_NS, pixels, 'camera')
+    short.data = short.data[:-WIDTH]  # one row missing: data size != step * height
+    wrong_encoding = convert.image(EPOCH_NS, pixels, 'camera')
+    wrong_encoding.encoding = '16UC1'
+    return {
+        # Without a track to follow, the detector finds no whole board.
+        'occluded': (_image_bytes(occluded, 0), 'board_not_found'),
+        'empty wall': (_image_bytes(np.full_like(pixels, 110), 0), 'too_dark'),
+        'black': (_image_bytes(np.zeros_like(pixels), 0), 'too_dark'),
+        'saturated': (_image_bytes(np.full_like(pixels, 255), 0), 'saturated'),
+        'short data': (serialize(short), 'bad_image'),
+        'wrong encoding': (serialize(wrong_encoding), 'bad_image'),
+        'corrupt bytes': (b'\x00\x01\x00\x00' + bytes(range(200)), 'bad_image'),
+        'wrong size': (_image_bytes(pixels[:240, :320].copy(), 0), 'bad_image'),
+    }
+
+
+def test_bad_frames_give_no_pose_and_a_diagnostic(ros_graph, node, frames, info_bytes):
+    poses = ros_graph.collect('/tip_pose', PoseStamped, QoSProfile(depth=100))
+    diagnostics = ros_graph.collect('/diagnostics', DiagnosticArray)
+    feed = Feed(ros_graph, node)
+    # Before any camera_info: wait, do not guess.
+    feed.image(_image_bytes(frames[0].image, 0))
+    assert node.session.stats.lost['no_camera_info'] == 1
+    # An uncalibrated camera's info (K = 0) is refused; the node keeps waiting.
+    zero_k = load_camera_config().with_resolution(WIDTH, HEIGHT).camera_info
+    bad_info = convert.camera_info(EPOCH_NS, camera_info_to_data(zero_k))
+    bad_info.k = np.zeros(9)
+    node.on_camera_info(serialize(bad_info))
+    assert node.session.camera_info is None
+    feed.info(info_bytes)
+    bad = _bad_images(frames[0].image)
+    for name, (data, status) in bad.items():
+        lost = node.session.stats.lost[status]
+        feed.image(data)
+        assert node.session.stats.lost[status] == lost + 1, name
+    ros_graph.spin_for(0.2)
+    assert poses == []
+    # The stream recovers on the next good frame.
+    feed.image(_image_bytes(frames[1].image, 1))
+    assert ros_graph.spin_until(lambda: len(poses) == 1, 5.0)
+    node.publish_diagnostics()
+    assert ros_graph.spin_until(lambda: len(diagnostics) >= 1, 5.0)
+    status = diagnostics[-1].status[0]
+    values = {kv.key: kv.value for kv in status.values}
+    assert status.name == 'lumpbeam/camera' and status.level == DiagnosticStatus.WARN
+    assert values['frames_in'] == str(len(bad) + 2)
+    assert values['poses_out'] == '1'
+    assert values['lost_bad_image'] == '4' and values['lost_too_dark'] == '2'
+    assert values['lost_board_not_found'] == '1' and values['lost_no_camera_info'] == '1'
+    assert values['camera_info'] == 'received'
+
+
+def test_parameters_come_from_the_camera_file_and_are_checked(ros_graph):
+    node = CameraNode(
+        context=ros_graph.context,
+        parameter_overrides=[
+            Parameter('tracker.max_rms_px', value=0.25),
+            Parameter('frame_id', value='base'),
+        ],
+    )
+    assert node.config.tracker.max_rms_px == 0.25
+    assert node.config.rig.board.squares_x == 9  # the file's default
+    assert node.frame_id == 'base'
+    descriptor = node.describe_parameter('tracker.max_rms_px')
+    assert descriptor.read_only and 'config/camera.yaml' in descriptor.description
+    node.destroy_node()
+    with pytest.raises(ConfigError, match='board.squares_y'):
+        CameraNode(
+            context=ros_graph.context,
+            parameter_overrides=[Parameter('board.squares_y', value=9)],
+        )
+
+
+def _write_bag(path, frames, info_bytes, corrupt_at=None):
+    with BagWriter(path) as bag:
+        bag.add_topic('/camera/image_raw', 'sensor_msgs/msg/Image')
+        bag.add_topic('/camera/camera_info', 'sensor_msgs/msg/CameraInfo')
+        for i, frame in enumerate(frames):
+            ns = EPOCH_NS + i * 5_555_556
+            bag.write_raw('/camera/camera_info', ns, info_bytes)
+            data = b'\x00\x01\x00\x00garbage' if i == corrupt_at else _image_bytes(frame.image, i)
+            bag.write_raw('/camera/image_raw', ns, data)
+
+
+def test_bag_source_survives_a_corrupt_frame(ros_graph, frames, info_bytes, tmp_path):
+    _write_bag(tmp_path / 'bag', frames, info_bytes, corrupt_at=5)
+    poses = ros_graph.collect('/tip_pose', PoseStamped, QoSProfile(depth=100))
+    node = CameraNode(
+        context=ros_graph.context,
+        parameter_overrides=[Parameter('bag_path', value=str(tmp_path / 'bag'))],
+    )
+    ros_graph.add_node(node)
+    ros_graph.spin_until(lambda: node.pose_publisher.get_subscription_count() >= 1, 5.0)
+    node.run_bag()
+    stats = node.session.stats
+    assert (stats.frames_in, stats.poses_out) == (len(frames), len(frames) - 1)
+    assert 'corrupt' in stats.last_reason
+    assert ros_graph.spin_until(lambda: len(poses) == len(frames) - 1, 5.0)
+    stamps = [p.header.stamp.sec * 1_000_000_000 + p.header.stamp.nanosec for p in poses]
+    assert EPOCH_NS + 5 * 5_555_556 not in stamps
+
+
+def test_main_reads_a_bag_with_a_params_file_and_rejects_a_missing_bag(
+    ros_graph, frames, info_bytes, tmp_path
+):
+    _write_bag(tmp_path / 'bag', frames[:6], info_bytes)
+    env = ros_env(ros_graph.domain_id)
+    base = [sys.executable, '-m', 'lumpbeam_ros.nodes.camera_node', '--ros-args']
+    params = ['--params-file', 'config/camera.yaml']
+    done = subprocess.run(
+        [*base, *params, '-p', f'bag_path:={tmp_path / "bag"}'],
+        env=env, capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert '6 frames, 6 poses' in done.stdout
+    missing = subprocess.run(
+        [*base, '-p', f'bag_path:={tmp_path / "nope"}'],
+        env=env, capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert missing.returncode == 2
+    assert missing.stderr.strip().startswith('camera_node: error:')
+    assert len(missing.stderr.strip().splitlines()) == 1
