@@ -7,8 +7,8 @@ import argparse
 from lumpbeam_ros.cli.output import non_negative_float, positive_float
 from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, parse_effect, write_drop_test_bag
-from lumpbeam_ros.synthetic.tracker import TrackerOptions
 from lumpbeam_ros.synthetic.images import ImageOptions, parse_image_size
+from lumpbeam_ros.synthetic.tracker import TrackerOptions
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

@@ -19,8 +19,8 @@ from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters, DropTestConfig
 from lumpbeam_ros.model.simulate import drop_test_events, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
-from lumpbeam_ros.synthetic.tracker import TrackerOptions, simulate_tracker, write_tracker_points
 from lumpbeam_ros.synthetic.images import ImageOptions, ImageStream
+from lumpbeam_ros.synthetic.tracker import TrackerOptions, simulate_tracker, write_tracker_points
 
 #: Pitch noise per metre of position noise: the camera sees the board about 1 m away.
 PITCH_NOISE_PER_M = 1.0
