@@ -127,6 +127,7 @@ def write_drop_test_bag(
     beam: BeamParameters,
     drop: DropTestConfig,
     options: SynthOptions,
+    *,
     tracker: TrackerOptions | None = None,
     images: ImageOptions | None = None,
 ) -> tuple[TipTrajectory, TipTrajectory]:

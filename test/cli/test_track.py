@@ -15,7 +15,9 @@ def bag(tmp_path_factory):
     """A 2.3 s synthetic drop test filmed at 320 x 240 (415 frames, 0.3 s of motion)."""
     path = tmp_path_factory.mktemp('track') / 'in'
     beam, drop = load_beam_config()
-    write_drop_test_bag(path, beam, drop, SynthOptions(duration_s=2.3), ImageOptions(320, 240))
+    write_drop_test_bag(
+        path, beam, drop, SynthOptions(duration_s=2.3), images=ImageOptions(320, 240)
+    )
     return path
 
 

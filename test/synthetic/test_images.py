@@ -56,7 +56,7 @@ def test_drop_test_bag_films_the_measured_motion(tmp_path):
     """With a hidden latency, frames show the measured (late) motion at the pose stamps."""
     options = SynthOptions(duration_s=2.1, noise_m=0.0, effects={'sensor_latency': 0.01})
     measured, truth = write_drop_test_bag(
-        tmp_path / 'bag', BeamParameters(), DropTestConfig(), options, ImageOptions(96, 72)
+        tmp_path / 'bag', BeamParameters(), DropTestConfig(), options, images=ImageOptions(96, 72)
     )
     poses = read_tip_poses(tmp_path / 'bag')
     stamps = [f.t for f in iter_images(tmp_path / 'bag')]

@@ -57,7 +57,9 @@ def test_lever_moves_the_reflector_along_the_tangent():
 
 def test_bag_holds_the_points_in_time_order(tmp_path):
     options = SynthOptions(duration_s=3.0)
-    write_drop_test_bag(tmp_path / 'bag', BeamParameters(), DROP, options, TrackerOptions())
+    write_drop_test_bag(
+        tmp_path / 'bag', BeamParameters(), DROP, options, tracker=TrackerOptions()
+    )
     points = read_points(tmp_path / 'bag')
     assert points.frame_id == 'tracker'
     assert points.t.size == 3001
