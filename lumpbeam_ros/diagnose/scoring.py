@@ -128,6 +128,13 @@ def decide(nominal: Score, candidates: Sequence[Score]) -> Decision:
         return Decision(
             fallback, best.name, f'{why} (best {best.name}, dBIC {margin_nominal:.1f})'
         )
+    if max(best.record_chi2, best.holdout_chi2) >= EXPLAINED_CHI2:
+        return Decision(
+            UNEXPLAINED,
+            best.name,
+            f'the best candidate, {best.name}, leaves chi2/n {best.record_chi2:.2f} '
+            f'(held-out {best.holdout_chi2:.2f}): a gap no library effect explains',
+        )
     if margin_runner < SIGNIFICANT_BIC or best.holdout_chi2 >= runner.holdout_chi2:
         return Decision(
             fallback,
@@ -139,13 +146,6 @@ def decide(nominal: Score, candidates: Sequence[Score]) -> Decision:
     if best.holdout_chi2 >= nominal.holdout_chi2:
         return Decision(
             fallback, best.name, f'{best.name} does not improve the held-out part of the record'
-        )
-    if max(best.record_chi2, best.holdout_chi2) >= EXPLAINED_CHI2:
-        return Decision(
-            UNEXPLAINED,
-            best.name,
-            f'the best candidate, {best.name}, leaves chi2/n {best.record_chi2:.2f} '
-            f'(held-out {best.holdout_chi2:.2f}): a gap no library effect explains',
         )
     if not best.physical:
         return Decision(
