@@ -1,0 +1,44 @@
+import numpy as np
+import pytest
+
+from lumpbeam_ros.diagnose.record import make_record
+from lumpbeam_ros.diagnose.signatures import decay_peaks, envelope_laws, time_shift
+from lumpbeam_ros.model.trajectory import TipTrajectory
+
+T = np.arange(0.0, 12.0, 1.0 / 180.0)
+TAU = np.clip(T - 2.0, 0.0, None)
+
+
+@pytest.mark.parametrize(
+    ('envelope', 'law'),
+    [
+        (0.02 * np.exp(-0.15 * TAU), 'exponential'),
+        (np.clip(0.02 - 0.0018 * TAU, 0.0, None), 'linear'),
+        (0.02 / (1.0 + 0.3 * TAU), 'amplitude_dependent'),
+    ],
+)
+def test_the_envelope_law_of_a_decay_is_recognised(envelope, law):
+    z = (
+        -0.03
+        + envelope * np.cos(19.2 * TAU)
+        + 1e-6 * np.random.default_rng(0).standard_normal(T.size)
+    )
+    peak_t, peak_a = decay_peaks(T, z, 2.0, -0.03)
+    assert 40 < peak_t.size < 70  # two peaks per 3 Hz period
+    laws = envelope_laws(peak_t, peak_a)
+    assert min(laws, key=laws.__getitem__) == law
+
+
+def test_too_few_peaks_give_no_law():
+    assert all(np.isnan(v) for v in envelope_laws(np.arange(3.0), np.ones(3)).values())
+
+
+@pytest.mark.parametrize('delay', [0.0, 0.015, 0.04])
+def test_time_shift_finds_a_late_measurement(delay):
+    def z_of(t):
+        tau = np.clip(t - 2.0, 0.0, None)
+        return -0.07 + 0.04 * (1.0 - np.exp(-0.1 * tau) * np.cos(19.2 * tau))
+
+    model = TipTrajectory(T, T * 0, z_of(T), T * 0, T * 0)
+    record = make_record(T, z_of(T - delay), T * 0, 4.5, [(2.0, 0.0)])
+    assert time_shift(record, model) == pytest.approx(delay, abs=6e-4)
