@@ -2,13 +2,19 @@
 
 Every model refits the two nominal parameters that the data identify and that trade off with
 the effects: ``k_total_nm_per_rad`` (k_tE, B.12: the static drop and the frequency) and
-``beta_identified`` (B.23: the damping). A candidate adds its effect's one parameter. All
-parameters are fitted as logarithms relative to a scale, so the least squares sees numbers
-of order one whatever the unit, and positivity holds by construction.
+``beta_identified`` (B.23: the damping), as logarithms of their ratio to the starting values
+(positive by construction, order one whatever the unit).
 
-Each effect has a search range, wider than its plausible range: a best fit outside the
-plausible range (or pinned to the search bound) is unphysical, and a diagnosis that needs it
-is ``unexplained``, not a name.
+A candidate adds one *strength*: a quantity that is zero when the effect is off and grows
+with it, fitted linearly in units of ``scale``. For four effects it is the SPEC parameter
+itself; for ``base_compliance`` it is the mount's compliance relative to the clamp joint,
+``k_clamp / k_base`` (a rigid mount is 0, where ``k_base`` would be infinite). So the nominal
+model is the candidate at strength 0, a bound that the least squares reaches in a step or
+two when the data hold no such effect, instead of crawling along a log-parameter to -inf.
+
+Each strength has a search bound, beyond its plausible range: a best fit outside the
+plausible range (or pinned at the bound) is unphysical, and a diagnosis that needs it is
+``unexplained``, not a name.
 """
 
 from __future__ import annotations
@@ -34,40 +40,71 @@ class Candidate:
     Attributes:
         name: ``'nominal'`` or an effect name of SPEC section 6.
         parameter: The effect's SPEC parameter name (``None`` for the nominal model).
-        scale: The unit the effect is fitted in (its log is fitted relative to it).
-        search: Bounds of the fitted value.
-        plausible: Values a real setup can have; outside them a fit is unphysical.
-        start: Where a fit starts: a small effect, a perturbation the data feel but far
-            from the nominal model's nesting limit, where the log-gradient would vanish.
+        scale: Unit of the fitted strength (``x[2] = strength / scale``).
+        search_max: Largest strength searched.
+        plausible_max: Largest strength a real setup can have.
+        start: Strength a fit starts from: small, but felt by the data.
+        reciprocal: The SPEC parameter is ``reference / strength`` (a compliance fitted
+            for a stiffness), else the strength itself.
+        reference: See ``reciprocal``.
     """
 
     name: str
     parameter: str | None = None
     scale: float = 1.0
-    search: tuple[float, float] = (0.0, 0.0)
-    plausible: tuple[float, float] = (0.0, math.inf)
-    start: float = 1.0
+    search_max: float = math.inf
+    plausible_max: float = math.inf
+    start: float = 0.0
+    reciprocal: bool = False
+    reference: float = 1.0
 
     @property
     def n_parameters(self) -> int:
         """Fitted parameters: k_tE and beta, plus the effect's one."""
         return 2 if self.parameter is None else 3
 
-    def bounds(self, nominal: BeamParameters) -> tuple[np.ndarray, np.ndarray]:
-        """Bounds of the fitted log-parameters ``[ln k/k0, ln beta/beta0, ln p/scale]``."""
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Bounds of ``x = [ln k/k0, ln beta/beta0, strength/scale]``."""
         lo = [math.log(STIFFNESS_FACTORS[0]), math.log(DAMPING_FACTORS[0])]
         hi = [math.log(STIFFNESS_FACTORS[1]), math.log(DAMPING_FACTORS[1])]
         if self.parameter is not None:
-            lo.append(math.log(self.search[0] / self.scale))
-            hi.append(math.log(self.search[1] / self.scale))
+            lo.append(0.0)
+            hi.append(self.search_max / self.scale)
         return np.asarray(lo), np.asarray(hi)
 
-    def beam(self, nominal: BeamParameters, x: np.ndarray) -> BeamParameters:
-        """The beam that the log-parameters ``x`` describe.
+    def start_x(self, nominal_x: np.ndarray, strength: float | None = None) -> np.ndarray:
+        """Starting point: the nominal model's refit values and a strength.
 
         Args:
-            nominal: The nominal beam (identified form, no effects): the reference of ``x``.
-            x: ``[ln k/k0, ln beta/beta0]`` and, for an effect, ``ln p/scale``.
+            nominal_x: The nominal fit's ``[ln k/k0, ln beta/beta0]``.
+            strength: The starting strength (default: :attr:`start`).
+
+        Returns:
+            The starting ``x``.
+        """
+        if self.parameter is None:
+            return np.asarray(nominal_x[:2], dtype=float)
+        return np.r_[nominal_x[:2], (self.start if strength is None else strength) / self.scale]
+
+    def value(self, x: np.ndarray) -> float:
+        """The effect's SPEC parameter (SI) at ``x``; NaN for the nominal model.
+
+        A reciprocal parameter at strength 0 is infinite (a rigid mount).
+        """
+        if self.parameter is None:
+            return float('nan')
+        strength = float(x[2]) * self.scale
+        if not self.reciprocal:
+            return strength
+        return self.reference / strength if strength > 0.0 else math.inf
+
+    def beam(self, nominal: BeamParameters, x: np.ndarray) -> BeamParameters:
+        """The beam that ``x`` describes.
+
+        Args:
+            nominal: The nominal beam in identified form (the reference of ``x``); any
+                effects it has stay on.
+            x: ``[ln k/k0, ln beta/beta0]`` and, for an effect, its strength.
 
         Returns:
             The beam with the refit nominal parameters and the effect switched on.
@@ -79,17 +116,10 @@ class Candidate:
         )
         if self.parameter is None:
             return beam
-        return replace(beam, effects=beam.effects.with_effect(self.name, self.value(x)))
-
-    def start_x(self, nominal_x: np.ndarray) -> np.ndarray:
-        """Starting log-parameters: the nominal model's refit values and the small start."""
-        if self.parameter is None:
-            return np.asarray(nominal_x[:2], dtype=float)
-        return np.r_[nominal_x[:2], math.log(self.start / self.scale)]
-
-    def value(self, x: np.ndarray) -> float:
-        """The effect's parameter in SI units (NaN for the nominal model)."""
-        return float('nan') if self.parameter is None else self.scale * math.exp(x[2])
+        value = self.value(x)
+        # Effects take 0 for "off"; an infinitely stiff mount is off.
+        value = 0.0 if math.isinf(value) else value
+        return replace(beam, effects=beam.effects.with_effect(self.name, value))
 
     def values(self, nominal: BeamParameters, x: np.ndarray) -> dict[str, float]:
         """All fitted parameters by name: the refit nominal ones and the effect's."""
@@ -102,19 +132,16 @@ class Candidate:
             out[self.parameter] = self.value(x)
         return out
 
-    def physical(self, nominal: BeamParameters, x: np.ndarray) -> bool:
-        """Whether the fitted values are within their search bounds and plausible range."""
-        lo, hi = self.bounds(nominal)
-        margin = 1e-3 * (hi - lo)
-        if np.any(x[:2] <= lo[:2] + margin[:2]) or np.any(x[:2] >= hi[:2] - margin[:2]):
+    def physical(self, x: np.ndarray) -> bool:
+        """Whether the fit stays off its bounds and inside the plausible strength."""
+        lo, hi = self.bounds()
+        margin = 1e-3 * (hi[:2] - lo[:2])
+        if np.any(x[:2] <= lo[:2] + margin) or np.any(x[:2] >= hi[:2] - margin):
             return False
         if self.parameter is None:
             return True
-        # Pinned at the upper search bound, the effect wanted to be larger still.
-        if x[2] >= hi[2] - margin[2]:
-            return False
-        value = self.value(x)
-        return self.plausible[0] <= value <= self.plausible[1]
+        strength = float(x[2]) * self.scale
+        return strength <= min(self.plausible_max, (1.0 - 1e-3) * self.search_max)
 
 
 def nominal_candidate() -> Candidate:
@@ -134,29 +161,30 @@ def effect_candidates(nominal: BeamParameters) -> list[Candidate]:
     k_clamp = float(nominal.joint_stiffness()[0])
     carried_kg = nominal.tip_mass_kg + nominal.mass_kg
     clamp_moment = nominal.gravity_mps2 * carried_kg * nominal.length_m
+    # name: (scale, search_max, plausible_max, start)
     table = {
-        # A mount much softer than the beam's own root would not be "a beam on a mount".
-        'base_compliance': (
-            k_clamp,
-            (1e-3 * k_clamp, 1e4 * k_clamp),
-            (0.05 * k_clamp, math.inf),
-            10.0 * k_clamp,
-        ),
+        # Compliance relative to the clamp joint; a mount 20 times softer than the beam's
+        # own root (k_base < k_clamp / 20) is not "a beam on a mount".
+        'base_compliance': (1.0, 1000.0, 20.0, 0.1),
         # Dry friction beyond a tenth of the clamp's static moment would lock the beam.
-        'coulomb_friction': (
-            1.0,
-            (1e-5 * clamp_moment, clamp_moment),
-            (0.0, 0.1 * clamp_moment),
-            0.1,
-        ),
+        'coulomb_friction': (1.0, clamp_moment, 0.1 * clamp_moment, 0.1),
         # c_q = rho C_d A / 2: 20 N s^2/m^2 is a plate of ~30 m^2; a tip body is far less.
-        'quadratic_drag': (1.0, (1e-4, 1e3), (0.0, 20.0), 0.05),
+        'quadratic_drag': (1.0, 1e3, 20.0, 0.05),
         # More than twice what the beam already carries is not an unnoticed bracket.
-        'added_mass': (1.0, (1e-4, 20.0 * carried_kg), (0.0, 2.0 * carried_kg), 0.03),
+        'added_mass': (1.0, 20.0 * carried_kg, 2.0 * carried_kg, 0.03),
         # Beyond a quarter of a second a camera pipeline is broken, not late.
-        'sensor_latency': (0.01, (1e-5, 2.0), (0.0, 0.25), 0.002),
+        'sensor_latency': (0.01, 2.0, 0.25, 0.002),
     }
     return [
-        Candidate(name, EFFECT_PARAMETERS[name], scale, search, plausible, start)
-        for name, (scale, search, plausible, start) in table.items()
+        Candidate(
+            name,
+            EFFECT_PARAMETERS[name],
+            scale,
+            search_max,
+            plausible,
+            start,
+            reciprocal=name == 'base_compliance',
+            reference=k_clamp,
+        )
+        for name, (scale, search_max, plausible, start) in table.items()
     ]

@@ -20,8 +20,9 @@ from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.model.simulate import simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
-#: Finite-difference step of the log-parameters: 0.2 %, well above the simulator's
-#: round-off and its dry-friction switching, well below any parameter's uncertainty.
+#: Finite-difference step of the fitted parameters (relative, at least 2e-3 absolute): well
+#: above the simulator's round-off and its dry-friction switching, well below any
+#: parameter's uncertainty.
 DIFF_STEP = 2e-3
 
 
@@ -31,7 +32,7 @@ class Fit:
 
     Attributes:
         candidate: The model.
-        x: Its fitted log-parameters (see :meth:`Candidate.beam`).
+        x: Its fitted parameters (see :meth:`Candidate.beam`).
         beam: The fitted beam.
         chi2: Sum of squared noise-normalized residuals over the fitted samples.
         n_residuals: Number of residuals (samples times two channels).
@@ -119,14 +120,14 @@ class FitProblem:
 
         Args:
             candidate: The model.
-            x0: Starting log-parameters (clipped into the bounds).
+            x0: Starting parameters (clipped into the bounds).
             end_s: Last fitted time, s.
             max_evaluations: Budget of residual evaluations (each one simulation).
 
         Returns:
             The fit.
         """
-        lo, hi = candidate.bounds(self.nominal)
+        lo, hi = candidate.bounds()
         x0 = np.clip(np.asarray(x0, dtype=float), lo + 1e-9, hi - 1e-9)
         start = self.simulations
 
@@ -140,8 +141,8 @@ class FitProblem:
             diff_step=DIFF_STEP,
             x_scale=1.0,
             max_nfev=max_evaluations,
-            xtol=1e-5,
-            ftol=1e-6,
+            xtol=1e-4,
+            ftol=1e-4,
         )
         return Fit(
             candidate=candidate,
@@ -150,5 +151,5 @@ class FitProblem:
             chi2=float(2.0 * result.cost),
             n_residuals=int(result.fun.size),
             evaluations=self.simulations - start,
-            physical=candidate.physical(self.nominal, result.x),
+            physical=candidate.physical(result.x),
         )

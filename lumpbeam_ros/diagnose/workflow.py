@@ -17,14 +17,12 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
-from lumpbeam_ros.diagnose.candidates import NOMINAL, Candidate, effect_candidates
-from lumpbeam_ros.diagnose.candidates import nominal_candidate as make_nominal_candidate
+from lumpbeam_ros.diagnose.candidates import effect_candidates, nominal_candidate
 from lumpbeam_ros.diagnose.fitting import Fit, FitProblem
 from lumpbeam_ros.diagnose.gap import SETTLE_S, Gap, decay_fit, measure_gap
 from lumpbeam_ros.diagnose.noise import noise_std
@@ -226,15 +224,16 @@ def _diagnose(record: Record, beam: BeamParameters, train_fraction: float) -> Di
     measured_fit = decay_fit(record.t, record.z, event)
     measured_mode = measured_fit.mode(0)
 
-    nominal_candidate = make_nominal_candidate()
-    nominal = _evaluate(problem, problem.fit(nominal_candidate, np.zeros(2), train_end))
+    nominal_model = nominal_candidate()
+    nominal = _evaluate(problem, problem.fit(nominal_model, np.zeros(2), train_end))
     sig = signatures(record, nominal.trajectory, measured_fit.offset)
 
     evaluated = [nominal]
     for candidate in effect_candidates(problem.nominal):
-        x0 = candidate.start_x(nominal.fit.x)
+        strength = None
         if candidate.name == 'sensor_latency' and sig.time_shift_s > candidate.start:
-            x0[2] = math.log(sig.time_shift_s / candidate.scale)
+            strength = sig.time_shift_s  # the delay seen at the load event
+        x0 = candidate.start_x(nominal.fit.x, strength)
         evaluated.append(_evaluate(problem, problem.fit(candidate, x0, train_end)))
 
     best_train = min(evaluated, key=lambda e: e.fit.chi2)
@@ -245,15 +244,15 @@ def _diagnose(record: Record, beam: BeamParameters, train_fraction: float) -> Di
     decision = decide(nominal_score, candidate_scores)
 
     # The final models use the whole record: more data, and the gaps are over all of it.
-    final_nominal = _evaluate(problem, problem.fit(nominal_candidate, nominal.fit.x))
+    final_nominal = _evaluate(problem, problem.fit(nominal_model, nominal.fit.x))
     augmented = final_nominal
     effect_parameters: dict[str, float] = {}
     if decision.missing_effect not in ('none', 'unexplained'):
-        winner = next(e for e in evaluated if e.fit.name == decision.missing_effect)
-        augmented = _evaluate(problem, problem.fit(winner.fit.candidate, winner.fit.x))
-        parameter = winner.fit.candidate.parameter
-        assert parameter is not None
-        effect_parameters = {parameter: augmented.fit.candidate.value(augmented.fit.x)}
+        winner = next(e.fit for e in evaluated if e.fit.name == decision.missing_effect)
+        augmented = _evaluate(problem, problem.fit(winner.candidate, winner.x))
+        effect_parameters = {
+            str(winner.candidate.parameter): winner.candidate.value(augmented.fit.x)
+        }
 
     return Diagnosis(
         missing_effect=decision.missing_effect,
@@ -291,6 +290,3 @@ def _score(
         record_chi2=_chi2(evaluated.residuals, np.ones_like(train)),
         physical=fit.physical,
     )
-
-
-__all__ = ['NOMINAL', 'Candidate', 'Diagnosis', 'diagnose', 'nominal_form']
