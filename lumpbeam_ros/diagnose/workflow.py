@@ -221,7 +221,12 @@ def _diagnose(record: Record, beam: BeamParameters, train_fraction: float) -> Di
     event = record.event_time_s
     train_end = event + train_fraction * (record.t[-1] - event)
     train = record.t <= train_end
-    measured_fit = decay_fit(record.t, record.z, event)
+    try:
+        measured_fit = decay_fit(record.t, record.z, event)
+    except LumpbeamError as exc:
+        raise LumpbeamError(
+            f'cannot measure the free decay after the load change at {event:.3f} s: {exc}'
+        ) from None
     measured_mode = measured_fit.mode(0)
 
     nominal_model = nominal_candidate()

@@ -49,6 +49,13 @@ def diagnoses():
         measured, _ = simulate_experiment(beam, drop, SynthOptions(effects=effects))
         record = record_from_trajectory(_noisy(measured, seed), events, drop.load_kg)
         out[label] = diagnose(record, beam)
+    # A beam stiffer and more damped than configured, nothing else: the refit absorbs it.
+    retuned = replace(beam, k_total_nm_per_rad=4300.0, beta_identified=20.0)
+    measured, _ = simulate_experiment(retuned, drop, SynthOptions())
+    out['retuned'] = diagnose(record_from_trajectory(_noisy(measured, 97), events, 4.5), beam)
+    # A 12 kg "bracket": the added-mass fit explains it, but with an absurd mass.
+    measured, _ = simulate_experiment(beam, drop, SynthOptions(effects={'added_mass': 12.0}))
+    out['absurd'] = diagnose(record_from_trajectory(_noisy(measured, 98), events, 4.5), beam)
     hard = simulate_hardening_drop(beam, drop, CUBIC_NM_PER_RAD3)
     out['hardening'] = diagnose(
         record_from_trajectory(_noisy(hard, 99), events, drop.load_kg), beam
@@ -87,6 +94,24 @@ def test_nominal_data_gets_none(diagnoses):
     assert d.gap_before.rms_m == pytest.approx(NOISE_M, rel=0.15)
     assert abs(d.gap_before.frequency_error) < 1e-3
     assert d.nominal.record_chi2 == pytest.approx(1.0, abs=0.15)
+
+
+def test_a_mistuned_configuration_is_refit_not_blamed_on_an_effect(diagnoses):
+    d = diagnoses['retuned']
+    assert d.missing_effect == 'none', d.decision.reason
+    assert d.nominal_beam.k_total_nm_per_rad == pytest.approx(4300.0, rel=0.01)
+    assert d.nominal_beam.beta_identified == pytest.approx(20.0, rel=0.05)
+    assert d.gap_before.rms_m == pytest.approx(NOISE_M, rel=0.15)
+
+
+def test_an_effect_that_needs_an_absurd_parameter_is_unexplained(diagnoses):
+    d = diagnoses['absurd']
+    assert d.missing_effect == 'unexplained', d.decision.reason
+    assert 'unphysical' in d.decision.reason
+    best = d.candidates[0]
+    assert best.name == 'added_mass' and not best.physical
+    assert d.effect_parameters == {}
+    assert d.augmented_beam == d.nominal_beam
 
 
 def test_a_hardening_clamp_is_unexplained(diagnoses):
