@@ -1,7 +1,7 @@
 """Residual signatures: the fingerprints by which each missing effect shows in a drop test.
 
 - Envelope shape of the free decay: viscous damping decays exponentially, dry friction
-  linearly (a fixed loss per cycle), quadratic drag hyperbolically (faster at large amplitude).
+  linearly (a fixed loss per cycle), quadratic drag faster at large amplitude.
 - Frequency drift with amplitude: a nonlinear spring changes the frequency as the swing
   decays; the library's effects do not (measured drift minus the model's own).
 - Time shift against the load event: a late sensor shows the drop late.
@@ -13,7 +13,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -34,8 +33,8 @@ class Signatures:
 
     Attributes:
         envelope: ``'exponential'``, ``'linear'`` or ``'amplitude_dependent'``: the decay law
-            whose envelope fits the measured peaks best.
-        envelope_fit_rms: Relative RMS misfit of the peaks under each law.
+            of the measured peaks (:func:`envelope_law`).
+        envelope_terms: The dry and quadratic decay terms and their F statistics.
         frequency_drift: Relative change of the measured frequency from the first to the
             second half of the decay, minus the model's own change.
         time_shift_s: How late the measurement is against the model around the event, s.
@@ -45,7 +44,7 @@ class Signatures:
     """
 
     envelope: str
-    envelope_fit_rms: dict[str, float]
+    envelope_terms: dict[str, float]
     frequency_drift: float
     time_shift_s: float
     slope_ratio_error: float
@@ -57,33 +56,59 @@ class Signatures:
         return asdict(self)
 
 
-def envelope_laws(t: np.ndarray, amplitude: np.ndarray) -> dict[str, float]:
-    """Relative RMS misfit of peak amplitudes under three decay laws, each a straight line.
+#: F statistic above which an extra decay term is real (one extra parameter; p ~ 0.003).
+ENVELOPE_F = 10.0
 
-    ``exponential``: ln A linear in t (viscous); ``linear``: A linear in t (dry friction);
-    ``amplitude_dependent``: 1/A linear in t (quadratic drag, dA/dt ~ -A^2).
+
+def envelope_terms(t: np.ndarray, amplitude: np.ndarray) -> dict[str, float]:
+    """Which decay law the peak amplitudes follow, beyond the viscous one.
+
+    The decay rate ``-dA/dt`` (central differences over one period) is regressed on the
+    amplitude three ways: ``a A`` (viscous: exponential envelope), ``a A + b`` (plus dry
+    friction: a constant loss, a linear envelope) and ``a A + c A^2`` (plus quadratic drag:
+    amplitude-dependent). An extra term counts when it has its physical sign (b, c > 0) and
+    its F statistic against the viscous law is large.
 
     Args:
-        t: Peak times, s.
-        amplitude: Peak amplitudes (positive).
+        t: Peak times, s (both signs of the swing, so half a period apart).
+        amplitude: Peak amplitudes, m.
 
     Returns:
-        Misfit of each law, relative to the mean amplitude (NaN with fewer than 4 peaks).
+        ``dry_m_per_s`` (b), ``quadratic_per_m_s`` (c) and their F statistics ``dry_f``,
+        ``quadratic_f`` (NaN with fewer than 8 peaks).
     """
-    laws = {
-        'exponential': (np.log, np.exp),
-        'linear': (lambda a: a, lambda y: y),
-        'amplitude_dependent': (lambda a: 1.0 / a, lambda y: 1.0 / np.maximum(y, 1e-12)),
+    keys = ('dry_m_per_s', 'quadratic_per_m_s', 'dry_f', 'quadratic_f')
+    if t.size < 8:
+        return dict.fromkeys(keys, float('nan'))
+    rate = -(amplitude[2:] - amplitude[:-2]) / (t[2:] - t[:-2])
+    amp = amplitude[1:-1]
+
+    def fit(*columns: np.ndarray) -> tuple[float, np.ndarray]:
+        design = np.column_stack(columns)
+        coef, *_ = np.linalg.lstsq(design, rate, rcond=None)
+        return float(np.sum((rate - design @ coef) ** 2)), coef
+
+    sse_viscous, _ = fit(amp)
+    sse_dry, dry = fit(amp, np.ones_like(amp))
+    sse_quadratic, quadratic = fit(amp, amp**2)
+    dof = amp.size - 2
+    return {
+        'dry_m_per_s': float(dry[1]),
+        'quadratic_per_m_s': float(quadratic[1]),
+        'dry_f': (sse_viscous - sse_dry) / max(sse_dry / dof, 1e-300),
+        'quadratic_f': (sse_viscous - sse_quadratic) / max(sse_quadratic / dof, 1e-300),
     }
-    out = {}
-    for name, (forward, inverse) in laws.items():
-        if t.size < 4:
-            out[name] = float('nan')
-            continue
-        line = np.polyval(np.polyfit(t, forward(amplitude), 1), t)
-        misfit = inverse(line) - amplitude
-        out[name] = float(np.sqrt(np.mean(misfit**2)) / np.mean(amplitude))
-    return out
+
+
+def envelope_law(terms: dict[str, float]) -> str:
+    """``'linear'``, ``'amplitude_dependent'`` or ``'exponential'`` from :func:`envelope_terms`."""
+    dry = terms['dry_m_per_s'] > 0.0 and terms['dry_f'] > ENVELOPE_F
+    quadratic = terms['quadratic_per_m_s'] > 0.0 and terms['quadratic_f'] > ENVELOPE_F
+    if dry and (not quadratic or terms['dry_f'] >= terms['quadratic_f']):
+        return 'linear'
+    if quadratic:
+        return 'amplitude_dependent'
+    return 'exponential'
 
 
 def decay_peaks(
@@ -165,9 +190,7 @@ def signatures(record: Record, model: TipTrajectory, level: float) -> Signatures
     """
     event = record.event_time_s
     peak_t, peak_a = decay_peaks(record.t, record.z, event, level)
-    laws = envelope_laws(peak_t, peak_a)
-    finite = {k: v for k, v in laws.items() if math.isfinite(v)}
-    envelope = min(finite, key=finite.__getitem__) if finite else 'unknown'
+    terms = envelope_terms(peak_t, peak_a)
     try:
         drift = _frequency_drift(record.t, record.z, event) - _frequency_drift(
             model.t, model.z, event
@@ -177,8 +200,8 @@ def signatures(record: Record, model: TipTrajectory, level: float) -> Signatures
     residual = model.z - record.z
     tail = record.t >= record.t[-1] - 0.2 * (record.t[-1] - event)
     return Signatures(
-        envelope=envelope,
-        envelope_fit_rms=laws,
+        envelope=envelope_law(terms),
+        envelope_terms=terms,
         frequency_drift=float(drift),
         time_shift_s=time_shift(record, model),
         slope_ratio_error=slope_ratio(record.t, record.z, record.pitch, event)

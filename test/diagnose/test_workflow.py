@@ -138,7 +138,10 @@ def test_signatures_point_at_their_effects(diagnoses):
     # A hardening spring slows down as the swing decays; linear effects do not.
     assert sig['hardening'].frequency_drift > 5e-4
     assert abs(sig['nominal'].frequency_drift) < 1e-4
+    # Dry friction adds a constant loss per cycle, drag one that grows with the swing.
     assert sig['nominal'].envelope == 'exponential'
+    assert sig['coulomb_friction'].envelope == 'linear'
+    assert sig['quadratic_drag'].envelope == 'amplitude_dependent'
 
 
 def test_json_form_has_the_spec_keys(diagnoses):
