@@ -39,7 +39,12 @@ def _summary(d: Diagnosis, seconds: float) -> str:
         f'  {d.decision.reason}',
         f'  noise: z {d.noise_z_m * 1e6:.1f} um, pitch {d.noise_pitch_rad * 1e6:.1f} urad',
     ]
-    for label, gap in (('gap before', d.gap_before), ('gap after ', d.gap_after)):
+    gaps = (
+        ('configured', d.gap_configured),
+        ('gap before', d.gap_before),
+        ('gap after ', d.gap_after),
+    )
+    for label, gap in gaps:
         lines.append(
             f'  {label}: rms {gap.rms_m * 1e6:9.1f} um  max {gap.max_m * 1e6:9.1f} um  '
             f'frequency {gap.frequency_error:+.2e}  damping {gap.damping_error:+.2e}'

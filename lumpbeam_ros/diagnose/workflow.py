@@ -62,6 +62,7 @@ class Diagnosis:
         gap_before: The nominal model (k_tE, beta refit) against the record.
         gap_after: The augmented model against the record (the nominal one when nothing
             is named).
+        gap_configured: The configured beam as given (nothing refit) against the record.
         candidates: One score per effect, best first.
         nominal: The nominal model's score.
         decision: The verdict and its reason.
@@ -81,6 +82,7 @@ class Diagnosis:
     effect_parameters: dict[str, float]
     gap_before: Gap
     gap_after: Gap
+    gap_configured: Gap
     candidates: list[Score]
     nominal: Score
     decision: Decision
@@ -108,6 +110,7 @@ class Diagnosis:
             ],
             'details': {
                 'reason': self.decision.reason,
+                'gap_configured': self.gap_configured.as_dict(),
                 'score': 'BIC (lower is better) of the fit on the training part',
                 'nominal': _score_details(self.nominal),
                 'candidates': [_score_details(s) for s in self.candidates],
@@ -158,10 +161,9 @@ def nominal_form(beam: BeamParameters) -> BeamParameters:
     )
 
 
-def _static_seed(problem: FitProblem, record: Record) -> BeamParameters:
+def _static_seed(model: TipTrajectory, record: Record, problem: FitProblem) -> BeamParameters:
     """Scales k_tE so the model's static drop at the event matches the data (B.12)."""
     beam = problem.nominal
-    model = problem.simulate(beam)
     event = record.event_time_s
     before, after = record.t < event, record.t >= event + SETTLE_S
     measured = float(np.mean(record.z[after]) - np.mean(record.z[before]))
@@ -217,7 +219,8 @@ def _diagnose(record: Record, beam: BeamParameters, train_fraction: float) -> Di
     sigma_z = max(noise_std(record.z), NOISE_FLOOR)
     sigma_pitch = max(noise_std(record.pitch), NOISE_FLOOR)
     problem = FitProblem(record, nominal_form(beam), sigma_z, sigma_pitch)
-    problem = FitProblem(record, _static_seed(problem, record), sigma_z, sigma_pitch)
+    configured = problem.simulate(problem.nominal)
+    problem.nominal = _static_seed(configured, record, problem)
     event = record.event_time_s
     train_end = event + train_fraction * (record.t[-1] - event)
     train = record.t <= train_end
@@ -264,6 +267,7 @@ def _diagnose(record: Record, beam: BeamParameters, train_fraction: float) -> Di
         effect_parameters=effect_parameters,
         gap_before=measure_gap(record, final_nominal.trajectory, measured_mode),
         gap_after=measure_gap(record, augmented.trajectory, measured_mode),
+        gap_configured=measure_gap(record, configured, measured_mode),
         candidates=sorted(candidate_scores, key=lambda s: s.bic),
         nominal=nominal_score,
         decision=decision,
