@@ -91,6 +91,7 @@ def test_nominal_data_gets_none(diagnoses):
     assert d.missing_effect == 'none', d.decision.reason
     assert d.effect_parameters == {}
     assert d.gap_after == d.gap_before
+    assert d.gap_configured.rms_m == pytest.approx(d.gap_before.rms_m, rel=0.01)
     assert d.gap_before.rms_m == pytest.approx(NOISE_M, rel=0.15)
     assert abs(d.gap_before.frequency_error) < 1e-3
     assert d.nominal.record_chi2 == pytest.approx(1.0, abs=0.15)
@@ -102,6 +103,9 @@ def test_a_mistuned_configuration_is_refit_not_blamed_on_an_effect(diagnoses):
     assert d.nominal_beam.k_total_nm_per_rad == pytest.approx(4300.0, rel=0.01)
     assert d.nominal_beam.beta_identified == pytest.approx(20.0, rel=0.05)
     assert d.gap_before.rms_m == pytest.approx(NOISE_M, rel=0.15)
+    # As configured, the model was off by the retuning (about 5 % in frequency).
+    assert d.gap_configured.frequency_error == pytest.approx(-0.05, abs=0.01)
+    assert d.gap_configured.rms_m > 100 * NOISE_M
 
 
 def test_an_effect_that_needs_an_absurd_parameter_is_unexplained(diagnoses):
