@@ -1,0 +1,94 @@
+"""``lumpbeam diagnose BAG``: the model-discrepancy workflow of SPEC section 6."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+from lumpbeam_ros.cli.output import write_json
+from lumpbeam_ros.diagnose.record import read_record
+from lumpbeam_ros.diagnose.workflow import Diagnosis, diagnose
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.model.parameters import load_beam_config, write_beam_config
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Adds the ``diagnose`` subcommand."""
+    parser = subparsers.add_parser(
+        'diagnose',
+        help='find the effect the model misses, add it, show the gap shrink',
+        description='Fits the nominal beam and each effect of SPEC section 6 to a drop-test '
+        'bag (/tip_pose, /tip_load), names the missing effect (or none, or unexplained) and '
+        'reports the gap between model and measurement before and after adding it.',
+    )
+    parser.add_argument('bag', help='bag folder with /tip_pose and /tip_load')
+    parser.add_argument('--config', help='nominal beam file (default: config/paper_beam.yaml)')
+    parser.add_argument('--json', metavar='FILE', help='write the result as JSON')
+    parser.add_argument('--plots', metavar='DIR', help='write figures (PNG) to this folder')
+    parser.add_argument(
+        '--write-model', metavar='FILE', help='write the augmented beam parameter file'
+    )
+    parser.set_defaults(handler=run)
+
+
+def _summary(d: Diagnosis, seconds: float) -> str:
+    lines = [
+        f'missing effect: {d.missing_effect}'
+        + ''.join(f'  ({k} = {v:.4g})' for k, v in d.effect_parameters.items()),
+        f'  {d.decision.reason}',
+        f'  noise: z {d.noise_z_m * 1e6:.1f} um, pitch {d.noise_pitch_rad * 1e6:.1f} urad',
+    ]
+    gaps = (
+        ('configured', d.gap_configured),
+        ('gap before', d.gap_before),
+        ('gap after ', d.gap_after),
+    )
+    for label, gap in gaps:
+        lines.append(
+            f'  {label}: rms {gap.rms_m * 1e6:9.1f} um  max {gap.max_m * 1e6:9.1f} um  '
+            f'frequency {gap.frequency_error:+.2e}  damping {gap.damping_error:+.2e}'
+        )
+    lines.append(f'  {"candidate":<18} {"BIC":>14} {"held-out chi2/n":>16}  parameter')
+    for s in [d.nominal, *d.candidates]:
+        effect = {k: v for k, v in s.parameters.items() if k not in _REFIT}
+        shown = ', '.join(f'{k} = {v:.4g}' for k, v in effect.items()) or '-'
+        flag = '' if s.physical else '  (unphysical)'
+        lines.append(f'  {s.name:<18} {s.bic:>14.1f} {s.holdout_chi2:>16.3f}  {shown}{flag}')
+    lines.append(f'  {d.simulations} simulations in {seconds:.1f} s')
+    return '\n'.join(lines)
+
+
+_REFIT = ('k_total_nm_per_rad', 'beta_identified')
+
+
+def run(args: argparse.Namespace) -> int:
+    """Diagnoses the bag, prints the verdict and writes the requested outputs."""
+    beam, drop = load_beam_config(args.config)
+    if not Path(args.bag).is_dir():
+        raise LumpbeamError(f'{args.bag}: no such bag folder')
+    record = read_record(args.bag)
+    start = time.perf_counter()
+    result = diagnose(record, beam)
+    print(_summary(result, time.perf_counter() - start))
+    if args.json:
+        write_json(args.json, result.as_dict())
+    if args.plots:
+        from lumpbeam_ros.plots.diagnosis import plot_diagnosis  # matplotlib only when asked
+
+        for path in plot_diagnosis(result, args.plots):
+            print(f'  wrote {path}')
+    if args.write_model:
+        header = (
+            f'Written by lumpbeam diagnose from {args.bag}: missing effect '
+            f'{result.missing_effect}.\n{result.decision.reason}\n'
+            'k_total_nm_per_rad and beta_identified are refit on the record with the effect.'
+        )
+        try:
+            write_beam_config(args.write_model, result.augmented_beam, drop, header)
+        except OSError as exc:
+            raise LumpbeamError(
+                f'cannot write the model to {args.write_model}: {exc.strerror or exc}'
+            ) from None
+        print(f'  wrote {args.write_model}')
+    return 0

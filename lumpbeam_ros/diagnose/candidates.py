@@ -1,0 +1,190 @@
+"""The models a diagnosis compares: the nominal beam and one candidate per SPEC section 6 effect.
+
+Every model refits the two nominal parameters that the data identify and that trade off with
+the effects: ``k_total_nm_per_rad`` (k_tE, B.12: the static drop and the frequency) and
+``beta_identified`` (B.23: the damping), as logarithms of their ratio to the starting values
+(positive by construction, order one whatever the unit).
+
+A candidate adds one *strength*: a quantity that is zero when the effect is off and grows
+with it, fitted linearly in units of ``scale``. For four effects it is the SPEC parameter
+itself; for ``base_compliance`` it is the mount's compliance relative to the clamp joint,
+``k_clamp / k_base`` (a rigid mount is 0, where ``k_base`` would be infinite). So the nominal
+model is the candidate at strength 0, a bound that the least squares reaches in a step or
+two when the data hold no such effect, instead of crawling along a log-parameter to -inf.
+
+Each strength has a search bound, beyond its plausible range: a best fit outside the
+plausible range (or pinned at the bound) is unphysical, and a diagnosis that needs it is
+``unexplained``, not a name.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters
+
+NOMINAL = 'nominal'
+
+#: Refit range of the nominal parameters, as factors of their starting values.
+STIFFNESS_FACTORS = (0.2, 5.0)
+DAMPING_FACTORS = (1e-3, 1e3)
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One model: the nominal beam, or the nominal beam plus one effect.
+
+    Attributes:
+        name: ``'nominal'`` or an effect name of SPEC section 6.
+        parameter: The effect's SPEC parameter name (``None`` for the nominal model).
+        scale: Unit of the fitted strength (``x[2] = strength / scale``).
+        search_max: Largest strength searched.
+        plausible_max: Largest strength a real setup can have.
+        start: Strength a fit starts from: small, but felt by the data.
+        reciprocal: The SPEC parameter is ``reference / strength`` (a compliance fitted
+            for a stiffness), else the strength itself.
+        reference: See ``reciprocal``.
+    """
+
+    name: str
+    parameter: str | None = None
+    scale: float = 1.0
+    search_max: float = math.inf
+    plausible_max: float = math.inf
+    start: float = 0.0
+    reciprocal: bool = False
+    reference: float = 1.0
+
+    @property
+    def n_parameters(self) -> int:
+        """Fitted parameters: k_tE and beta, plus the effect's one."""
+        return 2 if self.parameter is None else 3
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Bounds of ``x = [ln k/k0, ln beta/beta0, strength/scale]``."""
+        lo = [math.log(STIFFNESS_FACTORS[0]), math.log(DAMPING_FACTORS[0])]
+        hi = [math.log(STIFFNESS_FACTORS[1]), math.log(DAMPING_FACTORS[1])]
+        if self.parameter is not None:
+            lo.append(0.0)
+            hi.append(self.search_max / self.scale)
+        return np.asarray(lo), np.asarray(hi)
+
+    def start_x(self, nominal_x: np.ndarray, strength: float | None = None) -> np.ndarray:
+        """Starting point: the nominal model's refit values and a strength.
+
+        Args:
+            nominal_x: The nominal fit's ``[ln k/k0, ln beta/beta0]``.
+            strength: The starting strength (default: :attr:`start`).
+
+        Returns:
+            The starting ``x``.
+        """
+        if self.parameter is None:
+            return np.asarray(nominal_x[:2], dtype=float)
+        return np.r_[nominal_x[:2], (self.start if strength is None else strength) / self.scale]
+
+    def value(self, x: np.ndarray) -> float:
+        """The effect's SPEC parameter (SI) at ``x``; NaN for the nominal model.
+
+        A reciprocal parameter at strength 0 is infinite (a rigid mount).
+        """
+        if self.parameter is None:
+            return float('nan')
+        strength = float(x[2]) * self.scale
+        if not self.reciprocal:
+            return strength
+        return self.reference / strength if strength > 0.0 else math.inf
+
+    def beam(self, nominal: BeamParameters, x: np.ndarray) -> BeamParameters:
+        """The beam that ``x`` describes.
+
+        Args:
+            nominal: The nominal beam in identified form (the reference of ``x``); any
+                effects it has stay on.
+            x: ``[ln k/k0, ln beta/beta0]`` and, for an effect, its strength.
+
+        Returns:
+            The beam with the refit nominal parameters and the effect switched on.
+        """
+        beam = replace(
+            nominal,
+            k_total_nm_per_rad=nominal.k_total_nm_per_rad * math.exp(x[0]),
+            beta_identified=nominal.beta_identified * math.exp(x[1]),
+        )
+        if self.parameter is None:
+            return beam
+        value = self.value(x)
+        # Effects take 0 for "off"; an infinitely stiff mount is off.
+        value = 0.0 if math.isinf(value) else value
+        return replace(beam, effects=beam.effects.with_effect(self.name, value))
+
+    def values(self, nominal: BeamParameters, x: np.ndarray) -> dict[str, float]:
+        """All fitted parameters by name: the refit nominal ones and the effect's."""
+        beam = self.beam(nominal, x)
+        out = {
+            'k_total_nm_per_rad': beam.k_total_nm_per_rad,
+            'beta_identified': beam.beta_identified,
+        }
+        if self.parameter is not None:
+            out[self.parameter] = self.value(x)
+        return out
+
+    def physical(self, x: np.ndarray) -> bool:
+        """Whether the fit stays off its bounds and inside the plausible strength."""
+        lo, hi = self.bounds()
+        margin = 1e-3 * (hi[:2] - lo[:2])
+        if np.any(x[:2] <= lo[:2] + margin) or np.any(x[:2] >= hi[:2] - margin):
+            return False
+        if self.parameter is None:
+            return True
+        strength = float(x[2]) * self.scale
+        return strength <= min(self.plausible_max, (1.0 - 1e-3) * self.search_max)
+
+
+def nominal_candidate() -> Candidate:
+    """The nominal model: k_tE and beta refit, no effect."""
+    return Candidate(NOMINAL)
+
+
+def effect_candidates(nominal: BeamParameters) -> list[Candidate]:
+    """The five effects of SPEC section 6, with ranges scaled to the beam.
+
+    Args:
+        nominal: The nominal beam; its clamp stiffness, masses and length set the scales.
+
+    Returns:
+        One candidate per effect, in the order of SPEC section 6.
+    """
+    k_clamp = float(nominal.joint_stiffness()[0])
+    carried_kg = nominal.tip_mass_kg + nominal.mass_kg
+    clamp_moment = nominal.gravity_mps2 * carried_kg * nominal.length_m
+    # name: (scale, search_max, plausible_max, start)
+    table = {
+        # Compliance relative to the clamp joint; a mount 20 times softer than the beam's
+        # own root (k_base < k_clamp / 20) is not "a beam on a mount".
+        'base_compliance': (1.0, 1000.0, 20.0, 0.1),
+        # Dry friction beyond a tenth of the clamp's static moment would lock the beam.
+        'coulomb_friction': (1.0, clamp_moment, 0.1 * clamp_moment, 0.1),
+        # c_q = rho C_d A / 2: 20 N s^2/m^2 is a plate of ~30 m^2; a tip body is far less.
+        'quadratic_drag': (1.0, 1e3, 20.0, 0.05),
+        # More than twice what the beam already carries is not an unnoticed bracket.
+        'added_mass': (1.0, 20.0 * carried_kg, 2.0 * carried_kg, 0.03),
+        # Beyond a quarter of a second a camera pipeline is broken, not late.
+        'sensor_latency': (0.01, 2.0, 0.25, 0.002),
+    }
+    return [
+        Candidate(
+            name,
+            EFFECT_PARAMETERS[name],
+            scale,
+            search_max,
+            plausible,
+            start,
+            reciprocal=name == 'base_compliance',
+            reference=k_clamp,
+        )
+        for name, (scale, search_max, plausible, start) in table.items()
+    ]

@@ -1,0 +1,155 @@
+"""Least-squares fits of the candidate models to a record, in the time domain.
+
+A model is simulated under the record's own load schedule (``simulate_loads``) and compared
+with the measured tip z and pitch, each divided by its noise sigma, so the sum of squares is
+a chi-square and both channels count by their information: the pitch carries what separates
+a compliant mount from a softer beam (the slope-to-displacement ratio of the tip).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from lumpbeam_ros.diagnose.candidates import Candidate
+from lumpbeam_ros.diagnose.record import Record
+from lumpbeam_ros.model.parameters import BeamParameters
+from lumpbeam_ros.model.simulate import simulate_loads
+from lumpbeam_ros.model.trajectory import TipTrajectory
+
+#: Finite-difference step of the fitted parameters (relative, at least 2e-3 absolute): well
+#: above the simulator's round-off and its dry-friction switching, well below any
+#: parameter's uncertainty.
+DIFF_STEP = 2e-3
+
+
+@dataclass(frozen=True)
+class Fit:
+    """A candidate fitted to (part of) a record.
+
+    Attributes:
+        candidate: The model.
+        x: Its fitted parameters (see :meth:`Candidate.beam`).
+        beam: The fitted beam.
+        chi2: Sum of squared noise-normalized residuals over the fitted samples.
+        n_residuals: Number of residuals (samples times two channels).
+        evaluations: Simulations the fit took.
+        physical: Whether the fitted values are inside their plausible ranges.
+    """
+
+    candidate: Candidate
+    x: np.ndarray
+    beam: BeamParameters
+    chi2: float
+    n_residuals: int
+    evaluations: int
+    physical: bool
+
+    @property
+    def name(self) -> str:
+        """The candidate's name."""
+        return self.candidate.name
+
+    @property
+    def reduced_chi2(self) -> float:
+        """chi2 per residual: 1 when the model explains the data down to the noise."""
+        return self.chi2 / self.n_residuals
+
+
+class FitProblem:
+    """A record, its noise levels and the nominal beam that the models are built on.
+
+    Args:
+        record: The measurement.
+        nominal: The nominal beam in identified form with no effects (the reference of the
+            fitted log-parameters).
+        sigma_z: Noise of z, m.
+        sigma_pitch: Noise of the pitch, rad.
+    """
+
+    def __init__(
+        self, record: Record, nominal: BeamParameters, sigma_z: float, sigma_pitch: float
+    ):
+        self.record = record
+        self.nominal = nominal
+        self.sigma_z = sigma_z
+        self.sigma_pitch = sigma_pitch
+        self.simulations = 0
+
+    def simulate(self, beam: BeamParameters, end_s: float = math.inf) -> TipTrajectory:
+        """Simulates a beam at the record's stamps up to ``end_s``.
+
+        Args:
+            beam: The beam.
+            end_s: Last time of interest, s.
+
+        Returns:
+            The tip trajectory at the stamps ``t <= end_s``.
+        """
+        self.simulations += 1
+        t = self.record.t[self.record.t <= end_s]
+        return simulate_loads(beam, t, self.record.load_events, self.record.initial_load_kg)
+
+    def residuals(self, trajectory: TipTrajectory, start_s: float = -math.inf) -> np.ndarray:
+        """Noise-normalized residuals (model minus measurement), z then pitch.
+
+        Args:
+            trajectory: A simulation at (a prefix of) the record's stamps.
+            start_s: Only samples at or after this time.
+
+        Returns:
+            The stacked residuals.
+        """
+        n = len(trajectory)
+        keep = self.record.t[:n] >= start_s
+        rz = (trajectory.z[keep] - self.record.z[:n][keep]) / self.sigma_z
+        rp = (trajectory.pitch[keep] - self.record.pitch[:n][keep]) / self.sigma_pitch
+        return np.concatenate([rz, rp])
+
+    def fit(
+        self,
+        candidate: Candidate,
+        x0: np.ndarray,
+        end_s: float = math.inf,
+        max_evaluations: int = 60,
+    ) -> Fit:
+        """Fits a candidate by bounded least squares on the samples up to ``end_s``.
+
+        Args:
+            candidate: The model.
+            x0: Starting parameters (clipped into the bounds).
+            end_s: Last fitted time, s.
+            max_evaluations: Budget of residual evaluations (each one simulation).
+
+        Returns:
+            The fit.
+        """
+        lo, hi = candidate.bounds()
+        x0 = np.clip(np.asarray(x0, dtype=float), lo + 1e-9, hi - 1e-9)
+        start = self.simulations
+
+        def fun(x: np.ndarray) -> np.ndarray:
+            return self.residuals(self.simulate(candidate.beam(self.nominal, x), end_s))
+
+        result = least_squares(
+            fun,
+            x0,
+            bounds=(lo, hi),
+            diff_step=DIFF_STEP,
+            x_scale=1.0,
+            max_nfev=max_evaluations,
+            xtol=1e-4,
+            ftol=1e-4,
+        )
+        return Fit(
+            candidate=candidate,
+            x=result.x,
+            beam=candidate.beam(self.nominal, result.x),
+            chi2=float(2.0 * result.cost),
+            n_residuals=int(result.fun.size),
+            evaluations=self.simulations - start,
+            physical=candidate.physical(result.x),
+        )

@@ -1,0 +1,157 @@
+"""The measured record a diagnosis works on: tip poses and the load schedule that drove them."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from lumpbeam_ros.bagio import read_load_events, read_tip_poses
+from lumpbeam_ros.errors import BagError, LumpbeamError
+from lumpbeam_ros.model.trajectory import TipTrajectory
+
+#: Fewest poses after the last load change: two seconds at 180 Hz (six periods of the beam).
+MIN_SAMPLES_AFTER_EVENT = 360
+
+
+@dataclass(frozen=True)
+class Record:
+    """Tip poses in ``beam_base`` and the ``/tip_load`` schedule (SPEC sections 2, 3).
+
+    Attributes:
+        t: Pose stamps, s, increasing.
+        z: Vertical tip position, m.
+        pitch: Tip slope, rad.
+        initial_load_kg: The load hanging at the start; the beam is at rest with it.
+        load_events: ``(time, kg)`` load changes after the start, in time order.
+    """
+
+    t: np.ndarray
+    z: np.ndarray
+    pitch: np.ndarray
+    initial_load_kg: float
+    load_events: tuple[tuple[float, float], ...]
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    @property
+    def event_time_s(self) -> float:
+        """The time of the first load change (the drop of a drop test)."""
+        return self.load_events[0][0]
+
+    @property
+    def rate_hz(self) -> float:
+        """The median pose rate, Hz."""
+        return float(1.0 / np.median(np.diff(self.t)))
+
+
+def make_record(
+    t: np.ndarray,
+    z: np.ndarray,
+    pitch: np.ndarray,
+    initial_load_kg: float,
+    load_events: list[tuple[float, float]] | tuple[tuple[float, float], ...],
+    source: str = 'record',
+) -> Record:
+    """Checks and assembles a record; non-finite poses are dropped.
+
+    Args:
+        t: Pose stamps, s.
+        z: Vertical tip positions, m.
+        pitch: Tip slopes, rad.
+        initial_load_kg: Load at the start, kg.
+        load_events: ``(time, kg)`` load changes; at least one must fall inside the poses.
+        source: Name for error messages (a bag path).
+
+    Returns:
+        The record, sorted by time, with events before the first pose folded into the
+        initial load and events after the last pose dropped.
+
+    Raises:
+        LumpbeamError: Mismatched arrays, a negative or non-finite load, no load change
+            inside the record, or fewer than ``MIN_SAMPLES_AFTER_EVENT`` poses after it.
+    """
+    t, z, pitch = (np.asarray(a, dtype=float).ravel() for a in (t, z, pitch))
+    if not t.size == z.size == pitch.size:
+        raise LumpbeamError(f'{source}: pose arrays differ in length')
+    keep = np.isfinite(t) & np.isfinite(z) & np.isfinite(pitch)
+    t, z, pitch = t[keep], z[keep], pitch[keep]
+    order = np.argsort(t, kind='stable')
+    t, z, pitch = t[order], z[order], pitch[order]
+    if t.size and np.any(np.diff(t) <= 0.0):
+        unique = np.concatenate([[True], np.diff(t) > 0.0])
+        t, z, pitch = t[unique], z[unique], pitch[unique]
+    if t.size < MIN_SAMPLES_AFTER_EVENT:
+        raise LumpbeamError(f'{source}: {t.size} valid tip poses, need a longer record')
+    load = float(initial_load_kg)
+    events: list[tuple[float, float]] = []
+    for time, kg in sorted((float(a), float(b)) for a, b in load_events):
+        if not (np.isfinite(time) and np.isfinite(kg)) or kg < 0.0:
+            raise LumpbeamError(f'{source}: tip load {kg!r} kg at {time!r} s is not valid')
+        if time <= t[0]:
+            load = kg
+        elif time < t[-1] and kg != (events[-1][1] if events else load):
+            events.append((time, kg))
+    if not np.isfinite(load) or load < 0.0:
+        raise LumpbeamError(f'{source}: initial tip load {load!r} kg is not valid')
+    if not events:
+        raise LumpbeamError(
+            f'{source}: the tip load never changes during the poses; '
+            'a diagnosis needs a load event (a drop) to compare against'
+        )
+    after = int(np.count_nonzero(t > events[-1][0]))
+    if after < MIN_SAMPLES_AFTER_EVENT:
+        raise LumpbeamError(
+            f'{source}: {after} poses after the last load change at {events[-1][0]:.3f} s, '
+            f'need at least {MIN_SAMPLES_AFTER_EVENT}'
+        )
+    return Record(t, z, pitch, load, tuple(events))
+
+
+def record_from_trajectory(
+    trajectory: TipTrajectory, load_events: list[tuple[float, float]], initial_load_kg: float
+) -> Record:
+    """A record from a simulated (or synthetic) trajectory.
+
+    Args:
+        trajectory: Tip poses.
+        load_events: ``(time, kg)`` load changes.
+        initial_load_kg: Load at the start.
+
+    Returns:
+        The record.
+    """
+    return make_record(
+        trajectory.t, trajectory.z, trajectory.pitch, initial_load_kg, load_events, 'trajectory'
+    )
+
+
+def read_record(bag: str | Path) -> Record:
+    """Reads ``/tip_pose`` and ``/tip_load`` from a bag.
+
+    The first ``/tip_load`` sample gives the initial load, its changes the events
+    (``read_load_events(bag).changes()``).
+
+    Args:
+        bag: The bag folder.
+
+    Returns:
+        The record.
+
+    Raises:
+        BagError: The bag is unreadable, a topic is missing or empty, the poses are not in
+            ``beam_base``, or the record holds no usable load change.
+    """
+    poses = read_tip_poses(bag)
+    if poses.frame_id not in ('beam_base', ''):
+        raise BagError(f'{bag}: /tip_pose is in frame {poses.frame_id!r}, expected beam_base')
+    loads = read_load_events(bag).changes()
+    if loads.t.size == 0:
+        raise BagError(f'{bag}: /tip_load holds no message')
+    events = list(zip(loads.t[1:].tolist(), loads.kg[1:].tolist(), strict=True))
+    try:
+        return make_record(poses.t, poses.z, poses.pitch, float(loads.kg[0]), events, str(bag))
+    except LumpbeamError as exc:
+        raise BagError(str(exc)) from None

@@ -1,0 +1,76 @@
+import json
+
+import pytest
+
+from lumpbeam_ros.bagio import BagWriter
+from lumpbeam_ros.cli.main import main
+from lumpbeam_ros.model.parameters import DropTestConfig, load_beam_config
+from lumpbeam_ros.plots.diagnosis import FIGURES
+from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+
+SPEC_KEYS = ['missing_effect', 'effect_parameters', 'gap_before', 'gap_after', 'candidates']
+
+
+@pytest.fixture(scope='module')
+def late_bag(tmp_path_factory):
+    """A short drop test (4 s after the release) seen by a camera 15 ms late."""
+    out = tmp_path_factory.mktemp('diagnose') / 'late'
+    beam, _ = load_beam_config()
+    options = SynthOptions(duration_s=6.0, seed=5, effects={'sensor_latency': 0.015})
+    write_drop_test_bag(out, beam, DropTestConfig(duration_s=6.0), options)
+    return out
+
+
+def test_diagnose_writes_json_figures_and_a_model_that_reads_back(late_bag, tmp_path, capsys):
+    json_path, plots, model = tmp_path / 'd.json', tmp_path / 'plots', tmp_path / 'aug.yaml'
+    args = ['diagnose', str(late_bag), '--json', str(json_path), '--plots', str(plots)]
+    assert main([*args, '--write-model', str(model)]) == 0
+    printed = capsys.readouterr().out
+    assert 'missing effect: sensor_latency' in printed
+    assert 'gap before' in printed and 'gap after' in printed
+    result = json.loads(json_path.read_text())
+    assert list(result)[:5] == SPEC_KEYS
+    assert result['missing_effect'] == 'sensor_latency'
+    assert result['effect_parameters']['latency_s'] == pytest.approx(0.015, rel=0.1)
+    assert result['gap_after']['rms_m'] < 0.3 * result['gap_before']['rms_m']
+    assert len(result['candidates']) == 5
+    assert all(set(c) == {'name', 'parameters', 'score'} for c in result['candidates'])
+    for name in FIGURES:
+        assert (plots / name).stat().st_size > 10_000
+    beam, drop = load_beam_config(model)
+    assert beam.effects.active() == {'sensor_latency': pytest.approx(0.015, rel=0.1)}
+    assert beam.k_total_nm_per_rad == pytest.approx(3899.1, rel=0.02)
+    assert drop.release_time_s == 2.0
+    assert model.read_text().startswith('# Written by lumpbeam diagnose')
+
+
+def _write_still_bag(path):
+    with BagWriter(path) as bag:
+        bag.write_float('/tip_load', 0.0, 4.5)
+        for i in range(1000):
+            bag.write_pose('/tip_pose', i / 180.0, 2.3, -0.07, 0.04)
+
+
+@pytest.mark.parametrize(
+    ('setup', 'extra', 'message'),
+    [
+        (None, [], 'no such bag folder'),
+        (_write_still_bag, [], 'never changes'),
+        (_write_still_bag, ['--config', '/nonexistent/beam.yaml'], 'beam.yaml'),
+    ],
+)
+def test_user_mistakes_are_one_line_errors(tmp_path, capsys, setup, extra, message):
+    bag = tmp_path / 'bag'
+    if setup is not None:
+        setup(bag)
+    assert main(['diagnose', str(bag), *extra]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert message in err
+
+
+def test_a_bad_config_value_is_reported(tmp_path, late_bag, capsys):
+    config = tmp_path / 'bad.yaml'
+    config.write_text('/**:\n  ros__parameters:\n    beam:\n      length_m: -1.0\n')
+    assert main(['diagnose', str(late_bag), '--config', str(config)]) == 2
+    assert 'length_m' in capsys.readouterr().err

@@ -1,0 +1,85 @@
+import numpy as np
+import pytest
+
+from lumpbeam_ros.bagio import BagWriter
+from lumpbeam_ros.diagnose.record import make_record, read_record
+from lumpbeam_ros.errors import BagError, LumpbeamError
+from lumpbeam_ros.model.parameters import DropTestConfig, load_beam_config
+from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+
+T = np.arange(0.0, 6.0, 1.0 / 180.0)
+
+
+def _record(**changes):
+    args = {
+        't': T,
+        'z': np.zeros(T.size),
+        'pitch': np.zeros(T.size),
+        'initial_load_kg': 4.5,
+        'load_events': [(2.0, 0.0)],
+    }
+    args.update(changes)
+    return make_record(**args)
+
+
+def test_a_valid_record_keeps_its_event_and_drops_bad_samples():
+    z = np.zeros(T.size)
+    z[5] = np.nan
+    record = _record(z=z, load_events=[(2.0, 0.0), (-1.0, 4.5), (99.0, 1.0)])
+    assert len(record) == T.size - 1
+    assert record.initial_load_kg == 4.5
+    assert record.load_events == ((2.0, 0.0),)
+    assert record.rate_hz == pytest.approx(180.0)
+
+
+@pytest.mark.parametrize(
+    ('changes', 'message'),
+    [
+        ({'load_events': []}, 'never changes'),
+        ({'load_events': [(2.0, 4.5)]}, 'never changes'),
+        ({'load_events': [(5.5, 0.0)]}, 'poses after the last load change'),
+        ({'load_events': [(2.0, -1.0)]}, 'is not valid'),
+        ({'load_events': [(2.0, float('nan'))]}, 'is not valid'),
+        ({'initial_load_kg': -2.0}, 'initial tip load'),
+        ({'z': np.zeros(10)}, 'differ in length'),
+        ({'t': T[:100], 'z': np.zeros(100), 'pitch': np.zeros(100)}, 'valid tip poses'),
+    ],
+)
+def test_unusable_records_are_refused_with_a_reason(changes, message):
+    with pytest.raises(LumpbeamError, match=message):
+        _record(**changes)
+
+
+def test_reads_poses_and_load_changes_from_a_bag(tmp_path):
+    beam, _ = load_beam_config()
+    drop = DropTestConfig(release_time_s=1.0)
+    write_drop_test_bag(tmp_path / 'bag', beam, drop, SynthOptions(duration_s=4.0))
+    record = read_record(tmp_path / 'bag')
+    assert record.initial_load_kg == 4.5
+    assert record.load_events == ((1.0, 0.0),)
+    assert len(record) == 4 * 180 + 1
+    assert record.z[0] == pytest.approx(-0.0694, abs=5e-4)
+
+
+def test_bag_without_a_drop_or_without_loads_is_a_bag_error(tmp_path):
+    with BagWriter(tmp_path / 'still') as bag:
+        for i, t in enumerate(T):
+            if i % 180 == 0:
+                bag.write_float('/tip_load', t, 4.5)
+            bag.write_pose('/tip_pose', t, 2.3, -0.07, 0.04)
+    with pytest.raises(BagError, match='never changes'):
+        read_record(tmp_path / 'still')
+    with BagWriter(tmp_path / 'poses_only') as bag:
+        for t in T:
+            bag.write_pose('/tip_pose', t, 2.3, -0.07, 0.04)
+    with pytest.raises(BagError, match='tip_load'):
+        read_record(tmp_path / 'poses_only')
+
+
+def test_poses_in_another_frame_are_refused(tmp_path):
+    with BagWriter(tmp_path / 'camera') as bag:
+        bag.write_float('/tip_load', 0.0, 4.5)
+        for t in T:
+            bag.write_pose('/tip_pose', t, 2.3, -0.07, 0.04, frame='camera')
+    with pytest.raises(BagError, match='frame'):
+        read_record(tmp_path / 'camera')
