@@ -15,7 +15,7 @@ setup(
         (f'share/{PACKAGE}', ['package.xml']),
         (f'share/{PACKAGE}/config', glob('config/*.yaml')),
     ],
-    package_data={PACKAGE: ['data/*.csv', 'bench/*.xml']},
+    package_data={PACKAGE: ['data/*.csv', 'data/*.xml']},
     install_requires=['setuptools', 'numpy', 'scipy', 'pyyaml', 'threadpoolctl'],
     zip_safe=True,
     maintainer='lumpbeam_ros maintainers',

@@ -29,6 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
+from lumpbeam_ros.resources import large_frames_profile
+
 #: Domains the bench uses (Fast DDS ports are valid for any participant count; 0 is left to
 #: a developer's own graph, the test harness cycles through the same range).
 _DOMAINS = (*range(1, 102), *range(215, 233))
@@ -56,7 +58,7 @@ class StreamFigures:
 
 
 #: Fast DDS profile: shared memory with a 32 MB segment, UDP beside it.
-LARGE_FRAMES_PROFILE = Path(__file__).with_name('fastdds_large_frames.xml')
+LARGE_FRAMES_PROFILE = large_frames_profile()
 
 
 def _env(domain_id: int, large_frames: bool) -> dict[str, str]:

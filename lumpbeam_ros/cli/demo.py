@@ -29,6 +29,22 @@ def register(subparsers: Any) -> None:
     parser.add_argument('--domain-id', type=int, help='ROS domain (default: a random one)')
     parser.add_argument('--config', type=Path, help='beam parameter file')
     parser.add_argument('--json', type=Path, help='also write the summary here')
+    parser.add_argument(
+        '--image-size',
+        default='640x480',
+        metavar='WxH',
+        help='synthetic camera frames, tracked by the camera node (default 640x480)',
+    )
+    parser.add_argument(
+        '--no-images', action='store_true', help="play the bag's /tip_pose, no camera node"
+    )
+    parser.add_argument(
+        '--effect',
+        action='append',
+        metavar='NAME=VALUE',
+        help='effect hidden in the data for the diagnosis (repeatable; default '
+        'sensor_latency=0.015); --effect none hides nothing',
+    )
     parser.set_defaults(handler=run)
 
 
@@ -52,6 +68,17 @@ def run(args: argparse.Namespace) -> int:
         )
     if args.out.exists() and not args.out.is_dir():
         raise LumpbeamError(f'--out {args.out} is a file, not a folder')
+    from lumpbeam_ros.pipeline.demo import HIDDEN_EFFECT
+    from lumpbeam_ros.synthetic.drop_test import parse_effect
+    from lumpbeam_ros.synthetic.images import parse_image_size
+
+    if args.effect is None:
+        effects = dict(HIDDEN_EFFECT)
+    elif args.effect == ['none']:
+        effects = {}
+    else:
+        effects = dict(parse_effect(text) for text in args.effect)
+    size = None if args.no_images else parse_image_size(args.image_size)
     options = DemoOptions(
         out=args.out,
         duration_s=args.duration,
@@ -59,6 +86,8 @@ def run(args: argparse.Namespace) -> int:
         adopt_identified=args.adopt,
         domain_id=args.domain_id,
         beam_config=args.config,
+        image_size=size,
+        effects=effects,
     )
     result = run_demo(options, echo=lambda line: print(line, flush=True))
     if args.json is not None:

@@ -25,7 +25,7 @@ import json
 import math
 import shutil
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -70,6 +70,12 @@ PLAYER_DELAY_S = 4.0
 BAGS_DIR = 'bags'
 MARKER = '.lumpbeam-demo'
 
+#: What the built-in experiment hides for the diagnosis to find: a camera whose stamps are
+#: 15 ms late. It leaves the beam's frequency, damping and stiffness as they are, so the
+#: identification is still compared with the nominal truth, while the nominal model's
+#: prediction visibly runs ahead of the measurement.
+HIDDEN_EFFECT = {'sensor_latency': 0.015}
+
 #: The paper's figures for its beam (section B.3.2): f_E = 3.24 Hz, k_tE = 3899.1 N m/rad and
 #: c_tE = 0.08, whose damping ratio by B.22 is c_tE / (2 omega_d).
 PAPER = {
@@ -91,6 +97,10 @@ class DemoOptions:
         domain_id: ROS domain of the graph; a random private one when ``None``.
         beam_config: Beam parameter file (the package's paper_beam.yaml when ``None``).
         ready_timeout_s: Longest wait for the nodes to join the graph, s.
+        image_size: Width and height of the synthetic camera's frames; ``None`` plays the
+            bag's ``/tip_pose`` instead of running the camera node.
+        effects: Effects of SPEC section 6 hidden in the synthetic data, for the diagnosis
+            step to find (default: the camera's stamps 15 ms late).
     """
 
     out: Path = Path('results')
@@ -100,6 +110,8 @@ class DemoOptions:
     domain_id: int | None = None
     beam_config: Path | None = None
     ready_timeout_s: float = 60.0
+    image_size: tuple[int, int] | None = (640, 480)
+    effects: Mapping[str, float] = field(default_factory=lambda: dict(HIDDEN_EFFECT))
 
 
 @dataclass
@@ -163,16 +175,23 @@ def module_available(name: str) -> bool:
 def synthesize(run: DemoRun) -> None:
     """Writes the synthetic drop-test bag (``out/bags/input``)."""
     from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+    from lumpbeam_ros.synthetic.images import ImageOptions
 
     bags = _fresh_bags_dir(run.out / BAGS_DIR)
     run.input_bag = bags / 'input'
     run.recorded_bag = bags / 'recorded'
     run.normalized_bag = bags / 'recorded_sim_time'
-    options = SynthOptions(duration_s=run.options.duration_s, seed=run.options.seed)
-    write_drop_test_bag(run.input_bag, run.beam, run.drop, options)
+    options = SynthOptions(
+        duration_s=run.options.duration_s, seed=run.options.seed, effects=run.options.effects
+    )
+    size = run.options.image_size
+    images = None if size is None else ImageOptions(size[0], size[1], seed=run.options.seed)
+    write_drop_test_bag(run.input_bag, run.beam, run.drop, options, images=images)
+    hidden = ', '.join(f'{k}={v:g}' for k, v in run.options.effects.items()) or 'none'
+    frames = 'no images' if size is None else f'{size[0]}x{size[1]} camera frames'
     run.echo(
         f'  wrote {run.input_bag} ({run.options.duration_s:g} s, release at '
-        f'{run.drop.release_time_s:g} s)'
+        f'{run.drop.release_time_s:g} s, {frames}, hidden effect: {hidden})'
     )
 
 
@@ -378,8 +397,22 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
         f'samples'
     )
     if 'diagnosis' in summary:
-        lines.append(f'diagnosis: missing effect {summary["diagnosis"].get("missing_effect")}')
+        lines += diagnosis_lines(summary['diagnosis'])
     return lines
+
+
+def diagnosis_lines(diagnosis: dict[str, Any]) -> list[str]:
+    """The diagnosis in two lines: the effect found and the gap before and after adding it."""
+    found = diagnosis.get('missing_effect')
+    parameters = ', '.join(
+        f'{k} = {v:.4g}' for k, v in (diagnosis.get('effect_parameters') or {}).items()
+    )
+    before, after = diagnosis['gap_before'], diagnosis['gap_after']
+    return [
+        f'diagnosis: missing effect {found}' + (f' ({parameters})' if parameters else ''),
+        f'  gap to the measurement: RMS {before["rms_m"] * 1e3:.3f} mm with the nominal model, '
+        f'{after["rms_m"] * 1e3:.3f} mm with the effect added',
+    ]
 
 
 def default_steps() -> list[Step]:

@@ -22,6 +22,7 @@ from types import TracebackType
 from typing import IO
 
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.resources import large_frames_profile
 
 # Fast DDS maps domain ids to UDP ports; 1..101 are valid on Linux for any number of
 # participants. 0 is left to the user's own graph.
@@ -103,6 +104,8 @@ class ProcessGraph:
             ROS_HOME=str(home),
             ROS_LOG_DIR=str(home / 'log'),
             PYTHONUNBUFFERED='1',  # logs as they happen, not when a buffer fills
+            # Camera frames cross between processes: give shared memory room for them.
+            FASTRTPS_DEFAULT_PROFILES_FILE=str(large_frames_profile()),
         )
         self.children: dict[str, Child] = {}
 
