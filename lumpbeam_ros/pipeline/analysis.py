@@ -130,14 +130,35 @@ def normalize_recording(recorded: str | Path, out: str | Path) -> Path:
 
 
 def last_live_status(bag: str | Path) -> tuple[dict[str, str], int]:
-    """The last ``lumpbeam/identifier`` status on ``/beam_params`` (``({}, -1)`` if none)."""
+    """The latest live estimate of every key on ``/beam_params`` and the last status level.
+
+    A key that the last windows could not estimate keeps the latest value it had: the
+    stiffness (B.12) needs the release inside the window, and a 10 s window loses it near the
+    end of a 12 s record while the frequency and damping stay current.
+
+    Returns:
+        The values (``repr`` strings, as published) and the last level; ``({}, -1)`` if none.
+    """
     if '/beam_params' not in BagReader(bag).topics:
         return {}, -1
-    for _, statuses in reversed(read_diagnostics(bag)):
+    latest: dict[str, str] = {}
+    level = -1
+    for _, statuses in read_diagnostics(bag):
         for status in statuses:
-            if status.name == IDENTIFIER_STATUS:
-                return dict(status.values), status.level
-    return {}, -1
+            if status.name != IDENTIFIER_STATUS:
+                continue
+            level = status.level
+            for key, value in status.values.items():
+                if _is_finite_number(value) or key not in latest:
+                    latest[key] = value
+    return latest, level
+
+
+def _is_finite_number(text: str) -> bool:
+    try:
+        return math.isfinite(float(text))
+    except ValueError:
+        return False
 
 
 def analyze_recording(

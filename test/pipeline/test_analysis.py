@@ -80,3 +80,21 @@ def test_missing_prediction_is_a_bag_error(tmp_path):
         bag.write_float('/tip_load', 0.0, 4.5)
     with pytest.raises(BagError, match='tip_pose_predicted'):
         analyze_recording(tmp_path / 'only_pose', BEAM)
+
+
+def test_live_values_keep_the_latest_estimate_of_each_key(tmp_path):
+    # Near the end of a record the window loses the release: the stiffness turns NaN while
+    # the frequency stays current. The summary keeps the last stiffness it had.
+    bag = tmp_path / 'live'
+    with BagWriter(bag) as writer:
+        for stamp, k, f, level in ((1.0, '3885.0', '3.05', 0), (2.0, 'nan', '3.06', 1)):
+            status = convert.Status(
+                'lumpbeam/identifier',
+                level,
+                'test',
+                {'stiffness_total_nm_per_rad': k, 'natural_frequency_hz': f},
+            )
+            writer.write_diagnostics('/beam_params', stamp, [status])
+    values, level = last_live_status(bag)
+    assert values == {'stiffness_total_nm_per_rad': '3885.0', 'natural_frequency_hz': '3.06'}
+    assert level == 1
