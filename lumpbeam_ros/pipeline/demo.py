@@ -407,12 +407,14 @@ def diagnosis_lines(diagnosis: dict[str, Any]) -> list[str]:
     parameters = ', '.join(
         f'{k} = {v:.4g}' for k, v in (diagnosis.get('effect_parameters') or {}).items()
     )
-    before, after = diagnosis['gap_before'], diagnosis['gap_after']
-    return [
-        f'diagnosis: missing effect {found}' + (f' ({parameters})' if parameters else ''),
-        f'  gap to the measurement: RMS {before["rms_m"] * 1e3:.3f} mm with the nominal model, '
-        f'{after["rms_m"] * 1e3:.3f} mm with the effect added',
-    ]
+    lines = [f'diagnosis: missing effect {found}' + (f' ({parameters})' if parameters else '')]
+    before, after = diagnosis.get('gap_before'), diagnosis.get('gap_after')
+    if before and after:
+        lines.append(
+            f'  gap to the measurement: RMS {before["rms_m"] * 1e3:.3f} mm with the nominal '
+            f'model, {after["rms_m"] * 1e3:.3f} mm with the effect added'
+        )
+    return lines
 
 
 def default_steps() -> list[Step]:

@@ -8,7 +8,12 @@ from lumpbeam_ros.cli.main import main
 def test_demo_runs_the_graph_end_to_end(tmp_path, capsys):
     out = tmp_path / 'results'
     assert (
-        main(['demo', '--out', str(out), '--duration', '5', '--json', str(tmp_path / 's.json')])
+        main(
+            [
+                *('demo', '--out', str(out), '--duration', '5'),
+                *('--no-images', '--effect', 'none', '--json', str(tmp_path / 's.json')),
+            ]
+        )
         == 0
     )
     printed = capsys.readouterr().out
