@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.diagnose.candidates import effect_candidates, nominal_candidate
 from lumpbeam_ros.diagnose.fitting import Fit, FitProblem
 from lumpbeam_ros.diagnose.gap import SETTLE_S, Gap, decay_fit, measure_gap
@@ -36,7 +37,6 @@ from lumpbeam_ros.diagnose.scoring import (
 )
 from lumpbeam_ros.diagnose.signatures import Signatures, signatures
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.threads import single_threaded_blas
 from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.model.trajectory import TipTrajectory
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident import stiffness
 from lumpbeam_ros.ident.config import IdentifierConfig
@@ -24,7 +25,6 @@ from lumpbeam_ros.ident.release import Release, detect_release
 from lumpbeam_ros.ident.result import Identification, Status
 from lumpbeam_ros.ident.samples import PoseWindow
 from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParams, ModeGuess
-from lumpbeam_ros.ident.threads import single_threaded_blas
 from lumpbeam_ros.model import rules
 from lumpbeam_ros.model.parameters import BeamParameters
 

@@ -23,7 +23,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.signal import lfilter
 
-from lumpbeam_ros.ident.threads import single_threaded_blas
+from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.modes import LinearModel
 

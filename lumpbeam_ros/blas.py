@@ -1,4 +1,4 @@
-"""Single-threaded BLAS for the identifier's small matrices.
+"""Single-threaded BLAS for the small matrices of the identifier and the simulator.
 
 The identifier works on matrices of a few dozen columns. A multi-threaded BLAS hands each
 call to several threads, and on a busy two-core machine (a camera pipeline beside the
