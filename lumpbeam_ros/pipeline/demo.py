@@ -146,6 +146,7 @@ class DemoRun:
     nodes: list[str] = field(default_factory=list)
     analysis: RecordingAnalysis | None = None
     diagnosis: dict[str, Any] | None = None
+    camera_rms_m: float | None = None
     figures: list[Path] = field(default_factory=list)
     summary: dict[str, Any] = field(default_factory=dict)
     step_seconds: dict[str, float] = field(default_factory=dict)
@@ -324,6 +325,27 @@ def figures(run: DemoRun) -> None:
             title='Tip after the release: measured and predicted',
         ),
     ]
+    if run.with_camera:
+        run.figures.append(_camera_figure(run, folder / 'tip_tracked_vs_truth.png'))
+
+
+def _camera_figure(run: DemoRun, path: Path) -> Path:
+    """Draws the camera node's poses against the motion its frames showed (noise-free)."""
+    from lumpbeam_ros.plots.demo import plot_measured_vs_predicted, prediction_residual
+    from lumpbeam_ros.synthetic.drop_test import SynthOptions, simulate_experiment
+
+    options = SynthOptions(duration_s=run.options.duration_s, effects=run.options.effects)
+    seen, _ = simulate_experiment(run.beam, run.drop, options)
+    tracked = _analysis(run).measured
+    residual = prediction_residual(tracked.t, tracked.z, seen.t, seen.z)
+    run.camera_rms_m = residual.rms()
+    return plot_measured_vs_predicted(
+        residual,
+        path,
+        release_time_s=run.drop.release_time_s,
+        title='Tip: tracked by the camera node and as the camera saw it',
+        labels=('camera node /tip_pose', 'synthetic truth (what the frames show)'),
+    )
 
 
 def summarize(run: DemoRun) -> None:
@@ -358,6 +380,7 @@ def summarize(run: DemoRun) -> None:
         'predicted_samples': int(analysis.predicted.t.size),
         'nodes': list(run.nodes),
         'with_camera': run.with_camera,
+        'camera_rms_m': run.camera_rms_m,
         'figures': [str(p) for p in run.figures],
         'step_seconds': dict(run.step_seconds),
     }
@@ -396,6 +419,11 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
         f'max {summary["prediction_max_m"] * 1e3:.3f} mm over {summary["measured_samples"]} '
         f'samples'
     )
+    if summary.get('camera_rms_m') is not None:
+        lines.append(
+            f'camera node vs the synthetic truth: RMS {summary["camera_rms_m"] * 1e6:.1f} um '
+            f'in tip z'
+        )
     if 'diagnosis' in summary:
         lines += diagnosis_lines(summary['diagnosis'])
     return lines

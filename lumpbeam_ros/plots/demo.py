@@ -84,8 +84,11 @@ def plot_measured_vs_predicted(
     span: tuple[float, float] | None = None,
     release_time_s: float | None = None,
     title: str = 'Tip: measured (/tip_pose) and predicted (/tip_pose_predicted)',
+    labels: tuple[str, str] = ('measured /tip_pose', 'predicted /tip_pose_predicted'),
 ) -> Path:
     """Draws the measured and predicted tip z over time, and their difference below.
+
+    The difference is drawn in micrometres when it is below a tenth of a millimetre RMS.
 
     Args:
         residual: The aligned series (:func:`prediction_residual`).
@@ -93,6 +96,7 @@ def plot_measured_vs_predicted(
         span: ``(start, end)`` in s to show; all when ``None``.
         release_time_s: Marks the load's release, if given.
         title: Figure title.
+        labels: Legend entries of the two series.
 
     Returns:
         The written path.
@@ -114,18 +118,14 @@ def plot_measured_vs_predicted(
         2, 1, sharex=True, figsize=(9, 6), gridspec_kw={'height_ratios': [2, 1]}
     )
     try:
-        top.plot(t[keep], residual.measured[keep] * 1e3, lw=0.8, label='measured /tip_pose')
-        top.plot(
-            t[keep],
-            residual.predicted[keep] * 1e3,
-            lw=0.8,
-            ls='--',
-            label='predicted /tip_pose_predicted',
-        )
+        top.plot(t[keep], residual.measured[keep] * 1e3, lw=0.8, label=labels[0])
+        top.plot(t[keep], residual.predicted[keep] * 1e3, lw=0.8, ls='--', label=labels[1])
         top.set_ylabel('tip z (mm)')
         figure.suptitle(title)
-        bottom.plot(t[keep], residual.residual[keep] * 1e3, lw=0.6, color='tab:red')
-        bottom.set_ylabel('measured - predicted (mm)')
+        rms = float(np.sqrt(np.mean(residual.residual[keep] ** 2)))
+        scale, unit = (1e6, 'um') if rms < 1e-4 else (1e3, 'mm')
+        bottom.plot(t[keep], residual.residual[keep] * scale, lw=0.6, color='tab:red')
+        bottom.set_ylabel(f'difference ({unit})')
         bottom.set_xlabel('time (s, header stamp)')
         for axis in (top, bottom):
             axis.grid(alpha=0.3)
@@ -133,8 +133,9 @@ def plot_measured_vs_predicted(
                 axis.axvline(release_time_s, color='gray', lw=0.8, ls=':')
         # Above the axes: the oscillation fills the whole plot area.
         top.legend(loc='lower center', bbox_to_anchor=(0.5, 1.0), ncol=2, frameon=False)
-        rms = float(np.sqrt(np.mean(residual.residual[keep] ** 2)))
-        bottom.text(0.01, 0.9, f'RMS {rms * 1e3:.3f} mm', transform=bottom.transAxes, va='top')
+        bottom.text(
+            0.01, 0.9, f'RMS {rms * scale:.3f} {unit}', transform=bottom.transAxes, va='top'
+        )
         path = Path(path)
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
