@@ -4,6 +4,12 @@ A model is simulated under the record's own load schedule (``simulate_loads``) a
 with the measured tip z and pitch, each divided by its noise sigma, so the sum of squares is
 a chi-square and both channels count by their information: the pitch carries what separates
 a compliant mount from a softer beam (the slope-to-displacement ratio of the tip).
+
+A tracker may take up a new constant bias after losing its target
+(:func:`~lumpbeam_ros.diagnose.record.tracked_segments`): every stretch after the first is
+compared up to its own offset in each channel, projected out in closed form (its mean
+residual), so it costs no extra search dimension. The first stretch keeps the absolute
+level, so a record tracked throughout is compared as it is.
 """
 
 from __future__ import annotations
@@ -78,6 +84,7 @@ class FitProblem:
         self.sigma_z = sigma_z
         self.sigma_pitch = sigma_pitch
         self.simulations = 0
+        self._segments = record.tracked_segments()
 
     def simulate(self, beam: BeamParameters, end_s: float = math.inf) -> TipTrajectory:
         """Simulates a beam at the record's stamps up to ``end_s``.
@@ -107,7 +114,17 @@ class FitProblem:
         keep = self.record.t[:n] >= start_s
         rz = (trajectory.z[keep] - self.record.z[:n][keep]) / self.sigma_z
         rp = (trajectory.pitch[keep] - self.record.pitch[:n][keep]) / self.sigma_pitch
-        return np.concatenate([rz, rp])
+        return np.concatenate([self._debias(rz, keep), self._debias(rp, keep)])
+
+    def _debias(self, residual: np.ndarray, keep: np.ndarray) -> np.ndarray:
+        """Removes each later tracked stretch's own offset (the first one is the reference)."""
+        labels = self._segments[: keep.size][keep]
+        if labels.size == 0 or labels[-1] == 0:
+            return residual
+        counts = np.bincount(labels)
+        means = np.bincount(labels, weights=residual) / np.maximum(counts, 1)
+        means[0] = 0.0
+        return residual - means[labels]
 
     def fit(
         self,

@@ -14,6 +14,13 @@ from lumpbeam_ros.model.trajectory import TipTrajectory
 #: Fewest poses after the last load change: two seconds at 180 Hz (six periods of the beam).
 MIN_SAMPLES_AFTER_EVENT = 360
 
+#: A pause between poses longer than this many median periods is a tracking loss.
+TRACKING_LOSS_PERIODS = 1.5
+
+#: A stretch of poses shorter than this between two losses joins the stretch after it: a
+#: tracker that holds the target for a few frames has not settled on a new solution.
+MIN_TRACKED_SAMPLES = 20
+
 
 @dataclass(frozen=True)
 class Record:
@@ -45,6 +52,43 @@ class Record:
     def rate_hz(self) -> float:
         """The median pose rate, Hz."""
         return float(1.0 / np.median(np.diff(self.t)))
+
+    def tracked_segments(self) -> np.ndarray:
+        """Which tracked stretch each pose belongs to (see :func:`tracked_segments`)."""
+        return tracked_segments(self.t)
+
+
+def tracked_segments(t: np.ndarray) -> np.ndarray:
+    """Labels the stretches of poses between tracking losses, 0 for the first.
+
+    A camera tracker that loses its target (frames missing from the stamps) may settle on
+    a slightly different pose solution when it finds it again: a constant bias per stretch
+    (tens of micrometres, more than its noise), which no beam model can predict.
+
+    Args:
+        t: Increasing stamps, s.
+
+    Returns:
+        One integer label per stamp, non-decreasing, 0 up to the first loss.
+    """
+    t = np.asarray(t, dtype=float)
+    if t.size < 2:
+        return np.zeros(t.size, dtype=int)
+    step = np.diff(t)
+    starts = [0, *(np.flatnonzero(step > TRACKING_LOSS_PERIODS * np.median(step)) + 1)]
+    kept: list[int] = []
+    pending: int | None = None
+    for a, b in zip(starts, [*starts[1:], t.size], strict=True):
+        pending = a if pending is None else pending
+        if b - a >= MIN_TRACKED_SAMPLES:
+            kept.append(pending)  # a short stretch before it joins this one
+            pending = None
+    kept = kept or [0]  # a short last stretch stays with the one before
+    kept[0] = 0
+    labels = np.zeros(t.size, dtype=int)
+    for label, start in enumerate(kept[1:], start=1):
+        labels[start:] = label
+    return labels
 
 
 def make_record(

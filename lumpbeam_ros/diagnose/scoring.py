@@ -1,11 +1,13 @@
 """Scoring the candidate models and naming a winner only when the data insist on it.
 
-Scores are the Bayesian information criterion with the noise sigma estimated from the data
-(:mod:`~lumpbeam_ros.diagnose.noise`), so ``chi2`` is a sum of squared noise-normalized
-residuals: ``BIC = chi2 / phi + k ln n``. ``phi`` >= 1 inflates the noise for autocorrelated
-residuals, ``(1 + rho) / (1 - rho)`` with ``rho`` the lag-1 autocorrelation of the best
-model's residuals: when even the best model leaves a correlated pattern, ``n`` samples do not
-carry ``n`` independent pieces of evidence, and chi2 differences shrink accordingly.
+Scores are the Bayesian information criterion with the measurement-error floor estimated
+from the data (:mod:`~lumpbeam_ros.diagnose.noise`: white noise, or what a free-form fit of
+the decay leaves when the sensor's error is smooth), so ``chi2`` is a sum of squared
+error-normalized residuals: ``BIC = chi2 / phi + k ln n``. ``phi`` >= 1 inflates the noise
+for autocorrelated residuals, ``(1 + rho) / (1 - rho)`` with ``rho`` the lag-1
+autocorrelation of the best model's residuals: when even the best model leaves a correlated
+pattern, ``n`` samples do not carry ``n`` independent pieces of evidence, and chi2
+differences shrink accordingly.
 
 A BIC difference above 10 is "very strong" evidence (Kass and Raftery, 1995). The decision:
 

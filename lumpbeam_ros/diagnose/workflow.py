@@ -1,6 +1,8 @@
 """The discrepancy workflow of SPEC section 6: measure the gap, name the missing effect, close it.
 
-1. Noise sigma of z and pitch from the data (:mod:`~lumpbeam_ros.diagnose.noise`).
+1. Measurement error of z and pitch from the data (:mod:`~lumpbeam_ros.diagnose.noise`):
+   the larger of the white noise and what a free-form fit of the free decay leaves, so a
+   tracker's smooth error counts as error, not as missing physics.
 2. The nominal model, identified from the record: k_tE first scaled so that the model's
    static drop at the load event matches the measured one (B.12 in ratio form), then k_tE
    and beta refit jointly by least squares on the record (``beta`` scales c_tE, B.23; only
@@ -26,7 +28,7 @@ from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.diagnose.candidates import effect_candidates, nominal_candidate
 from lumpbeam_ros.diagnose.fitting import Fit, FitProblem
 from lumpbeam_ros.diagnose.gap import SETTLE_S, Gap, decay_fit, measure_gap
-from lumpbeam_ros.diagnose.noise import noise_std
+from lumpbeam_ros.diagnose.noise import decay_error_std, noise_std
 from lumpbeam_ros.diagnose.record import Record
 from lumpbeam_ros.diagnose.scoring import (
     Decision,
@@ -161,6 +163,29 @@ def nominal_form(beam: BeamParameters) -> BeamParameters:
     )
 
 
+def measurement_error(record: Record) -> tuple[float, float]:
+    """The error floor of z (m) and pitch (rad) that a right model's residual sits at.
+
+    The larger of the white noise (differences) and the free-form decay fit's residual
+    after the first load event (:mod:`~lumpbeam_ros.diagnose.noise`), at least
+    ``NOISE_FLOOR``.
+
+    Args:
+        record: The measurement.
+
+    Returns:
+        ``(sigma_z, sigma_pitch)``.
+    """
+    event = record.event_time_s
+    end = record.load_events[1][0] if len(record.load_events) > 1 else np.inf
+    free = record.t < end  # the decay is free up to the next load change
+    sigmas = []
+    for y in (record.z, record.pitch):
+        slow = decay_error_std(record.t[free], y[free], event + SETTLE_S, event)
+        sigmas.append(max(noise_std(y), slow, NOISE_FLOOR))
+    return sigmas[0], sigmas[1]
+
+
 def _static_seed(model: TipTrajectory, record: Record, problem: FitProblem) -> BeamParameters:
     """Scales k_tE so the model's static drop at the event matches the data (B.12)."""
     beam = problem.nominal
@@ -216,8 +241,7 @@ def diagnose(
 
 
 def _diagnose(record: Record, beam: BeamParameters, train_fraction: float) -> Diagnosis:
-    sigma_z = max(noise_std(record.z), NOISE_FLOOR)
-    sigma_pitch = max(noise_std(record.pitch), NOISE_FLOOR)
+    sigma_z, sigma_pitch = measurement_error(record)
     problem = FitProblem(record, nominal_form(beam), sigma_z, sigma_pitch)
     configured = problem.simulate(problem.nominal)
     problem.nominal = _static_seed(configured, record, problem)

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.bagio import BagWriter
-from lumpbeam_ros.diagnose.record import make_record, read_record
+from lumpbeam_ros.diagnose.record import make_record, read_record, tracked_segments
 from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.model.parameters import DropTestConfig, load_beam_config
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
@@ -83,3 +83,22 @@ def test_poses_in_another_frame_are_refused(tmp_path):
             bag.write_pose('/tip_pose', t, 2.3, -0.07, 0.04, frame='camera')
     with pytest.raises(BagError, match='frame'):
         read_record(tmp_path / 'camera')
+
+
+@pytest.mark.parametrize(
+    ('lost', 'starts'),
+    [
+        ([], [0]),  # tracked throughout
+        ([(100, 110)], [0, 110]),  # one loss: a new stretch after it
+        ([(100, 110), (112, 114)], [0, 110]),  # a few frames between losses join the next
+        ([(100, 110), (595, 597)], [0, 110]),  # a short last stretch stays with the one before
+    ],
+)
+def test_tracked_segments_start_after_each_loss(lost, starts):
+    keep = np.ones(600, dtype=bool)
+    for a, b in lost:
+        keep[a:b] = False
+    index = np.flatnonzero(keep)
+    labels = tracked_segments(index / 180.0)
+    assert np.all(np.diff(labels) >= 0)
+    assert [int(index[np.argmax(labels == k)]) for k in range(labels.max() + 1)] == starts

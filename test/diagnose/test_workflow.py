@@ -71,6 +71,8 @@ def test_names_the_hidden_effect_fits_it_and_closes_the_gap(diagnoses, effect):
     assert set(d.effect_parameters) == {parameter}
     assert d.effect_parameters[parameter] == pytest.approx(HIDDEN[effect], rel=0.25)
     assert d.gap_after.rms_m <= 0.3 * d.gap_before.rms_m
+    # The error floor is the white noise: the free-form decay absorbs every envelope.
+    assert d.noise_z_m == pytest.approx(NOISE_M, rel=0.1)
     # Down to the noise: the augmented model leaves white noise of the right size.
     assert d.gap_after.rms_m == pytest.approx(NOISE_M, rel=0.15)
     assert d.augmented_beam.effects.value(effect) == d.effect_parameters[parameter]
