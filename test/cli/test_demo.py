@@ -82,3 +82,22 @@ def test_summary_table_reads_back_from_json():
         *('3.0588', '+-', '1e-06', '-', '3.0588', '1.0000'),
     ]
     assert 'RMS 0.020 mm' in lines[4] and lines[-1] == 'diagnosis: missing effect none'
+
+
+def test_demo_tracks_images_and_names_the_hidden_latency(tmp_path, capsys):
+    # The default demo: camera frames through the camera node, and a 15 ms camera latency
+    # hidden in the data for the diagnosis step.
+    out = tmp_path / 'results'
+    assert main(['demo', '--out', str(out), '--duration', '7']) == 0
+    summary = json.loads((out / 'summary.json').read_text())
+    assert summary['with_camera']
+    assert summary['measured_samples'] > 0.9 * (7 * 180 + 1)
+    rows = summary['quantities']
+    assert rows['natural_frequency_hz']['identified'] == pytest.approx(3.0588, rel=2e-3)
+    assert summary['camera_rms_m'] < 100e-6
+    diagnosis = summary['diagnosis']
+    assert diagnosis['missing_effect'] == 'sensor_latency'
+    assert diagnosis['effect_parameters']['latency_s'] == pytest.approx(0.015, rel=0.25)
+    assert diagnosis['gap_after']['rms_m'] < 0.3 * diagnosis['gap_before']['rms_m']
+    assert (out / 'figures' / 'tip_tracked_vs_truth.png').stat().st_size > 10_000
+    assert 'diagnosis: missing effect sensor_latency' in capsys.readouterr().out
