@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import signal
+import sys
 from typing import Any
 
 from lumpbeam_ros.cli.output import positive_float
@@ -59,6 +60,13 @@ def run(args: argparse.Namespace) -> int:
     try:
         player = Player(reader, args.topics, rate=args.rate)
         time.sleep(args.delay)
+        # A message sent before a reliable subscriber is matched is not delivered to it.
+        unheard = player.wait_for_subscribers(args.delay)
+        if unheard:
+            print(
+                f'lumpbeam play: warning: no subscriber yet on {", ".join(unheard)}',
+                file=sys.stderr,
+            )
         passes = 0
         while True:
             stats = player.play(lambda: stopped['signal'] is not None)
@@ -76,4 +84,10 @@ def run(args: argparse.Namespace) -> int:
         f'played {args.bag} ({passes} pass{"es" if passes > 1 else ""}): {total} messages in '
         f'the last pass, lateness p99 {stats.lateness_percentile_ms(99):.2f} ms'
     )
+    if not stats.delivered:
+        print(
+            'lumpbeam play: warning: reliable subscribers did not acknowledge every message '
+            'before the end',
+            file=sys.stderr,
+        )
     return 0

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from rclpy.context import Context
+from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
@@ -25,6 +26,9 @@ from lumpbeam_ros.bagio.qos import default_profile, from_dict
 from lumpbeam_ros.errors import BagError
 from lumpbeam_ros.nodes.msgtypes import from_bag_qos, message_class
 
+#: Longest wait at the end of playback for reliable subscribers' acknowledgements, s.
+DELIVERY_TIMEOUT_S = 5.0
+
 
 @dataclass
 class PlayStats:
@@ -33,10 +37,13 @@ class PlayStats:
     Attributes:
         published: Messages published per topic.
         lateness_s: Publish time minus scheduled time of every message, s.
+        delivered: Whether reliable subscribers acknowledged every message at the end.
     """
 
     published: dict[str, int] = field(default_factory=dict)
     lateness_s: list[float] = field(default_factory=list)
+
+    delivered: bool = True
 
     def lateness_percentile_ms(self, q: float) -> float:
         """Returns a percentile of the lateness, ms (0 when nothing was published)."""
@@ -103,7 +110,42 @@ class Player(Node):
             self._outlets[raw.topic].publish(bytes(raw.data))
             stats.lateness_s.append(time.perf_counter() - due)
             stats.published[raw.topic] += 1
+        stats.delivered = self.wait_for_delivery()
         return stats
+
+    def wait_for_subscribers(self, timeout_s: float) -> list[str]:
+        """Waits until every played topic has a matched subscriber, at most ``timeout_s``.
+
+        Returns:
+            The topics still without one (empty when all are heard).
+        """
+        deadline = time.monotonic() + timeout_s
+        while True:
+            unheard = [
+                name for name, pub in self._outlets.items() if pub.get_subscription_count() == 0
+            ]
+            if not unheard or time.monotonic() >= deadline:
+                return unheard
+            time.sleep(0.05)
+
+    def wait_for_delivery(self, timeout_s: float = DELIVERY_TIMEOUT_S) -> bool:
+        """Waits until reliable subscribers have acknowledged everything published.
+
+        A player that exits right after its last message can take that message with it: the
+        DDS writer goes before the reader's acknowledgement arrives.
+
+        Args:
+            timeout_s: Longest wait, shared by all publishers, s.
+
+        Returns:
+            Whether everything was acknowledged in time (best-effort topics always are).
+        """
+        deadline = time.monotonic() + timeout_s
+        delivered = True
+        for publisher in [*self._outlets.values(), self._clock]:
+            left = max(0.0, deadline - time.monotonic())
+            delivered &= publisher.wait_for_all_acked(Duration(seconds=left))
+        return delivered
 
     @staticmethod
     def _qos(name: str, entry: object) -> QoSProfile:

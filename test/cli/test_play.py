@@ -118,3 +118,16 @@ def test_play_command_end_to_end(short_bag, capsys, monkeypatch):
     assert main(['play', str(short_bag), '--rate', '5', '--delay', '0.1']) == 0
     out = capsys.readouterr().out
     assert 'played' in out and '64 messages' in out
+
+
+def test_player_waits_for_subscribers_and_for_delivery(ros_graph, short_bag):
+    player = Player(BagReader(short_bag), ['/tip_pose'], context=ros_graph.context)
+    assert player.wait_for_subscribers(0.2) == ['/tip_pose']  # nobody listens yet
+    poses = ros_graph.collect('/tip_pose', PoseStamped, 100)
+    waiter = threading.Thread(target=lambda: player.wait_for_subscribers(5.0))
+    waiter.start()
+    ros_graph.spin_until(lambda: not waiter.is_alive(), 5.0)
+    assert player.wait_for_subscribers(0.0) == []
+    _, stats = _play(ros_graph, short_bag)
+    assert stats.delivered
+    assert ros_graph.spin_until(lambda: len(poses) == 60, 5.0)
