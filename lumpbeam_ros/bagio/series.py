@@ -13,7 +13,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from lumpbeam_ros.bagio import convert
+from lumpbeam_ros.bagio import convert, fastscan
 from lumpbeam_ros.bagio.reader import BagReader, open_bag
 from lumpbeam_ros.errors import BagError
 
@@ -79,12 +79,14 @@ def _sorted_columns(rows: list[tuple[float, ...]], width: int) -> list[np.ndarra
     return [table[:, i].copy() for i in range(width)]
 
 
-def read_tip_poses(bag: Bag, topic: str = '/tip_pose') -> PoseSeries:
+def read_tip_poses(bag: Bag, topic: str = '/tip_pose', *, fast: bool = True) -> PoseSeries:
     """Reads a ``geometry_msgs/PoseStamped`` topic as planar tip poses.
 
     Args:
         bag: Bag folder or open reader.
         topic: E.g. ``'/tip_pose'``, ``'/tip_pose_truth'``, ``'/tip_pose_predicted'``.
+        fast: Decode the topic in one vectorized pass (:mod:`~lumpbeam_ros.bagio.fastscan`)
+            when the files allow it; ``False`` always takes the general, per-message reader.
 
     Returns:
         The poses sorted by stamp (empty arrays for an empty topic).
@@ -93,6 +95,11 @@ def read_tip_poses(bag: Bag, topic: str = '/tip_pose') -> PoseSeries:
         BagError: Missing topic, another type, corrupt messages or mixed frames.
     """
     reader = open_bag(bag)
+    reader.require(topic, 'geometry_msgs/msg/PoseStamped')
+    if fast:
+        poses = _fast_poses(reader, topic)
+        if poses is not None:
+            return poses
     rows, frames = [], set()
     for _, msg in reader.messages(topic, 'geometry_msgs/msg/PoseStamped'):
         ns, x, z, pitch, frame = convert.pose_values(msg)
@@ -102,15 +109,52 @@ def read_tip_poses(bag: Bag, topic: str = '/tip_pose') -> PoseSeries:
     return PoseSeries(t, x, z, pitch, _single_frame(frames, reader, topic))
 
 
+def _fast_scan(reader: BagReader, topic: str) -> tuple[list[int], list[bytes]] | None:
+    """Log times and payloads of a topic across a bag's files (``None``: read in full)."""
+    if reader.truncated:
+        return None
+    log_times: list[int] = []
+    payloads: list[bytes] = []
+    for file in reader.info.files:
+        part = fastscan.scan_topic(file, topic)
+        if part is None:
+            return None
+        log_times += part[0]
+        payloads += part[1]
+    return log_times, payloads
+
+
+def _fast_poses(reader: BagReader, topic: str) -> PoseSeries | None:
+    """The poses by :mod:`~lumpbeam_ros.bagio.fastscan`, or ``None`` to read them in full."""
+    scanned = _fast_scan(reader, topic)
+    decoded = None if scanned is None else fastscan.decode_pose_stamped(scanned[1])
+    if decoded is None:
+        return None
+    ns, position, orientation, frame = decoded
+    order = np.argsort(ns, kind='stable')
+    pitch = convert.quaternions_to_pitch(orientation[order])
+    return PoseSeries(
+        ns[order] / convert.NS_PER_S, position[order, 0], position[order, 2], pitch, frame
+    )
+
+
 def read_floats(bag: Bag, topic: str) -> tuple[np.ndarray, np.ndarray]:
     """Reads a ``std_msgs/Float64`` topic as ``(log time s, value)`` arrays, sorted.
 
     Raises:
         BagError: Missing topic, another type or corrupt messages.
     """
+    reader = open_bag(bag)
+    reader.require(topic, 'std_msgs/msg/Float64')
+    scanned = _fast_scan(reader, topic)
+    values = None if scanned is None else fastscan.decode_float64(scanned[1])
+    if values is not None:
+        ns = np.asarray(scanned[0], dtype=np.int64)
+        order = np.argsort(ns, kind='stable')
+        return ns[order] / convert.NS_PER_S, values[order]
     rows = [
         (convert.ns_to_seconds(ns), float(msg.data))
-        for ns, msg in open_bag(bag).messages(topic, 'std_msgs/msg/Float64')
+        for ns, msg in reader.messages(topic, 'std_msgs/msg/Float64')
     ]
     t, value = _sorted_columns(rows, 2)
     return t, value

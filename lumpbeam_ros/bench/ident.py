@@ -15,15 +15,18 @@ solution (:func:`~lumpbeam_ros.ident.identify.identify_from`).
 from __future__ import annotations
 
 import math
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 from scipy.optimize import curve_fit
 
+from lumpbeam_ros.bagio import BagWriter, read_load_events, read_tip_poses
 from lumpbeam_ros.bench.result import BenchResult, best_time
 from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.identify import identify, identify_from
-from lumpbeam_ros.ident.samples import PoseWindow, clean_window
+from lumpbeam_ros.ident.samples import PoseWindow, clean_loads, clean_window
 from lumpbeam_ros.ident.window import SlidingWindow
 from lumpbeam_ros.model import rules
 from lumpbeam_ros.model.chain import LumpedChain
@@ -159,6 +162,41 @@ def _batch(quick: bool, beam: BeamParameters, truth: dict[str, float]) -> BenchR
     )
 
 
+def _analyze_bag(bag: Path, beam: BeamParameters, config: IdentifierConfig, fast: bool) -> str:
+    """``lumpbeam analyze``'s path from a bag to estimates; returns the status."""
+    poses = read_tip_poses(bag, fast=fast)
+    series = read_load_events(bag)
+    window = clean_window(poses.t, poses.z, poses.pitch, clean_loads(series.t, series.kg))
+    return identify(window, beam, config, strict=True).status.name
+
+
+def _analyze(quick: bool, beam: BeamParameters) -> BenchResult:
+    """Pose messages per second from a bag to estimates, as ``lumpbeam analyze`` goes."""
+    duration = 30.0 if quick else 120.0
+    t, z, pitch = drop_record(duration, beam)
+    config = IdentifierConfig(max_fit_s=duration)
+    with tempfile.TemporaryDirectory() as folder:
+        bag = Path(folder) / 'drop'
+        loads = load_messages(_drop(duration), duration)
+        with BagWriter(bag) as writer:
+            for i, stamp in enumerate(t):
+                while loads and loads[0][0] <= stamp:
+                    writer.write_float('/tip_load', *loads.pop(0))
+                writer.write_pose('/tip_pose', stamp, beam.length_m, z[i], pitch[i])
+        ours_s, status = best_time(lambda: _analyze_bag(bag, beam, config, fast=True))
+        base_s, _ = best_time(lambda: _analyze_bag(bag, beam, config, fast=False), 1)
+    value, baseline_value = t.size / ours_s, t.size / base_s
+    return BenchResult(
+        name='analyze_bag_throughput',
+        value=value,
+        unit='pose msgs/s',
+        baseline='the same analysis through the mcap reader and per-message CDR decoding',
+        baseline_value=baseline_value,
+        ratio=value / baseline_value,
+        details={'poses': int(t.size), 'status': status, 'seconds': ours_s},
+    )
+
+
 def _live(quick: bool, beam: BeamParameters, truth: dict[str, float]) -> BenchResult:
     config = IdentifierConfig()
     duration = 16.0 if quick else 30.0
@@ -249,4 +287,4 @@ def run(quick: bool = False) -> list[BenchResult]:
     """
     beam = BeamParameters()
     truth = model_truth(beam)
-    return [_batch(quick, beam, truth), _live(quick, beam, truth)]
+    return [_analyze(quick, beam), _batch(quick, beam, truth), _live(quick, beam, truth)]
