@@ -7,7 +7,15 @@ from lumpbeam_ros.model.parameters import BeamParameters
 
 def test_quick_run_reports_both_figures_with_baselines():
     results = {r.name: r for r in ident.run(quick=True)}
-    assert set(results) == {'ident_batch_throughput', 'ident_window_update_10s_180hz'}
+    assert set(results) == {
+        'analyze_bag_throughput',
+        'ident_batch_throughput',
+        'ident_window_update_10s_180hz',
+    }
+    bag = results['analyze_bag_throughput']
+    assert bag.unit == 'pose msgs/s' and bag.details['status'] == 'OK'
+    assert bag.details['poses'] == 30 * 180 + 1
+    assert bag.ratio == pytest.approx(bag.value / bag.baseline_value)
     batch = results['ident_batch_throughput']
     assert batch.unit == 'samples/s' and batch.value > 0 and batch.baseline_value > 0
     assert batch.ratio == pytest.approx(batch.value / batch.baseline_value)
