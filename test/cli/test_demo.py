@@ -44,6 +44,10 @@ def test_demo_runs_the_graph_end_to_end(tmp_path, capsys):
         (['--duration', '2.5'], 'less than 1 s after the release'),
         (['--domain-id', '500'], '--domain-id must be in 1..101'),
         (['--config', '/no/such.yaml'], 'no such file'),
+        (['--effect', 'gravity_wave=1'], 'unknown effect'),
+        (['--effect', 'sensor_latency=-0.01'], 'zero or positive'),
+        (['--image-size', '640by480'], 'expected WIDTHxHEIGHT'),
+        (['--image-size', '8x8'], 'at least'),
     ],
 )
 def test_demo_refuses_bad_options(tmp_path, capsys, args, message):
