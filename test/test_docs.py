@@ -1,0 +1,269 @@
+"""The user docs: their examples run, and doc/interfaces.md names everything the code defines.
+
+The names are taken from the code itself (topic strings, the JSON dictionaries the commands
+write, the identification's fields, the effect table, the argument parsers), so a key, topic
+or option added to the code without a line in doc/interfaces.md fails here, as does an item
+the page still calls planned after the code has it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import doctest
+import re
+from dataclasses import fields
+from functools import cache
+from pathlib import Path
+
+import pytest
+
+from lumpbeam_ros.bench.result import BenchResult
+from lumpbeam_ros.cli.analyze import SPEC_KEYS
+from lumpbeam_ros.cli.main import COMMANDS, build_parser
+from lumpbeam_ros.diagnose.gap import Gap
+from lumpbeam_ros.diagnose.signatures import Signatures
+from lumpbeam_ros.ident.result import Identification
+from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS
+from lumpbeam_ros.model.reproduce import Comparison, TableRow
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / 'lumpbeam_ros'
+DOCS = sorted((ROOT / 'doc').glob('*.md'))
+INTERFACES = ROOT / 'doc' / 'interfaces.md'
+TEXT = INTERFACES.read_text(encoding='utf-8')
+
+#: The section titles code and docs point to; they must not change.
+SECTIONS = (
+    'Beam model',
+    'Frames, units and time',
+    'Topics',
+    'Bags',
+    'Command line',
+    'Missing effects',
+    'Configuration',
+)
+
+#: The effect names the interface reserves, implemented or not.
+CONTRACT_EFFECTS = {
+    'base_compliance': 'k_base_nm_per_rad',
+    'coulomb_friction': 'torque_nm',
+    'quadratic_drag': 'c_q',
+    'added_mass': 'mass_kg',
+    'sensor_latency': 'latency_s',
+    'cubic_stiffness': 'k3_nm_per_rad3',
+    'sensor_scale': 'scale',
+    'mount_tilt': 'tilt_rad',
+}
+
+TOPIC_NAME = re.compile(r'/[a-z][a-z0-9_]*(?:/[a-z][a-z0-9_]*)*')
+PLANNED = re.compile(r'`([^`]+)` \(planned\)')
+
+
+def _parse(relative: str) -> ast.Module:
+    return ast.parse((PACKAGE / relative).read_text(encoding='utf-8'))
+
+
+def _function(relative: str, qualname: str) -> ast.AST:
+    """The definition ``qualname`` (``'Class.method'`` or ``'function'``) in a module."""
+    scope: ast.AST = _parse(relative)
+    for part in qualname.split('.'):
+        scope = next(
+            node
+            for node in ast.iter_child_nodes(scope)
+            if isinstance(node, ast.FunctionDef | ast.ClassDef) and node.name == part
+        )
+    return scope
+
+
+def _string(node: ast.AST | None) -> str | None:
+    if isinstance(node, ast.Constant) and isinstance(node.value, str):
+        return node.value
+    return None
+
+
+def dict_keys(relative: str, qualname: str) -> set[str]:
+    """String keys a function puts into dictionaries: literals and ``d['key'] = ...``."""
+    keys: set[str] = set()
+    for node in ast.walk(_function(relative, qualname)):
+        if isinstance(node, ast.Dict):
+            keys |= {k for k in map(_string, node.keys) if k is not None}
+        elif isinstance(node, ast.Subscript) and isinstance(node.ctx, ast.Store):
+            key = _string(node.slice)
+            if key is not None:
+                keys.add(key)
+    return keys
+
+
+def pair_keys(relative: str, qualname: str) -> set[str]:
+    """First items of the literal ``('key', value)`` pairs in a function."""
+    return {
+        key
+        for node in ast.walk(_function(relative, qualname))
+        if isinstance(node, ast.Tuple) and len(node.elts) == 2
+        for key in [_string(node.elts[0])]
+        if key is not None
+    }
+
+
+def field_names(cls: type) -> set[str]:
+    return {f.name for f in fields(cls)}
+
+
+@cache
+def code_topics() -> frozenset[str]:
+    """Every string constant in the package that is a whole topic name."""
+    topics = set()
+    for path in PACKAGE.rglob('*.py'):
+        for node in ast.walk(ast.parse(path.read_text(encoding='utf-8'))):
+            value = _string(node)
+            if value is not None and TOPIC_NAME.fullmatch(value):
+                topics.add(value)
+    return frozenset(topics)
+
+
+@cache
+def json_keys() -> dict[str, set[str]]:
+    """The keys each output of the product writes, by where they come from."""
+    identification = field_names(Identification)
+    return {
+        'reproduce': dict_keys('cli/reproduce.py', 'result_json')
+        | field_names(TableRow)
+        | field_names(Comparison)
+        | dict_keys('model/reproduce.py', 'paper_frequencies')
+        | dict_keys('model/reproduce.py', 'static_test'),
+        'analyze': set(SPEC_KEYS)
+        | {f'{key}_std' for key in SPEC_KEYS}
+        | {'release_time_s', 'static_deflection_m'}
+        | identification,
+        '/beam_params': (identification - {'status', 'message'})
+        | pair_keys('nodes/identifier_node.py', 'IdentifierNode.diagnostics'),
+        '/diagnostics': dict_keys('nodes/camera_node.py', 'CameraNode.diagnostic_status'),
+        'diagnose': dict_keys('diagnose/workflow.py', 'Diagnosis.as_dict')
+        | dict_keys('diagnose/workflow.py', '_score_details')
+        | field_names(Gap)
+        | field_names(Signatures),
+        'compare': dict_keys('compare/comparison.py', 'Comparison.as_dict'),
+        'track': dict_keys('cli/track.py', 'run'),
+        'bench': dict_keys('cli/bench.py', 'run') | field_names(BenchResult),
+        'demo': dict_keys('pipeline/demo.py', 'summarize'),
+    }
+
+
+def subparsers() -> dict[str, argparse.ArgumentParser]:
+    action = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    return dict(action.choices)
+
+
+def section(title: str) -> str:
+    """The text of one ``##``/``###`` section, up to the next heading of its level or above."""
+    level = title.split(' ')[0]
+    match = re.search(rf'^{re.escape(title)}$(.*?)(?=^#{{1,{len(level)}}} |\Z)', TEXT, re.M | re.S)
+    assert match, f'doc/interfaces.md has no section {title!r}'
+    return match.group(1)
+
+
+@pytest.mark.parametrize('path', DOCS, ids=lambda p: p.name)
+def test_doc_examples_run(path):
+    result = doctest.testfile(
+        str(path),
+        module_relative=False,
+        optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE,
+        encoding='utf-8',
+    )
+    assert result.failed == 0, f'{result.failed} failing example(s) in {path.name}; see above'
+
+
+def test_interfaces_has_runnable_examples():
+    examples = doctest.DocTestParser().get_examples(TEXT)
+    assert len(examples) >= 20
+
+
+@pytest.mark.parametrize('title', SECTIONS)
+def test_stable_section_titles(title):
+    assert re.search(rf'^## {re.escape(title)}$', TEXT, re.M)
+
+
+def test_self_contained():
+    # A clone of the product has only its own docs: no outside contract file to point to.
+    assert not re.search(r'SPEC|\.\./shared|shared/', TEXT)
+
+
+def test_every_topic_of_the_code_is_listed():
+    missing = sorted(t for t in code_topics() if f'`{t}`' not in TEXT)
+    assert not missing, f'add these topics to doc/interfaces.md "Topics": {missing}'
+
+
+@pytest.mark.parametrize('output', sorted(json_keys()))
+def test_every_output_key_is_listed(output):
+    keys = json_keys()[output]
+    assert keys, f'no keys found for {output}: has the code moved?'
+    missing = sorted(k for k in keys if f'`{k}`' not in TEXT and not _inline_listed(k))
+    assert not missing, f'add these {output} keys to doc/interfaces.md: {missing}'
+
+
+def _inline_listed(key: str) -> bool:
+    """Keys inside a braced list, e.g. `{n_s, uniform_m, loaded_m, end_load_m}`."""
+    return any(
+        re.search(rf'(?<![\w]){re.escape(key)}(?![\w])', group)
+        for group in re.findall(r'`\{([^`]*)\}`', TEXT)
+    )
+
+
+def test_every_command_and_option_is_listed():
+    parsers = subparsers()
+    headings = re.findall(r'^### lumpbeam (\w+)( \(planned\))?$', TEXT, re.M)
+    for name, planned in headings:
+        assert (name in parsers) != bool(planned), (
+            f'doc/interfaces.md "### lumpbeam {name}": planned or not, as the code has it'
+        )
+    for name, parser in parsers.items():
+        text = section(f'### lumpbeam {name}')
+        for action in parser._actions:
+            for option in action.option_strings:
+                if option in ('-h', '--help'):
+                    continue
+                assert re.search(rf'`{re.escape(option)}[` ]', text), (
+                    f'doc/interfaces.md "### lumpbeam {name}" does not list {option}'
+                )
+
+
+def test_planned_items_are_not_in_the_code_yet():
+    planned = PLANNED.findall(TEXT)
+    assert planned, 'the page marks nothing as planned: drop this test or the markers'
+    options = {
+        option
+        for parser in subparsers().values()
+        for a in parser._actions
+        for option in a.option_strings
+    }
+    topics = code_topics()
+    done = []
+    for item in planned:
+        if item.startswith('lumpbeam '):
+            done += [item] if item.split()[1] in COMMANDS else []
+        elif item.startswith('--'):
+            done += [item] if item in options else []
+        elif item.startswith('/'):
+            done += [item] if item in topics else []
+        elif item in CONTRACT_EFFECTS:
+            done += [item] if item in EFFECT_PARAMETERS else []
+        else:
+            pytest.fail(
+                f'doc/interfaces.md marks {item!r} planned: not a command, option, '
+                'topic or effect this test knows'
+            )
+    assert not done, f'the code has these; drop "(planned)" in doc/interfaces.md: {done}'
+
+
+def test_missing_effects_table():
+    text = section('## Missing effects')
+    rows = dict(re.findall(r'^\| `(\w+)`(?: \(planned\))? \| `(\w+)` \|', text, re.M))
+    assert rows == CONTRACT_EFFECTS
+    assert set(EFFECT_PARAMETERS.items()) <= set(rows.items())
+    for name in CONTRACT_EFFECTS:
+        implemented = re.search(rf'^\| `{name}` \|.*\| yes \|$', text, re.M) is not None
+        assert implemented == (name in EFFECT_PARAMETERS), (
+            f'doc/interfaces.md "Missing effects": {name} is '
+            f'{"" if name in EFFECT_PARAMETERS else "not "}in the model'
+        )
