@@ -54,7 +54,8 @@ def _bag(path, frames, encoding, info, with_info=True):
                 image = np.rint(image.astype(float) * 4095 / 255).astype(np.uint16)
             elif encoding in PATTERNS:
                 image = grey_scene_mosaic(image, encoding)
-            bag.write_message('/camera/image_raw', convert.image(ns, image, 'camera', encoding), ns)
+            msg = convert.image(ns, image, 'camera', encoding)
+            bag.write_message('/camera/image_raw', msg, ns)
     return path
 
 
@@ -143,3 +144,126 @@ def test_lossless_kinds_give_exactly_the_mono8_poses(tmp_path, footage):
         tracked[kind] = np.column_stack([poses.z, poses.pitch])
     for kind in LOSSLESS[1:]:
         np.testing.assert_array_equal(tracked[kind], tracked['bag mono8'], err_msg=kind)
+
+
+def _bad_source(case, tmp_path, footage):
+    """Writes a broken input; returns SRC and the options."""
+    info, frames = footage
+    few = frames[:6]
+    calibration = str(write_calibration(tmp_path / 'camera.yaml', info))
+    fps = ['--fps', '30']
+    if case == 'unsupported distortion model':
+        bad = write_calibration(tmp_path / 'fisheye.yaml', info, model='kannala_brandt_x')
+        return _folder(tmp_path / 'frames', few, '.png'), ['--camera-info', str(bad), *fps]
+    if case == 'camera matrix of zeros':
+        bad = write_calibration(tmp_path / 'zero.yaml', info, k=[0.0] * 9)
+        return _folder(tmp_path / 'frames', few, '.png'), ['--camera-info', str(bad), *fps]
+    if case == 'camera_info of another size':
+        small = info.scaled(320, 240)
+        return _bag(tmp_path / 'in', few, 'mono8', small), []
+    if case == 'calibration of another size':
+        other = write_calibration(tmp_path / 'other.yaml', info.scaled(320, 240))
+        return _folder(tmp_path / 'frames', few, '.png'), ['--camera-info', str(other), *fps]
+    if case == 'unreadable video':
+        (tmp_path / 'clip.avi').write_bytes(b'RIFF' + bytes(200))
+        return tmp_path / 'clip.avi', ['--camera-info', calibration, *fps]
+    if case == 'image folder with mixed sizes':
+        folder = _folder(tmp_path / 'frames', few, '.png')
+        cv2.imwrite(str(folder / '00003.png'), cv2.resize(few[3].image, (320, 240)))
+        return folder, ['--camera-info', calibration, *fps]
+    if case == 'timestamps file shorter than the video':
+        src = write_video(tmp_path / 'clip.avi', [f.image for f in few], 'MJPG')
+        stamps = write_timestamps(tmp_path / 'stamps.txt', _stamps_ns(few)[:4])
+        return src, ['--camera-info', calibration, '--timestamps', str(stamps)]
+    if case == 'no frames at all':
+        (tmp_path / 'frames').mkdir()
+        return tmp_path / 'frames', ['--camera-info', calibration, *fps]
+    if case == 'video without --fps or --timestamps':
+        src = write_video(tmp_path / 'clip.avi', [f.image for f in few], 'MJPG')
+        return src, ['--camera-info', calibration]
+    if case == 'folder without --fps or --timestamps':
+        return _folder(tmp_path / 'frames', few, '.png'), ['--camera-info', calibration]
+    if case == 'video without --camera-info':
+        return write_video(tmp_path / 'clip.avi', [f.image for f in few], 'MJPG'), fps
+    if case == 'bad --board':
+        return _bag(tmp_path / 'in', few, 'mono8', info), ['--board', '7x7']
+    raise AssertionError(case)
+
+
+BAD_INPUTS = {
+    # The camera model's own words follow the file's name (and the model's name).
+    'unsupported distortion model': 'fisheye.yaml: camera info: ',
+    'camera matrix of zeros': 'zero.yaml: camera info: ',
+    'camera_info of another size': (
+        'in /camera/image_raw message 0: image is 640 x 480 px but the camera info '
+        '(/camera/camera_info of'
+    ),
+    'calibration of another size': '00000.png: image is 640 x 480 px but the camera info',
+    'unreadable video': 'clip.avi: OpenCV cannot open it as a video',
+    'image folder with mixed sizes': ('00003.png: image is 320 x 240 px but the camera info ('),
+    'timestamps file shorter than the video': 'stamps.txt has 4 stamps but',
+    'no frames at all': 'frames: no image files',
+    'video without --fps or --timestamps': (
+        'clip.avi is a video without stamps: give --fps HZ or --timestamps FILE'
+    ),
+    'folder without --fps or --timestamps': 'frames is an image folder without stamps',
+    'video without --camera-info': 'clip.avi has no camera_info: give --camera-info FILE',
+    'bad --board': "--board '7x7': columns and rows must differ",
+}
+
+
+@pytest.mark.parametrize('case', sorted(BAD_INPUTS))
+def test_bad_input_is_one_line_naming_it_and_exit_2(case, tmp_path, footage, capsys):
+    src, options = _bad_source(case, tmp_path, footage)
+    out = tmp_path / 'out'
+    assert main(['track', str(src), str(out), *options]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith('lumpbeam track: error:') and len(err.splitlines()) == 1, err
+    assert BAD_INPUTS[case] in err, err
+    if case == 'unsupported distortion model':
+        assert 'kannala_brandt_x' in err
+    assert not out.exists()  # an incomplete OUT is not left behind
+    print(f'\n{case}: {err}')
+
+
+def test_a_corrupt_jpeg_in_a_bag_is_a_lost_frame_named_on_stderr(tmp_path, footage, capsys):
+    info, frames = footage
+    few = frames[:8]
+    with BagWriter(tmp_path / 'in') as bag:
+        for i, (frame, ns) in enumerate(zip(few, _stamps_ns(few), strict=True)):
+            _, data = cv2.imencode('.jpg', frame.image)
+            data = data.tobytes()[: len(data) // 2] if i == 5 else data.tobytes()
+            msg = convert.compressed_image(ns, data, 'jpeg', 'camera')
+            bag.write_message('/camera/image_raw/compressed', msg, ns)
+    calibration = write_calibration(tmp_path / 'camera.yaml', info)
+    out = tmp_path / 'out'
+    assert main(['track', str(tmp_path / 'in'), str(out), '--camera-info', str(calibration)]) == 0
+    printed = capsys.readouterr()
+    assert '8 frames, 7 poses, 1 lost (bad_image 1)' in printed.out
+    warning = printed.err.strip()
+    assert len(warning.splitlines()) == 1 and warning.startswith('lumpbeam track: warning:')
+    assert '/camera/image_raw/compressed message 5: corrupt JPEG' in warning
+    print(f'\ncorrupt JPEG in a bag: {warning}')
+    stamps = read_tip_poses(out).t
+    assert len(stamps) == 7 and seconds_to_ns(few[5].stamp) / 1e9 not in stamps
+
+
+@pytest.mark.parametrize('board', [None, ('6x4', '0.08')])
+def test_the_board_comes_from_the_options(board, tmp_path, footage):
+    """Footage of a 7 x 5-square board of 80 mm squares: found only when told so."""
+    from dataclasses import replace
+
+    from lumpbeam_ros.vision.config import with_board
+
+    info, frames = footage
+    config = with_board(load_camera_config().with_resolution(WIDTH, HEIGHT), (6, 4), 0.08)
+    config = replace(config, camera_info=info)
+    other = render_frames(config, drop_test_trajectory().slice_time(START_S, 2.0), 8)
+    src = _bag(tmp_path / 'in', other, 'mono8', info)
+    options = [] if board is None else ['--board', board[0], '--square-m', board[1]]
+    assert main(['track', str(src), str(tmp_path / 'out'), '--quiet', *options]) == 0
+    if board is None:
+        assert len(read_tip_poses(tmp_path / 'out').t) == 0  # no 8 x 6 pattern there
+    else:
+        poses, error = _errors(tmp_path / 'out', other)
+        assert len(poses.t) == 8 and np.max(np.abs(error[:, 1])) < 20e-6
