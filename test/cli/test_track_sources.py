@@ -1,5 +1,8 @@
 """Footage of every kind a lab records, through ``lumpbeam track``, against the truth."""
 
+import io
+import sys
+
 import cv2
 import numpy as np
 import pytest
@@ -267,3 +270,24 @@ def test_the_board_comes_from_the_options(board, tmp_path, footage):
     else:
         poses, error = _errors(tmp_path / 'out', other)
         assert len(poses.t) == 8 and np.max(np.abs(error[:, 1])) < 20e-6
+
+
+class _Terminal(io.StringIO):
+    def isatty(self):
+        return True
+
+
+@pytest.mark.parametrize('quiet', [False, True])
+def test_a_progress_bar_on_a_terminal_unless_quiet(quiet, tmp_path, footage, monkeypatch):
+    info, frames = footage
+    src = _bag(tmp_path / 'in', frames[:10], 'mono8', info)
+    terminal = _Terminal()
+    monkeypatch.setattr(sys, 'stderr', terminal)
+    options = ['--quiet'] if quiet else []
+    assert main(['track', str(src), str(tmp_path / 'out'), *options]) == 0
+    drawn = terminal.getvalue()
+    if quiet:
+        assert drawn == ''
+    else:
+        assert drawn.startswith('\rtracking [') and drawn.endswith('] 100%\n')
+        assert drawn.count('\r') == 10  # one redraw per frame (10 % each)
