@@ -21,8 +21,18 @@ from lumpbeam_ros.errors import BagError
 
 NS_PER_S = 1_000_000_000
 
-#: Channels per pixel of the image encodings the project reads and writes.
-IMAGE_CHANNELS = {'mono8': 1, 'bgr8': 3, 'rgb8': 3}
+#: Channels per pixel and sample type of the image encodings the project reads and writes
+#: (names of ROS's ``sensor_msgs/image_encodings``); a Bayer mosaic is one raw channel.
+IMAGE_ENCODINGS: dict[str, tuple[int, type[np.generic]]] = {
+    'mono8': (1, np.uint8),
+    'bgr8': (3, np.uint8),
+    'rgb8': (3, np.uint8),
+    'mono16': (1, np.uint16),
+    'bayer_rggb8': (1, np.uint8),
+    'bayer_bggr8': (1, np.uint8),
+    'bayer_gbrg8': (1, np.uint8),
+    'bayer_grbg8': (1, np.uint8),
+}
 
 
 def seconds_to_ns(seconds: float) -> int:
@@ -136,41 +146,45 @@ def clock(ns: int) -> Any:
 
 
 def image(ns: int, pixels: np.ndarray, frame_id: str, encoding: str | None = None) -> Any:
-    """Builds a ``sensor_msgs/msg/Image`` from an 8-bit array.
+    """Builds a ``sensor_msgs/msg/Image`` from an array.
 
     Args:
         ns: Exposure time, ns.
-        pixels: ``(height, width)`` uint8 for mono8, ``(height, width, 3)`` for bgr8/rgb8.
+        pixels: ``(height, width)`` for mono8, mono16 and the Bayer mosaics,
+            ``(height, width, 3)`` for bgr8/rgb8; uint16 for mono16, uint8 otherwise.
         frame_id: The camera's optical frame.
-        encoding: ``'mono8'``, ``'bgr8'`` or ``'rgb8'``; ``None`` means mono8 for a 2-D array
-            and bgr8 (OpenCV's order) for a 3-channel one.
+        encoding: One of :data:`IMAGE_ENCODINGS`; ``None`` means mono8 for a 2-D array and
+            bgr8 (OpenCV's order) for a 3-channel one.
 
     Returns:
-        The message, rows packed (``step = width * channels``).
+        The message, rows packed (``step = width * channels * bytes per sample``), little
+        endian.
 
     Raises:
-        BagError: Not uint8, a shape that does not fit the encoding, or an unknown encoding.
+        BagError: A sample type or shape that does not fit the encoding, or an unknown
+            encoding.
     """
     pixels = np.asarray(pixels)
-    if pixels.dtype != np.uint8:
-        raise BagError(f'image must be uint8, got {pixels.dtype}')
     if encoding is None:
         encoding = 'mono8' if pixels.ndim == 2 else 'bgr8'
-    if encoding not in IMAGE_CHANNELS:
-        raise BagError(f'unsupported image encoding {encoding!r} (use {sorted(IMAGE_CHANNELS)})')
-    channels = IMAGE_CHANNELS[encoding]
+    if encoding not in IMAGE_ENCODINGS:
+        raise BagError(f'unsupported image encoding {encoding!r} (use {sorted(IMAGE_ENCODINGS)})')
+    channels, dtype = IMAGE_ENCODINGS[encoding]
+    if pixels.dtype != dtype:
+        raise BagError(f'{encoding} image must be {np.dtype(dtype)}, got {pixels.dtype}')
     expected_ndim = 2 if channels == 1 else 3
     if pixels.ndim != expected_ndim or (channels > 1 and pixels.shape[2] != channels):
         raise BagError(f'image of shape {pixels.shape} does not fit encoding {encoding}')
     height, width = pixels.shape[:2]
+    data = np.ascontiguousarray(pixels, dtype=np.dtype(dtype).newbyteorder('<'))
     return message_class('sensor_msgs/msg/Image')(
         header=header(ns, frame_id),
         height=height,
         width=width,
         encoding=encoding,
         is_bigendian=0,
-        step=width * channels,
-        data=np.ascontiguousarray(pixels).reshape(-1),
+        step=width * channels * data.itemsize,
+        data=data.view(np.uint8).reshape(-1),
     )
 
 
@@ -181,19 +195,21 @@ def image_array(msg: Any) -> np.ndarray:
         msg: The image message.
 
     Returns:
-        ``(height, width)`` for mono8, ``(height, width, 3)`` for bgr8/rgb8 (channel order as
-        the encoding says), uint8.
+        ``(height, width)`` for mono8, mono16 and the Bayer mosaics, ``(height, width, 3)``
+        for bgr8/rgb8 (channel order as the encoding says); uint16 (native byte order) for
+        mono16, uint8 otherwise.
 
     Raises:
         BagError: Unsupported encoding, a step shorter than a row, or a data size that does not
             match ``step * height``.
     """
     encoding = msg.encoding
-    if encoding not in IMAGE_CHANNELS:
-        raise BagError(f'unsupported image encoding {encoding!r} (use {sorted(IMAGE_CHANNELS)})')
-    channels = IMAGE_CHANNELS[encoding]
+    if encoding not in IMAGE_ENCODINGS:
+        raise BagError(f'unsupported image encoding {encoding!r} (use {sorted(IMAGE_ENCODINGS)})')
+    channels, dtype = IMAGE_ENCODINGS[encoding]
+    itemsize = np.dtype(dtype).itemsize
     height, width, step = int(msg.height), int(msg.width), int(msg.step)
-    row = width * channels
+    row = width * channels * itemsize
     if step < row:
         raise BagError(f'image step {step} is shorter than a {encoding} row of {row} bytes')
     data = np.frombuffer(msg.data, dtype=np.uint8)
@@ -203,7 +219,31 @@ def image_array(msg: Any) -> np.ndarray:
             f'{step * height}'
         )
     rows = data.reshape(height, step)[:, :row]
+    if itemsize > 1:
+        order = '>' if msg.is_bigendian else '<'
+        samples = np.ascontiguousarray(rows).view(np.dtype(dtype).newbyteorder(order))
+        rows = samples.astype(dtype, copy=False)
     return rows.reshape(height, width) if channels == 1 else rows.reshape(height, width, channels)
+
+
+def compressed_image(ns: int, data: bytes, image_format: str, frame_id: str) -> Any:
+    """Builds a ``sensor_msgs/msg/CompressedImage``.
+
+    Args:
+        ns: Exposure time, ns.
+        data: The encoded image (the bytes of a JPEG or PNG file).
+        image_format: ``format`` as image_transport writes it, e.g. ``'jpeg'``, ``'png'`` or
+            ``'mono8; jpeg compressed mono8'``.
+        frame_id: The camera's optical frame.
+
+    Returns:
+        The message.
+    """
+    return message_class('sensor_msgs/msg/CompressedImage')(
+        header=header(ns, frame_id),
+        format=image_format,
+        data=np.frombuffer(bytes(data), dtype=np.uint8),
+    )
 
 
 @dataclass(frozen=True)

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any
 
 from lumpbeam_ros.bagio import BagReader, read_load_events, read_tip_poses
 from lumpbeam_ros.cli.output import write_json
+from lumpbeam_ros.cli.progress import Progress
 from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.ident.config import load_identifier_config
 from lumpbeam_ros.ident.identify import identify
@@ -49,43 +49,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(handler=run)
 
 
-class Progress:
-    """A one-line progress bar on a stream, drawn only when it is a TTY or the job is long.
-
-    Args:
-        total: Units of work expected.
-        label: What is being done.
-        stream: Where to draw (default ``sys.stderr``).
-        width: Characters of the bar.
-    """
-
-    def __init__(self, total: int, label: str, stream: TextIO | None = None, width: int = 30):
-        self.stream = stream or sys.stderr
-        self.total = max(int(total), 1)
-        self.label = label
-        self.width = width
-        self.done = 0
-        self._shown = -1
-        self.enabled = self.stream.isatty() or total > LONG_BAG_POSES
-
-    def tick(self, units: int = 1) -> None:
-        """Counts ``units`` of work; redraws at each whole per cent."""
-        self.done += units
-        percent = min(100, 100 * self.done // self.total)
-        if self.enabled and percent != self._shown:
-            self._shown = percent
-            filled = self.width * percent // 100
-            bar = '#' * filled + '.' * (self.width - filled)
-            self.stream.write(f'\r{self.label} [{bar}] {percent:3d}%')
-            self.stream.flush()
-
-    def close(self) -> None:
-        """Ends the line."""
-        if self.enabled and self._shown >= 0:
-            self.stream.write('\n')
-            self.stream.flush()
-
-
 class _CountingReader(BagReader):
     """A bag reader that ticks a progress bar per message it deserializes."""
 
@@ -114,7 +77,8 @@ def read_window(bag: str | Path) -> PoseWindow:
     if POSE_TOPIC not in reader.topics:
         have = ', '.join(sorted(reader.topics)) or 'no topics'
         raise BagError(f'{bag}: no {POSE_TOPIC} in the bag (it has {have})')
-    reader.progress = Progress(reader.topics[POSE_TOPIC].count, f'reading {POSE_TOPIC}')
+    count = reader.topics[POSE_TOPIC].count
+    reader.progress = Progress(count, f'reading {POSE_TOPIC}', long_job=LONG_BAG_POSES)
     try:
         poses = read_tip_poses(reader, POSE_TOPIC)
     finally:

@@ -16,8 +16,18 @@ same lines. A frame that gives no pose (board lost, bad encoding, wrong size, bl
 saturated, corrupt, no camera info yet) gives no message, a throttled warning and a count
 in the diagnostics; never a stale pose, never an exception out of a callback.
 
-With parameter ``bag_path`` the node reads the frames of a bag in-process instead
-(:meth:`CameraNode.run_bag`): as fast as it tracks, for rates a topic cannot carry.
+Instead of subscribing, the node can read frames in-process (as fast as it tracks, for rates
+a topic cannot carry): a bag with ``bag_path`` (:meth:`CameraNode.run_bag`; ``Image`` or
+``CompressedImage``), a video file or an image folder with ``footage_path`` and its stamps
+(``footage_fps`` or ``footage_timestamps``), or a live camera through OpenCV's capture API
+with ``video_device`` (a device index such as ``0``, a device path such as ``/dev/video2``,
+or any file or URL OpenCV opens; each frame is stamped with the node's clock when it
+arrives) (:meth:`CameraNode.run_footage`). The readers are the ROS-free ones of
+:mod:`lumpbeam_ros.vision.sources`, shared with ``lumpbeam track``.
+
+The intrinsics come from ``/camera/camera_info``, or from a ROS camera calibration file
+given as ``camera_info_url`` (``file:///path/camera.yaml``, as camera_info_manager takes it),
+or from the ``camera.*`` parameters with ``use_config_camera_info``.
 
 Parameters: the keys of ``config/camera.yaml`` (read-only), plus the node's own (see
 :data:`NODE_PARAMETERS`). Run it with ``camera_node --ros-args --params-file camera.yaml``.
@@ -46,12 +56,21 @@ from sensor_msgs.msg import Image
 
 from lumpbeam_ros.bagio import BagReader
 from lumpbeam_ros.bagio.convert import NS_PER_S, pitch_to_quaternion
-from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.paramfile import read_parameter_file
 from lumpbeam_ros.resources import config_path
+from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
 from lumpbeam_ros.vision.config import camera_config_from_parameters
-from lumpbeam_ros.vision.messages import decode_camera_info
+from lumpbeam_ros.vision.messages import IMAGE_TYPES, decode_camera_info
 from lumpbeam_ros.vision.session import TrackingSession
+from lumpbeam_ros.vision.sources import (
+    DeviceSource,
+    FolderSource,
+    FootageError,
+    FrameStamps,
+    VideoSource,
+    open_footage,
+)
 from lumpbeam_ros.vision.tracker import TrackResult
 
 #: The node's own parameters: name -> (default, description).
@@ -63,6 +82,26 @@ NODE_PARAMETERS: dict[str, tuple[Any, str]] = {
     'use_config_camera_info': (
         False,
         'track with the intrinsics of the camera.* parameters, without waiting for camera_info',
+    ),
+    'camera_info_url': (
+        '',
+        'ROS camera calibration YAML as file:///path.yaml: the intrinsics, without waiting '
+        'for camera_info (empty: off)',
+    ),
+    'footage_path': (
+        '',
+        'read frames from this video file or image folder in-process (empty: off)',
+    ),
+    'footage_fps': (0.0, 'frame rate stamping footage_path: t_i = footage_start_time_s + i / fps'),
+    'footage_start_time_s': (0.0, 'stamp of the first frame of footage_path with footage_fps, s'),
+    'footage_timestamps': (
+        '',
+        'timestamps file of footage_path instead of footage_fps: one stamp per line, s',
+    ),
+    'video_device': (
+        '',
+        'read a live camera through OpenCV: device index (0), device path or URL; frames are '
+        'stamped with the node clock on arrival (empty: off)',
     ),
     'diagnostics_period_s': (1.0, 'period of /diagnostics, s'),
     'warning_period_s': (2.0, 'at most one warning per kind of problem in this period, s'),
@@ -112,7 +151,12 @@ class CameraNode(Node):
         self.config = camera_config_from_parameters(values, 'camera_node parameters')
         self.frame_id = str(self._param('frame_id'))
         known = self.config.camera_info if self._param('use_config_camera_info') else None
+        url = str(self._param('camera_info_url'))
+        if url:
+            known = camera_info_from_url(url)
         self.session = TrackingSession(self.config, known)
+        #: Why the in-process source stopped early (empty: it did not).
+        self.source_problem = ''
         self._warning_period = float(self._param('warning_period_s'))
         self._last_warning: dict[str, float] = {}
         self._period_counts = (0, 0)
@@ -124,7 +168,9 @@ class CameraNode(Node):
         )
         self.diagnostics_publisher = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         self.bag_path = str(self._param('bag_path'))
-        if not self.bag_path:
+        self.footage_path = str(self._param('footage_path'))
+        self.video_device = str(self._param('video_device'))
+        if not self.in_process:
             # Raw: the bytes go to the same decoder as a bag's, without rclpy's copy.
             self.create_subscription(
                 Image, '/camera/image_raw', self.on_image, qos_profile_sensor_data, raw=True
@@ -166,6 +212,11 @@ class CameraNode(Node):
     def _param(self, name: str) -> Any:
         return self.get_parameter(name).value
 
+    @property
+    def in_process(self) -> bool:
+        """Whether frames are read in-process (a bag, footage or a device), not subscribed."""
+        return bool(self.bag_path or self.footage_path or self.video_device)
+
     # -- input ------------------------------------------------------------------------------
 
     def on_camera_info(self, data: bytes) -> None:
@@ -177,11 +228,14 @@ class CameraNode(Node):
         except LumpbeamError as exc:
             self.warn('camera_info', f'camera_info ignored: {exc}')
 
-    def on_image(self, data: bytes) -> None:
-        """Tracks one serialized image and publishes its pose."""
-        frame, result = self.session.process_message(data)
-        if frame is not None and result.ok:
-            self.publish_pose(frame.stamp_ns, result)
+    def on_image(self, data: bytes, msgtype: str = 'sensor_msgs/msg/Image') -> None:
+        """Tracks one serialized image (``Image`` or ``CompressedImage``), publishes its pose."""
+        frame, result = self.session.process_message(data, msgtype)
+        self._publish_or_warn(None if frame is None else frame.stamp_ns, result)
+
+    def _publish_or_warn(self, stamp_ns: int | None, result: TrackResult) -> None:
+        if stamp_ns is not None and result.ok:
+            self.publish_pose(stamp_ns, result)
         else:
             self.warn(result.status.value, f'no pose: {result.reason}')
 
@@ -199,14 +253,63 @@ class CameraNode(Node):
         reader = BagReader(self.bag_path)
         image_topic = str(self._param('bag_image_topic'))
         info_topic = str(self._param('bag_camera_info_topic'))
-        reader.require(image_topic, 'sensor_msgs/msg/Image')
+        msgtype = reader.require(image_topic).msgtype
+        if msgtype not in IMAGE_TYPES:
+            raise BagError(f'{reader.path}: topic {image_topic} has type {msgtype}, not an image')
         for raw in reader.iter_raw([image_topic, info_topic]):
             if should_stop():
                 break
             if raw.topic == info_topic:
                 self.on_camera_info(raw.data)
             else:
-                self.on_image(raw.data)
+                self.on_image(raw.data, msgtype)
+
+    def open_source(self) -> VideoSource | FolderSource | DeviceSource:
+        """Opens ``footage_path`` with its stamps, or ``video_device``.
+
+        Raises:
+            FootageError: No intrinsics, unreadable footage or device, no or too few stamps.
+        """
+        if self.session.camera_info is None:
+            raise FootageError(
+                'footage has no camera_info: set camera_info_url (or use_config_camera_info)'
+            )
+        if self.video_device:
+            return DeviceSource(self.video_device, lambda: self.get_clock().now().nanoseconds)
+        stamps = None
+        if self._param('footage_timestamps'):
+            stamps = FrameStamps.from_file(str(self._param('footage_timestamps')))
+        elif float(self._param('footage_fps')) > 0:
+            start = float(self._param('footage_start_time_s'))
+            stamps = FrameStamps.from_fps(float(self._param('footage_fps')), start)
+        return open_footage(self.footage_path, stamps, 'footage_fps or footage_timestamps')
+
+    def run_footage(self, should_stop: Callable[[], bool] = lambda: False) -> None:
+        """Tracks every frame of ``footage_path`` or ``video_device``, publishing the poses.
+
+        A frame that does not decode or has the wrong size is a lost frame (a throttled
+        warning, counted in the diagnostics); stamps that run out end the reading, with a
+        warning and an ERROR diagnostic.
+
+        Args:
+            should_stop: Polled between frames; ``True`` ends early.
+
+        Raises:
+            FootageError: The source cannot be opened (see :meth:`open_source`).
+        """
+        source = self.open_source()
+        try:
+            for frame in source:
+                if frame.pixels is None:
+                    result = self.session.reject(f'{frame.label}: {frame.problem}', frame.stamp)
+                else:
+                    result = self.session.process(frame.pixels, frame.stamp, frame.encoding)
+                self._publish_or_warn(frame.stamp_ns, result)
+                if should_stop():
+                    break
+        except FootageError as exc:
+            self.source_problem = str(exc)
+            self.warn('source', f'footage stopped: {exc}')
 
     # -- output -----------------------------------------------------------------------------
 
@@ -248,7 +351,9 @@ class CameraNode(Node):
         poses = stats.poses_out - self._period_counts[1]
         self._period_counts = (stats.frames_in, stats.poses_out)
         self._period_start = now
-        if frames == 0:
+        if self.source_problem:
+            level, message = DiagnosticStatus.ERROR, f'footage stopped: {self.source_problem}'
+        elif frames == 0:
             level, message = DiagnosticStatus.WARN, 'no images'
             if self.session.camera_info is None:
                 message = 'no images, no camera_info'
@@ -296,10 +401,19 @@ def main(args: Sequence[str] | None = None) -> int:
     node = None
     try:
         node = CameraNode()
-        if node.bag_path:
-            node.run_bag(lambda: not rclpy.ok())
+        if node.in_process:
+
+            def should_stop() -> bool:
+                rclpy.spin_once(node, timeout_sec=0.0)  # timers: /diagnostics keeps coming
+                return not rclpy.ok()
+
+            if node.bag_path:
+                node.run_bag(should_stop)
+            else:
+                node.run_footage(should_stop)
             s = node.session.stats
-            print(f'camera_node: {node.bag_path}: {s.frames_in} frames, {s.poses_out} poses')
+            name = node.bag_path or node.footage_path or f'video device {node.video_device}'
+            print(f'camera_node: {name}: {s.frames_in} frames, {s.poses_out} poses')
         else:
             rclpy.spin(node)
     except LumpbeamError as exc:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -9,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from lumpbeam_ros.errors import ConfigError
+from lumpbeam_ros.errors import ConfigError, LumpbeamError
 from lumpbeam_ros.paramfile import check_known_keys, get_float, get_int, read_parameter_file
 from lumpbeam_ros.resources import config_path
 from lumpbeam_ros.vision.board import Checkerboard
@@ -249,3 +251,50 @@ def load_camera_config(path: str | Path | None = None) -> CameraConfig:
     """
     path = config_path('camera.yaml') if path is None else Path(path)
     return camera_config_from_parameters(read_parameter_file(path), path)
+
+
+def parse_board(text: str) -> tuple[int, int]:
+    """Parses ``COLSxROWS``, the board's inner corners (e.g. ``8x6`` for 9 x 7 squares).
+
+    Raises:
+        LumpbeamError: Not two integers joined by ``x``, fewer than 2 either way, or a
+            square pattern (its orientation would be ambiguous).
+    """
+    match = re.fullmatch(r'\s*(\d+)\s*[xX]\s*(\d+)\s*', text)
+    if match is None:
+        raise LumpbeamError(f'--board {text!r}: expected COLSxROWS inner corners, e.g. 8x6')
+    cols, rows = int(match.group(1)), int(match.group(2))
+    if min(cols, rows) < 2:
+        raise LumpbeamError(f'--board {text!r}: need at least 2 inner corners each way')
+    if cols == rows:
+        raise LumpbeamError(f'--board {text!r}: columns and rows must differ')
+    return cols, rows
+
+
+def with_board(
+    config: CameraConfig,
+    inner_corners: tuple[int, int] | None = None,
+    square_size_m: float | None = None,
+) -> CameraConfig:
+    """Returns the configuration with another checkerboard (the rest of the rig unchanged).
+
+    Args:
+        config: The configuration.
+        inner_corners: ``(columns, rows)`` of inner corners (see :func:`parse_board`), or
+            ``None`` to keep the configured pattern.
+        square_size_m: The edge of one square, m, or ``None`` to keep it.
+
+    Returns:
+        The configuration.
+
+    Raises:
+        LumpbeamError: A square size that is not a positive finite number.
+    """
+    board = config.rig.board
+    if inner_corners is not None:
+        board = replace(board, squares_x=inner_corners[0] + 1, squares_y=inner_corners[1] + 1)
+    if square_size_m is not None:
+        if not (math.isfinite(square_size_m) and square_size_m > 0):
+            raise LumpbeamError(f'--square-m {square_size_m!r}: must be a positive length, m')
+        board = replace(board, square_size_m=float(square_size_m))
+    return replace(config, rig=replace(config.rig, board=board))

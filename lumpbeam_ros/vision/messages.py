@@ -15,10 +15,15 @@ import numpy as np
 
 from lumpbeam_ros.bagio import CameraInfoData, convert
 from lumpbeam_ros.bagio.typestore import deserialize
+from lumpbeam_ros.errors import BagError
 from lumpbeam_ros.vision.camera_model import CameraInfo
+from lumpbeam_ros.vision.sources.pixels import decode_compressed, tracker_pixels
 
 IMAGE_TYPE = 'sensor_msgs/msg/Image'
+COMPRESSED_IMAGE_TYPE = 'sensor_msgs/msg/CompressedImage'
 CAMERA_INFO_TYPE = 'sensor_msgs/msg/CameraInfo'
+#: The image message types the tracker reads.
+IMAGE_TYPES = (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE)
 
 
 class CameraFrame(NamedTuple):
@@ -26,7 +31,8 @@ class CameraFrame(NamedTuple):
 
     Attributes:
         stamp_ns: Header stamp, ns (exact: a pose carries it unchanged).
-        pixels: ``(h, w)`` for mono8, ``(h, w, 3)`` for bgr8/rgb8, uint8.
+        pixels: ``(h, w)`` for mono8, ``(h, w, 3)`` for bgr8/rgb8, uint8 (other encodings
+            are converted on decoding, see :mod:`lumpbeam_ros.vision.sources.pixels`).
         encoding: ``'mono8'``, ``'bgr8'`` or ``'rgb8'``.
         frame_id: The camera's optical frame.
     """
@@ -85,23 +91,51 @@ def camera_info_to_data(info: CameraInfo, frame_id: str = 'camera') -> CameraInf
 
 
 def decode_image(data: bytes | memoryview) -> CameraFrame:
-    """Decodes a serialized ``sensor_msgs/msg/Image``.
+    """Decodes a serialized ``sensor_msgs/msg/Image`` into tracker-ready pixels.
 
     Args:
         data: CDR bytes (a raw subscription's message, or a bag record).
 
     Returns:
-        The frame.
+        The frame; mono16 and Bayer images come out as mono8.
 
     Raises:
         BagError: Corrupt bytes, an unsupported encoding, or a data size that does not
             match ``step * height``.
     """
     msg = deserialize(data, IMAGE_TYPE)
-    pixels = convert.image_array(msg)
-    return CameraFrame(
-        convert.time_ns(msg.header.stamp), pixels, msg.encoding, msg.header.frame_id
-    )
+    pixels, encoding = tracker_pixels(convert.image_array(msg), msg.encoding)
+    return CameraFrame(convert.time_ns(msg.header.stamp), pixels, encoding, msg.header.frame_id)
+
+
+def decode_compressed_image(data: bytes | memoryview) -> CameraFrame:
+    """Decodes a serialized ``sensor_msgs/msg/CompressedImage`` (JPEG or PNG).
+
+    Args:
+        data: CDR bytes.
+
+    Returns:
+        The frame (mono8 for a grey image, bgr8 for a colour one).
+
+    Raises:
+        BagError: Corrupt bytes, a corrupt or truncated JPEG or PNG, or a depth image.
+    """
+    msg = deserialize(data, COMPRESSED_IMAGE_TYPE)
+    pixels, encoding = decode_compressed(msg.data, msg.format)
+    return CameraFrame(convert.time_ns(msg.header.stamp), pixels, encoding, msg.header.frame_id)
+
+
+def decode_frame(data: bytes | memoryview, msgtype: str = IMAGE_TYPE) -> CameraFrame:
+    """Decodes an image message of either type in :data:`IMAGE_TYPES`.
+
+    Raises:
+        BagError: As :func:`decode_image` or :func:`decode_compressed_image`, or another type.
+    """
+    if msgtype == COMPRESSED_IMAGE_TYPE:
+        return decode_compressed_image(data)
+    if msgtype == IMAGE_TYPE:
+        return decode_image(data)
+    raise BagError(f'{msgtype} is not an image type ({", ".join(IMAGE_TYPES)})')
 
 
 def decode_camera_info(data: bytes | memoryview) -> CameraInfo:

@@ -1,17 +1,26 @@
-"""The camera pipeline over a bag, offline: ``lumpbeam track BAG OUT`` (SPEC section 5).
+"""The camera pipeline over recorded footage, offline: ``lumpbeam track SRC OUT``.
 
-OUT is a copy of BAG plus ``/tip_pose``: every other topic is copied as its stored CDR bytes
-(never decoded), with its type, definition and offered QoS; the images are tracked on the
-way and each pose is written right after its image, stamped with the image's stamp and
-logged at the image's log time. A ``/tip_pose`` already in BAG is replaced by the tracked
-one (the summary says so). The frames go through the same
-:class:`~lumpbeam_ros.vision.session.TrackingSession` as the camera node's.
+From a bag (:func:`track_bag`), OUT is a copy of it plus ``/tip_pose``: every other topic is
+copied as its stored CDR bytes (never decoded), with its type, definition and offered QoS;
+the images (``sensor_msgs/Image`` or ``sensor_msgs/CompressedImage``) are tracked on the way
+and each pose is written right after its image, stamped with the image's stamp and logged at
+the image's log time. A ``/tip_pose`` already in the bag is replaced by the tracked one (the
+summary says so). From a video or an image folder (:func:`track_footage`), OUT holds
+``/tip_pose`` and the ``/camera/camera_info`` used, stamped as the footage's stamps say.
+The frames go through the same :class:`~lumpbeam_ros.vision.session.TrackingSession` as the
+camera node's.
+
+A frame that does not decode is a lost frame (counted, and the first of each kind named in
+the summary); an image whose size is not the camera's stops the run with an error, and OUT,
+incomplete, is removed.
 """
 
 from __future__ import annotations
 
+import shutil
 import time
 from collections import Counter
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -22,14 +31,26 @@ from lumpbeam_ros.bagio import BagReader, BagWriter, convert, read_camera_info, 
 from lumpbeam_ros.bagio.qos import from_dict
 from lumpbeam_ros.bagio.typestore import is_known
 from lumpbeam_ros.errors import BagError, LumpbeamError
+from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import CameraConfig
-from lumpbeam_ros.vision.messages import camera_info_from_data, decode_camera_info
+from lumpbeam_ros.vision.messages import (
+    IMAGE_TYPES,
+    camera_info_from_data,
+    camera_info_to_data,
+    decode_camera_info,
+    decode_frame,
+)
 from lumpbeam_ros.vision.session import TrackingSession
+from lumpbeam_ros.vision.sources import FootageError, FootageFrame
 
 POSE_TOPIC = '/tip_pose'
 TRUTH_TOPIC = '/tip_pose_truth'
 IMAGE_TOPIC = '/camera/image_raw'
+COMPRESSED_IMAGE_TOPIC = '/camera/image_raw/compressed'
 CAMERA_INFO_TOPIC = '/camera/camera_info'
+
+#: Called after each frame with the frames done and the frames expected (``None``: unknown).
+ProgressCallback = Callable[[int, 'int | None'], None]
 
 
 @dataclass
@@ -47,6 +68,8 @@ class TrackSummary:
         pitch_rms_mrad: RMS error of the pitch against the truth, mrad (NaN without).
         z_bias_um: Mean z error against the truth, um (NaN without).
         compared: Poses matched to a truth sample by stamp.
+        first_problems: For each kind of lost frame, the first one: which frame and why.
+        image_topic: The bag topic tracked (empty for footage).
     """
 
     frames: int = 0
@@ -59,6 +82,8 @@ class TrackSummary:
     pitch_rms_mrad: float = float('nan')
     z_bias_um: float = float('nan')
     compared: int = 0
+    first_problems: dict[str, str] = field(default_factory=dict)
+    image_topic: str = ''
 
     @property
     def lost(self) -> int:
@@ -122,68 +147,271 @@ def _compare_with_truth(out: Path, summary: TrackSummary) -> None:
     summary.pitch_rms_mrad = float(np.sqrt(np.mean(dpitch**2)) * 1e3)
 
 
+def _choose_image_topic(reader: BagReader, image_topic: str | None) -> str:
+    """The topic to track: the one asked for, else the camera's raw or compressed images."""
+    images = {n: e for n, e in reader.topics.items() if e.msgtype in IMAGE_TYPES}
+    if image_topic is not None:
+        entry = reader.require(image_topic)
+        if entry.msgtype not in IMAGE_TYPES:
+            raise BagError(
+                f'{reader.path}: topic {image_topic} has type {entry.msgtype}, not an image '
+                f'({", ".join(IMAGE_TYPES)})'
+            )
+        return image_topic
+    for preferred in (IMAGE_TOPIC, COMPRESSED_IMAGE_TOPIC):
+        if preferred in images:
+            return preferred
+    if len(images) == 1:
+        return next(iter(images))
+    listed = ', '.join(sorted(images)) if images else 'none'
+    raise BagError(
+        f'{reader.path}: no topic {IMAGE_TOPIC} (image topics: {listed}; choose one with '
+        f'--image-topic)'
+    )
+
+
+def _check_size(pixels: object, info: CameraInfo, label: str, info_source: str) -> None:
+    """Stops the run on an image whose size is not the camera's.
+
+    Raises:
+        FootageError: The size differs (mixed sizes, or a calibration of another camera).
+    """
+    height, width = getattr(pixels, 'shape', (0, 0))[:2]
+    if (width, height) != (info.width, info.height):
+        raise FootageError(
+            f'{label}: image is {width} x {height} px but the camera info ({info_source}) '
+            f'is {info.width} x {info.height} px'
+        )
+
+
+class _Run:
+    """One tracking run: the session, the pose output, the tally and the progress.
+
+    Args:
+        session: The tracking session (with its intrinsics).
+        writer: OUT; ``/tip_pose`` is declared on it.
+        source: The input, for messages.
+        info_source: Where the intrinsics came from, for messages.
+        total: Frames expected (``None``: unknown).
+        progress: Called after each frame.
+    """
+
+    def __init__(
+        self,
+        session: TrackingSession,
+        writer: BagWriter,
+        source: str,
+        info_source: str,
+        total: int | None,
+        progress: ProgressCallback | None,
+    ):
+        self.session = session
+        self.writer = writer
+        self.source = source
+        self.info_source = info_source
+        self.total = total
+        self.progress = progress
+        self.summary = TrackSummary()
+        self.tracking_s = 0.0
+        self.done = 0
+        writer.add_topic(POSE_TOPIC, 'geometry_msgs/msg/PoseStamped')
+
+    def track(
+        self, label: str, stamp_ns: int, pixels: object, encoding: str, log_time_ns: int
+    ) -> None:
+        """Tracks one decoded frame and writes its pose.
+
+        Raises:
+            FootageError: The image's size is not the camera's.
+        """
+        info = self.session.camera_info
+        if info is not None:
+            _check_size(pixels, info, label, self.info_source)
+        start = time.perf_counter()
+        result = self.session.process(pixels, convert.ns_to_seconds(stamp_ns), encoding)
+        self.tracking_s += time.perf_counter() - start
+        if result.ok:
+            x, z, pitch = (float(v) for v in result.pose)
+            msg = convert.pose_stamped(stamp_ns, x, z, pitch, 'beam_base')
+            self.writer.write_message(POSE_TOPIC, msg, log_time_ns)
+        else:
+            self._note(label, result.status.value, result.reason)
+        self._tick()
+
+    def reject(self, label: str, reason: str) -> None:
+        """Counts a frame that did not decode."""
+        self.session.reject(reason)
+        self._note(label, 'bad_image', reason)
+        self._tick()
+
+    def finish(self) -> TrackSummary:
+        """Fills in the summary.
+
+        Raises:
+            FootageError: Not one frame was read.
+        """
+        stats, summary = self.session.stats, self.summary
+        if stats.frames_in == 0:
+            raise FootageError(f'{self.source}: no frames at all')
+        summary.frames, summary.poses = stats.frames_in, stats.poses_out
+        summary.lost_by_reason = dict(Counter(stats.lost))
+        summary.fps = stats.frames_in / self.tracking_s if self.tracking_s > 0 else float('nan')
+        return summary
+
+    def _note(self, label: str, status: str, reason: str) -> None:
+        self.summary.first_problems.setdefault(status, f'{label}: {reason or status}')
+
+    def _tick(self) -> None:
+        self.done += 1
+        if self.progress is not None:
+            self.progress(self.done, self.total)
+
+
+def _removing_on_error(out: Path, write: Callable[[], TrackSummary]) -> TrackSummary:
+    """Runs ``write``; when the input turns out unusable, removes the incomplete OUT."""
+    try:
+        return write()
+    except LumpbeamError:
+        shutil.rmtree(out, ignore_errors=True)
+        raise
+
+
 def track_bag(
     bag: str | Path,
     out: str | Path,
     config: CameraConfig,
-    image_topic: str = IMAGE_TOPIC,
+    image_topic: str | None = None,
     camera_info_topic: str = CAMERA_INFO_TOPIC,
+    camera_info: CameraInfo | None = None,
+    camera_info_source: str = '',
+    progress: ProgressCallback | None = None,
 ) -> TrackSummary:
     """Tracks a bag's images and writes OUT = BAG + ``/tip_pose``.
 
     Args:
         bag: The input bag folder.
         out: The bag folder to create (must not exist).
-        config: Rig geometry and tracker settings; the intrinsics come from the bag.
-        image_topic: The images to track.
-        camera_info_topic: The camera's calibration (the first message is used, and any
-            later change is followed).
+        config: Rig geometry and tracker settings.
+        image_topic: The images to track (``Image`` or ``CompressedImage``); ``None``
+            takes ``/camera/image_raw``, else ``/camera/image_raw/compressed``, else the
+            bag's only image topic.
+        camera_info_topic: The camera's calibration in the bag (the first message is used,
+            and any later change is followed); not needed with ``camera_info``.
+        camera_info: Intrinsics to use instead of the bag's (e.g. from a calibration file).
+        camera_info_source: Where ``camera_info`` came from, for messages.
+        progress: Called after each image.
 
     Returns:
         The summary.
 
     Raises:
         BagError: OUT exists; BAG is not a bag, has no images or no camera info.
+        FootageError: An image of another size than the camera info says.
         LumpbeamError: The camera info is unusable (e.g. K = 0).
     """
     out = Path(out)
     if out.exists():
         raise BagError(f'{out} exists already; a bag is never overwritten')
     reader = BagReader(bag)
-    images = reader.require(image_topic, 'sensor_msgs/msg/Image')
-    if images.count == 0:
+    image_topic = _choose_image_topic(reader, image_topic)
+    entry = reader.topics[image_topic]
+    if entry.count == 0:
         raise BagError(f'{reader.path}: topic {image_topic} has no images')
-    reader.require(camera_info_topic, 'sensor_msgs/msg/CameraInfo')
-    info = camera_info_from_data(read_camera_info(reader, camera_info_topic))
-    session = TrackingSession(config, info)
-    summary = TrackSummary()
-    tracking_s = 0.0
-    with BagWriter(out) as writer:
-        copied = _declare_copies(reader, writer, summary)
-        writer.add_topic(POSE_TOPIC, 'geometry_msgs/msg/PoseStamped')
-        for raw in reader.iter_raw():
-            if raw.topic == POSE_TOPIC:
-                summary.replaced_poses += 1
-                continue
-            if raw.topic in copied:
-                writer.write_raw(raw.topic, raw.log_time_ns, raw.data)
-            if raw.topic == camera_info_topic:
-                try:
-                    session.set_camera_info(decode_camera_info(raw.data))
-                except LumpbeamError:
-                    pass  # a bad calibration message: keep the one in use
-            elif raw.topic == image_topic:
-                start = time.perf_counter()
-                frame, result = session.process_message(raw.data)
-                tracking_s += time.perf_counter() - start
-                if frame is not None and result.ok:
-                    x, z, pitch = (float(v) for v in result.pose)
-                    msg = convert.pose_stamped(frame.stamp_ns, x, z, pitch, 'beam_base')
-                    writer.write_message(POSE_TOPIC, msg, raw.log_time_ns)
-    stats = session.stats
-    summary.frames, summary.poses = stats.frames_in, stats.poses_out
-    summary.lost_by_reason = dict(Counter(stats.lost))
-    summary.fps = stats.frames_in / tracking_s if tracking_s > 0 else float('nan')
+    follow_info = camera_info is None
+    if camera_info is None:
+        reader.require(camera_info_topic, 'sensor_msgs/msg/CameraInfo')
+        data = read_camera_info(reader, camera_info_topic)
+        try:
+            camera_info = camera_info_from_data(data)
+        except LumpbeamError as exc:
+            raise BagError(f'{reader.path}: {camera_info_topic}: {exc}') from None
+        camera_info_source = f'{camera_info_topic} of {reader.path}'
+    session = TrackingSession(config, camera_info)
+
+    def write() -> TrackSummary:
+        with BagWriter(out) as writer:
+            name = str(reader.path)
+            run = _Run(session, writer, name, camera_info_source, entry.count, progress)
+            copied = _declare_copies(reader, writer, run.summary)
+            index = 0
+            for raw in reader.iter_raw():
+                if raw.topic == POSE_TOPIC:
+                    run.summary.replaced_poses += 1
+                    continue
+                if raw.topic in copied:
+                    writer.write_raw(raw.topic, raw.log_time_ns, raw.data)
+                if raw.topic == camera_info_topic and follow_info:
+                    try:
+                        session.set_camera_info(decode_camera_info(raw.data))
+                    except LumpbeamError:
+                        pass  # a bad calibration message: keep the one in use
+                elif raw.topic == image_topic:
+                    label = f'{reader.path} {image_topic} message {index}'
+                    index += 1
+                    try:
+                        frame = decode_frame(raw.data, entry.msgtype)
+                    except LumpbeamError as exc:
+                        run.reject(label, str(exc))
+                        continue
+                    run.track(label, frame.stamp_ns, frame.pixels, frame.encoding, raw.log_time_ns)
+        return run.finish()
+
+    summary = _removing_on_error(out, write)
+    summary.image_topic = image_topic
     if TRUTH_TOPIC in reader.topics and summary.poses:
         _compare_with_truth(out, summary)
     return summary
+
+
+def track_footage(
+    frames: Iterable[FootageFrame],
+    out: str | Path,
+    config: CameraConfig,
+    camera_info: CameraInfo,
+    source: str,
+    camera_info_source: str,
+    total: int | None = None,
+    progress: ProgressCallback | None = None,
+) -> TrackSummary:
+    """Tracks a video's or an image folder's frames into OUT: ``/tip_pose`` and the intrinsics.
+
+    Args:
+        frames: The footage (a :mod:`~lumpbeam_ros.vision.sources` reader).
+        out: The bag folder to create (must not exist).
+        config: Rig geometry and tracker settings.
+        camera_info: The intrinsics (written once to ``/camera/camera_info``, at the first
+            frame's stamp).
+        source: The footage, for messages.
+        camera_info_source: Where the intrinsics came from, for messages.
+        total: Frames expected, for the progress (``None``: unknown).
+        progress: Called after each frame.
+
+    Returns:
+        The summary.
+
+    Raises:
+        BagError: OUT exists.
+        FootageError: An image of another size than the camera's, stamps that run out
+            before the footage, no frame at all.
+        LumpbeamError: The intrinsics do not fit the configuration.
+    """
+    out = Path(out)
+    if out.exists():
+        raise BagError(f'{out} exists already; a bag is never overwritten')
+    session = TrackingSession(config, camera_info)
+
+    def write() -> TrackSummary:
+        with BagWriter(out) as writer:
+            run = _Run(session, writer, source, camera_info_source, total, progress)
+            for frame in frames:
+                if frame.index == 0:
+                    info = convert.camera_info(frame.stamp_ns, camera_info_to_data(camera_info))
+                    writer.write_message(CAMERA_INFO_TOPIC, info, frame.stamp_ns)
+                if frame.pixels is None:
+                    run.reject(frame.label, frame.problem)
+                else:
+                    run.track(frame.label, frame.stamp_ns, frame.pixels, frame.encoding,
+                              frame.stamp_ns)  # fmt: skip
+        return run.finish()
+
+    return _removing_on_error(out, write)

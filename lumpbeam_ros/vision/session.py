@@ -17,7 +17,7 @@ import numpy as np
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import CameraConfig
-from lumpbeam_ros.vision.messages import CameraFrame, decode_image
+from lumpbeam_ros.vision.messages import IMAGE_TYPE, CameraFrame, decode_frame
 from lumpbeam_ros.vision.tracker import TipTracker, TrackResult, TrackStatus
 
 
@@ -124,11 +124,14 @@ class TrackingSession:
             result = self._tracker.process(pixels, stamp, encoding)
         return self._count(result)
 
-    def process_message(self, data: bytes | memoryview) -> tuple[CameraFrame | None, TrackResult]:
-        """Decodes a serialized ``sensor_msgs/msg/Image`` and tracks it.
+    def process_message(
+        self, data: bytes | memoryview, msgtype: str = IMAGE_TYPE
+    ) -> tuple[CameraFrame | None, TrackResult]:
+        """Decodes a serialized image message and tracks it.
 
         Args:
             data: CDR bytes.
+            msgtype: ``sensor_msgs/msg/Image`` or ``sensor_msgs/msg/CompressedImage``.
 
         Returns:
             The decoded frame (``None`` when undecodable; its ``stamp_ns`` is what a pose
@@ -136,10 +139,22 @@ class TrackingSession:
             ``BAD_IMAGE`` result.
         """
         try:
-            frame = decode_image(data)
+            frame = decode_frame(data, msgtype)
         except LumpbeamError as exc:
-            return None, self._count(TrackResult(math.nan, TrackStatus.BAD_IMAGE, str(exc)))
+            return None, self.reject(str(exc))
         return frame, self.process(frame.pixels, frame.stamp, frame.encoding)
+
+    def reject(self, reason: str, stamp: float = math.nan) -> TrackResult:
+        """Counts a frame that could not be decoded (a ``BAD_IMAGE`` result).
+
+        Args:
+            reason: One line: what was wrong with it.
+            stamp: Its stamp when known, s.
+
+        Returns:
+            The result.
+        """
+        return self._count(TrackResult(stamp, TrackStatus.BAD_IMAGE, reason))
 
     def _count(self, result: TrackResult) -> TrackResult:
         stats = self.stats

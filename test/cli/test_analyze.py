@@ -1,11 +1,10 @@
-import io
 import json
 import shutil
 
 import pytest
 
 from lumpbeam_ros.bagio import BagWriter
-from lumpbeam_ros.cli.analyze import SPEC_KEYS, Progress
+from lumpbeam_ros.cli.analyze import SPEC_KEYS
 from lumpbeam_ros.cli.main import main
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.modes import chain_modes
@@ -123,16 +122,3 @@ def test_bad_identifier_config_is_one_line(drop_bag, tmp_path, capsys):
     bad.write_text('/**:\n  ros__parameters:\n    fit:\n      max_modes: 7\n')
     assert main(['analyze', str(drop_bag), '--identifier-config', str(bad)]) == 2
     assert 'fit.max_modes: must be 1 or 2' in _error_line(capsys)
-
-
-@pytest.mark.parametrize(('total', 'shown'), [(10, False), (300_000, True)])
-def test_progress_bar_only_for_a_tty_or_a_long_job(total, shown):
-    stream = io.StringIO()
-    bar = Progress(total, 'reading', stream=stream, width=10)
-    for _ in range(total // 2):
-        bar.tick()
-    bar.close()
-    text = stream.getvalue()
-    assert bool(text) == shown
-    if shown:
-        assert text.endswith(' 50%\n') and '#####.....' in text

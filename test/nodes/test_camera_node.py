@@ -1,9 +1,11 @@
 import subprocess
 import sys
 
+import cv2
 import numpy as np
 import pytest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from footage import write_calibration, write_video
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
 from harness import SENSOR_QOS, ros_env
 from rclpy.parameter import Parameter
@@ -18,6 +20,7 @@ from lumpbeam_ros.nodes.camera_node import CameraNode
 from lumpbeam_ros.vision.accuracy import drop_test_trajectory, render_frames
 from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.vision.messages import camera_info_to_data
+from lumpbeam_ros.vision.sources import FootageError
 
 WIDTH, HEIGHT = 640, 480
 #: Image stamps far from zero: a float second there cannot carry every nanosecond.
@@ -225,3 +228,116 @@ def test_main_reads_a_bag_with_a_params_file_and_rejects_a_missing_bag(
     assert missing.returncode == 2
     assert missing.stderr.strip().startswith('camera_node: error:')
     assert len(missing.stderr.strip().splitlines()) == 1
+
+
+# -- in-process footage: a video, an image folder, a capture device ------------------------
+
+
+def _footage_node(ros_graph, **parameters):
+    overrides = [Parameter(name, value=value) for name, value in parameters.items()]
+    node = CameraNode(context=ros_graph.context, parameter_overrides=overrides)
+    ros_graph.add_node(node)
+    ros_graph.spin_until(lambda: node.pose_publisher.get_subscription_count() >= 1, 5.0)
+    return node
+
+
+@pytest.fixture
+def calibration_url(tmp_path):
+    info = load_camera_config().with_resolution(WIDTH, HEIGHT).camera_info
+    return f'file://{write_calibration(tmp_path / "camera.yaml", info)}'
+
+
+def test_a_video_with_a_calibration_file_in_process(ros_graph, frames, tmp_path, calibration_url):
+    video = write_video(tmp_path / 'clip.mkv', [f.image for f in frames], 'FFV1')
+    poses = ros_graph.collect('/tip_pose', PoseStamped, QoSProfile(depth=100))
+    node = _footage_node(
+        ros_graph, footage_path=str(video), footage_fps=180.0, footage_start_time_s=1.95,
+        camera_info_url=calibration_url,
+    )  # fmt: skip
+    node.run_footage()
+    assert (node.session.stats.frames_in, node.session.stats.poses_out) == (12, 12)
+    assert ros_graph.spin_until(lambda: len(poses) == len(frames), 5.0)
+    for i, (pose, frame) in enumerate(zip(poses, frames, strict=True)):
+        stamp_ns, x, z, pitch, _ = convert.pose_values(pose)
+        assert stamp_ns == 1_950_000_000 + round(i * 1e9 / 180)
+        assert abs(z - frame.truth[1]) < 20e-6 and abs(pitch - frame.truth[2]) < 1e-4
+
+
+def test_a_video_device_goes_through_opencv_capture(ros_graph, frames, tmp_path, calibration_url):
+    """A video file given as the device takes the live path: stamped by the node's clock."""
+    video = write_video(tmp_path / 'clip.avi', [f.image for f in frames], 'MJPG')
+    poses = ros_graph.collect('/tip_pose', PoseStamped, QoSProfile(depth=100))
+    node = _footage_node(ros_graph, video_device=str(video), camera_info_url=calibration_url)
+    before = node.get_clock().now().nanoseconds
+    node.run_footage()
+    after = node.get_clock().now().nanoseconds
+    assert node.session.stats.poses_out == len(frames)
+    assert ros_graph.spin_until(lambda: len(poses) == len(frames), 5.0)
+    stamps = [convert.pose_values(p)[0] for p in poses]
+    assert before <= stamps[0] and stamps == sorted(stamps) and stamps[-1] <= after
+    assert all(abs(convert.pose_values(p)[2] - f.truth[1]) < 30e-6 for p, f in
+               zip(poses, frames, strict=True))  # fmt: skip
+
+
+def test_bad_footage_frames_give_warnings_and_a_diagnostic(
+    ros_graph, frames, tmp_path, calibration_url
+):
+    folder = tmp_path / 'frames'
+    folder.mkdir()
+    for i, frame in enumerate(frames[:6]):
+        cv2.imwrite(str(folder / f'{i:03d}.png'), frame.image)
+    (folder / '002.png').write_bytes(b'\x89PNG\r\n\x1a\n broken')  # a corrupt file
+    cv2.imwrite(str(folder / '004.png'), cv2.resize(frames[4].image, (320, 240)))  # mixed sizes
+    poses = ros_graph.collect('/tip_pose', PoseStamped, QoSProfile(depth=100))
+    node = _footage_node(
+        ros_graph, footage_path=str(folder), footage_fps=30.0, camera_info_url=calibration_url
+    )
+    node.run_footage()
+    stats = node.session.stats
+    assert (stats.frames_in, stats.poses_out, stats.lost['bad_image']) == (6, 4, 2)
+    assert ros_graph.spin_until(lambda: len(poses) == 4, 5.0)
+    ros_graph.spin_for(0.2)
+    assert len(poses) == 4  # nothing for the two bad frames
+    stamps = [convert.pose_values(p)[0] for p in poses]
+    assert stamps == [round(i * 1e9 / 30) for i in (0, 1, 3, 5)]
+    status = node.diagnostic_status()
+    values = {kv.key: kv.value for kv in status.values}
+    assert status.level == DiagnosticStatus.WARN and values['lost_bad_image'] == '2'
+    # The last lost frame, 004.png, is the one of another size.
+    assert 'does not match the camera (640 x 480)' in values['last_reason']
+
+
+@pytest.mark.parametrize(
+    ('parameters', 'error', 'match'),
+    [
+        ({'camera_info_url': 'file:///nonexistent/cam.yaml'}, ConfigError, 'cannot read'),
+        ({'camera_info_url': 'package://x/cam.yaml'}, ConfigError, 'package://'),
+        ({'footage_path': 'clip.avi'}, FootageError, 'set camera_info_url'),
+    ],
+)
+def test_bad_calibration_or_footage_parameters_are_refused(ros_graph, parameters, error, match):
+    with pytest.raises(error, match=match):
+        node = _footage_node(ros_graph, **parameters)
+        node.run_footage()
+
+
+def test_a_calibration_with_an_unsupported_model_is_refused(ros_graph, tmp_path):
+    info = load_camera_config().with_resolution(WIDTH, HEIGHT).camera_info
+    path = write_calibration(tmp_path / 'fisheye.yaml', info, model='kannala_brandt_x')
+    with pytest.raises(ConfigError, match='fisheye.yaml: camera info:.*kannala_brandt_x'):
+        _footage_node(ros_graph, camera_info_url=f'file://{path}')
+
+
+def test_main_refuses_unreadable_footage_in_one_line(ros_graph, tmp_path, calibration_url):
+    (tmp_path / 'clip.avi').write_text('not a video')
+    env = ros_env(ros_graph.domain_id)
+    done = subprocess.run(
+        [sys.executable, '-m', 'lumpbeam_ros.nodes.camera_node', '--ros-args',
+         '-p', f'footage_path:={tmp_path / "clip.avi"}', '-p', 'footage_fps:=30.0',
+         '-p', f'camera_info_url:={calibration_url}'],
+        env=env, capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert done.returncode == 2
+    err = done.stderr.strip()
+    assert err.startswith('camera_node: error:') and len(err.splitlines()) == 1
+    assert 'clip.avi: OpenCV cannot open it as a video' in err
