@@ -44,6 +44,10 @@ MAX_SADDLE_MISFIT = 0.08
 #: See :data:`MAX_SADDLE_MISFIT`.
 MISFIT_MEDIANS = 2.5
 
+#: ... but never beyond this: in a frame of pure noise the median misfit is above 1, and
+#: a loose limit would let a few noise pixels pass for corners.
+MISFIT_CEILING = 0.25
+
 #: The saddle check's window reaches this far beyond the refinement's, px: an occluder
 #: at the edge of the refinement window, where ``cornerSubPix`` still reads it, needs
 #: pixels around it to show in the misfit.
@@ -256,6 +260,7 @@ def select_corners(
     pattern_size: tuple[int, int],
     radius: int,
     min_contrast_dn: float,
+    polarity: float | None = None,
 ) -> CornerSelection:
     """Keeps the refined corners that pass the saddle check (before the residual check).
 
@@ -268,6 +273,8 @@ def select_corners(
         radius: The refinement window's half-size, px (the check reads
             :data:`CHECK_MARGIN_PX` more).
         min_contrast_dn: Least light-dark difference at a corner, DN.
+        polarity: The board's colour order (:func:`board_polarity` of a whole view), or
+            ``None`` to take the majority's. A labelling one square off flips it.
 
     Returns:
         The selection (``outliers`` is 0: see :func:`reject_outliers`).
@@ -282,8 +289,45 @@ def select_corners(
     )
     signed = amplitude * corner_parity(pattern_size)[found]
     # The board's colour order (dark or light square at corner 0) from the majority.
-    polarity = 1.0 if np.median(signed) >= 0 else -1.0
-    limit = max(MAX_SADDLE_MISFIT, MISFIT_MEDIANS * float(np.median(misfit)))
+    if polarity is None:
+        polarity = 1.0 if np.median(signed) >= 0 else -1.0
+    limit = min(max(MAX_SADDLE_MISFIT, MISFIT_MEDIANS * float(np.median(misfit))), MISFIT_CEILING)
     good = (signed * polarity >= min_contrast_dn / 2.0) & (misfit <= limit)
     mask[np.flatnonzero(found)[good]] = True
     return CornerSelection(mask, int(np.count_nonzero(~found)), int(np.count_nonzero(~good)), 0)
+
+
+def board_polarity(
+    image: np.ndarray, corners: np.ndarray, pattern_size: tuple[int, int], radius: int
+) -> float:
+    """The board's colour order in a view of the whole board: +1 or -1.
+
+    Args:
+        image: Grey image.
+        corners: All corners (N x 2, finite), in board order.
+        pattern_size: ``(corners per row, rows)``.
+        radius: The refinement window's half-size, px.
+
+    Returns:
+        The sign of corner 0's saddle amplitude, by the majority of all corners.
+    """
+    along_x, along_y = grid_axes(corners, pattern_size)
+    amplitude, _ = saddle_fit(image, corners, along_x, along_y, radius + CHECK_MARGIN_PX)
+    return 1.0 if np.median(amplitude * corner_parity(pattern_size)) >= 0 else -1.0
+
+
+def labelling_is_unambiguous(count: int, pattern_size: tuple[int, int]) -> bool:
+    """Whether so many corners were found that the grid cannot be one square off.
+
+    A labelling shifted by a square leaves a whole row or column of predictions over the
+    board's blank margin, so it finds at most ``N - min(cols, rows)`` corners.
+
+    Args:
+        count: Corners found and verified.
+        pattern_size: ``(corners per row, rows)``.
+
+    Returns:
+        Whether ``count`` exceeds what any shifted labelling could find.
+    """
+    cols, rows = pattern_size
+    return count > cols * rows - min(cols, rows)

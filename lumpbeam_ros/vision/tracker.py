@@ -39,7 +39,13 @@ from lumpbeam_ros.vision.free_pose import (
     free_pose_from_board_pose,
     planar_part,
 )
-from lumpbeam_ros.vision.partial import coverage_problem, reject_outliers, select_corners
+from lumpbeam_ros.vision.partial import (
+    board_polarity,
+    coverage_problem,
+    labelling_is_unambiguous,
+    reject_outliers,
+    select_corners,
+)
 from lumpbeam_ros.vision.pose import (
     PlaneFit,
     PlaneModel,
@@ -181,6 +187,10 @@ class TipTracker:
     def reset(self) -> None:
         """Forgets the tracking history (the next frame runs full detection)."""
         self._history: list[tuple[float, np.ndarray, np.ndarray]] = []
+        # How far the last tracked frame's corners were from their prediction, px (infinite
+        # after a detection): a partial view is trusted only after a close prediction.
+        self._prediction_error = math.inf
+        self._polarity: float | None = None
 
     def process(self, image: np.ndarray, stamp: float, encoding: str = 'mono8') -> TrackResult:
         """Measures the tip pose in one frame.
@@ -319,9 +329,10 @@ class TipTracker:
     ) -> tuple[TrackResult | None, str]:
         """Tracks from predicted corners, with those seen; the reason when too few are."""
         corners = refine_corners(gray, guess, self._half_window)
+        pattern = self._board.pattern_size
         selection = select_corners(
-            gray, corners, guess, self._board.pattern_size, self._half_window,
-            self.settings.min_contrast_dn,
+            gray, corners, guess, pattern, self._half_window, self.settings.min_contrast_dn,
+            self._polarity,
         )  # fmt: skip
         ideal = np.full_like(corners, np.nan)
         ideal[selection.mask] = self.camera_info.undistort_pixels(corners[selection.mask])
@@ -332,13 +343,25 @@ class TipTracker:
             self.settings.min_corner_spread, self._board.square_size_m,
         )  # fmt: skip
         if shortage:
-            return None, f'{shortage} ({selection.describe()})'
+            # With no corner at all where the board should be, it is not a partial view.
+            return None, f'{shortage} ({selection.describe()})' if mask.any() else ''
+        error = float(np.median(np.linalg.norm(corners[mask] - guess[mask], axis=1)))
+        if not labelling_is_unambiguous(int(mask.sum()), pattern) and not (
+            self._prediction_error <= self._half_window / 2
+        ):
+            # Few corners after a poor prediction may be neighbours caught one square off.
+            return None, (
+                f'partial view ({selection.describe()}) right after a detection or a poor '
+                f'prediction ({self._prediction_error:.1f} px)'
+            )
         ideal[~mask] = np.nan
         corners = np.where(mask[:, None], corners, np.nan)
         fit, _ = self._fit(ideal, pose_guess)
         if fit is None:
             return None, ''
-        return self._accept(stamp, corners, ideal, fit, detected=False), ''
+        result = self._accept(stamp, corners, ideal, fit, detected=False)
+        self._prediction_error = error
+        return result, ''
 
     def _track(self, gray: np.ndarray, stamp: float) -> TrackResult:
         prediction = self._predict(stamp)
@@ -382,6 +405,8 @@ class TipTracker:
             )  # fmt: skip
         if self._window_from_detection:
             self._half_window = self._window_for(corners)
+        self._polarity = board_polarity(gray, corners, self._board.pattern_size, self._half_window)
+        self._prediction_error = math.inf
         if self.pose_model == 'free':
             initial = free_pose_from_board_pose(self._model.rig, camera_board)
         else:
