@@ -8,6 +8,7 @@ from typing import Any
 
 from lumpbeam_ros.cli.output import write_json
 from lumpbeam_ros.vision.config import load_camera_config
+from lumpbeam_ros.vision.free_pose import POSE_MODELS
 from lumpbeam_ros.vision.offline import CAMERA_INFO_TOPIC, IMAGE_TOPIC, TrackSummary, track_bag
 
 
@@ -25,6 +26,14 @@ def register(subparsers: Any) -> None:
     parser.add_argument('--image-topic', default=IMAGE_TOPIC, help=f'({IMAGE_TOPIC})')
     parser.add_argument(
         '--camera-info-topic', default=CAMERA_INFO_TOPIC, help=f'({CAMERA_INFO_TOPIC})'
+    )
+    parser.add_argument(
+        '--pose-model',
+        choices=POSE_MODELS,
+        default='plane',
+        help='plane: x, z, pitch in the plane of bending (default); free: the full 6-DoF pose '
+        "(torsion, a handheld check; with identity extrinsics, the camera's pose in the "
+        "board's frame)",
     )
     parser.add_argument('--json', metavar='FILE', help='also write the summary as JSON')
     parser.set_defaults(handler=run)
@@ -52,7 +61,9 @@ def summary_lines(summary: TrackSummary, bag: str, out: str) -> list[str]:
 def run(args: argparse.Namespace) -> int:
     """Tracks the bag and prints the summary."""
     config = load_camera_config(args.config)
-    summary = track_bag(args.bag, args.out, config, args.image_topic, args.camera_info_topic)
+    summary = track_bag(
+        args.bag, args.out, config, args.image_topic, args.camera_info_topic, args.pose_model
+    )
     print('\n'.join(summary_lines(summary, args.bag, args.out)))
     if args.json:
         write_json(

@@ -50,6 +50,7 @@ from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.paramfile import read_parameter_file
 from lumpbeam_ros.resources import config_path
 from lumpbeam_ros.vision.config import camera_config_from_parameters
+from lumpbeam_ros.vision.free_pose import rpy_quaternion
 from lumpbeam_ros.vision.messages import decode_camera_info
 from lumpbeam_ros.vision.session import TrackingSession
 from lumpbeam_ros.vision.tracker import TrackResult
@@ -63,6 +64,11 @@ NODE_PARAMETERS: dict[str, tuple[Any, str]] = {
     'use_config_camera_info': (
         False,
         'track with the intrinsics of the camera.* parameters, without waiting for camera_info',
+    ),
+    'pose_model': (
+        'plane',
+        'plane: x, z, pitch in the plane of bending; free: the full 6-DoF pose (with identity '
+        "extrinsics, the camera's pose in the board's frame)",
     ),
     'diagnostics_period_s': (1.0, 'period of /diagnostics, s'),
     'warning_period_s': (2.0, 'at most one warning per kind of problem in this period, s'),
@@ -112,7 +118,9 @@ class CameraNode(Node):
         self.config = camera_config_from_parameters(values, 'camera_node parameters')
         self.frame_id = str(self._param('frame_id'))
         known = self.config.camera_info if self._param('use_config_camera_info') else None
-        self.session = TrackingSession(self.config, known)
+        self.session = TrackingSession(self.config, None, str(self._param('pose_model')))
+        if known is not None:
+            self.session.set_camera_info(known)
         self._warning_period = float(self._param('warning_period_s'))
         self._last_warning: dict[str, float] = {}
         self._period_counts = (0, 0)
@@ -219,12 +227,17 @@ class CameraNode(Node):
         msg.pose.position.x, msg.pose.position.z = x, z
         q = msg.pose.orientation
         q.x, q.y, q.z, q.w = pitch_to_quaternion(pitch)
+        if result.pose6 is not None:
+            msg.pose.position.y = float(result.pose6[1])
+            q.x, q.y, q.z, q.w = rpy_quaternion(*result.pose6[3:])
         self.pose_publisher.publish(msg)
         with_covariance = PoseWithCovarianceStamped(header=msg.header)
         with_covariance.pose.pose = msg.pose
         # y, roll and yaw are fixed by the planar model (zero variance): not free guesses.
         covariance = np.zeros((6, 6))
         covariance[np.ix_(_COVARIANCE_INDEX, _COVARIANCE_INDEX)] = result.covariance
+        if result.covariance6 is not None:
+            covariance = result.covariance6
         with_covariance.pose.covariance = covariance.ravel().tolist()
         self.covariance_publisher.publish(with_covariance)
 

@@ -23,8 +23,10 @@ from lumpbeam_ros.bagio.qos import from_dict
 from lumpbeam_ros.bagio.typestore import is_known
 from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.vision.config import CameraConfig
+from lumpbeam_ros.vision.free_pose import rpy_quaternion
 from lumpbeam_ros.vision.messages import camera_info_from_data, decode_camera_info
 from lumpbeam_ros.vision.session import TrackingSession
+from lumpbeam_ros.vision.tracker import TrackResult
 
 POSE_TOPIC = '/tip_pose'
 TRUTH_TOPIC = '/tip_pose_truth'
@@ -122,12 +124,24 @@ def _compare_with_truth(out: Path, summary: TrackSummary) -> None:
     summary.pitch_rms_mrad = float(np.sqrt(np.mean(dpitch**2)) * 1e3)
 
 
+def pose_message(stamp_ns: int, result: TrackResult) -> object:
+    """The ``/tip_pose`` message of a tracked frame (6-DoF with the free model)."""
+    if result.pose6 is not None:
+        p = result.pose6
+        return convert.pose_stamped_6dof(
+            stamp_ns, tuple(p[:3]), rpy_quaternion(*p[3:]), 'beam_base'
+        )
+    x, z, pitch = (float(v) for v in result.pose)
+    return convert.pose_stamped(stamp_ns, x, z, pitch, 'beam_base')
+
+
 def track_bag(
     bag: str | Path,
     out: str | Path,
     config: CameraConfig,
     image_topic: str = IMAGE_TOPIC,
     camera_info_topic: str = CAMERA_INFO_TOPIC,
+    pose_model: str = 'plane',
 ) -> TrackSummary:
     """Tracks a bag's images and writes OUT = BAG + ``/tip_pose``.
 
@@ -138,6 +152,7 @@ def track_bag(
         image_topic: The images to track.
         camera_info_topic: The camera's calibration (the first message is used, and any
             later change is followed).
+        pose_model: ``'plane'`` or ``'free'`` (the full 6-DoF pose is written).
 
     Returns:
         The summary.
@@ -155,7 +170,7 @@ def track_bag(
         raise BagError(f'{reader.path}: topic {image_topic} has no images')
     reader.require(camera_info_topic, 'sensor_msgs/msg/CameraInfo')
     info = camera_info_from_data(read_camera_info(reader, camera_info_topic))
-    session = TrackingSession(config, info)
+    session = TrackingSession(config, info, pose_model)
     summary = TrackSummary()
     tracking_s = 0.0
     with BagWriter(out) as writer:
@@ -177,8 +192,7 @@ def track_bag(
                 frame, result = session.process_message(raw.data)
                 tracking_s += time.perf_counter() - start
                 if frame is not None and result.ok:
-                    x, z, pitch = (float(v) for v in result.pose)
-                    msg = convert.pose_stamped(frame.stamp_ns, x, z, pitch, 'beam_base')
+                    msg = pose_message(frame.stamp_ns, result)
                     writer.write_message(POSE_TOPIC, msg, raw.log_time_ns)
     stats = session.stats
     summary.frames, summary.poses = stats.frames_in, stats.poses_out

@@ -13,7 +13,7 @@ from sensor_msgs.msg import Image
 
 from lumpbeam_ros.bagio import BagWriter, convert
 from lumpbeam_ros.bagio.typestore import serialize
-from lumpbeam_ros.errors import ConfigError
+from lumpbeam_ros.errors import ConfigError, LumpbeamError
 from lumpbeam_ros.nodes.camera_node import CameraNode
 from lumpbeam_ros.vision.accuracy import drop_test_trajectory, render_frames
 from lumpbeam_ros.vision.config import load_camera_config
@@ -225,3 +225,17 @@ def test_main_reads_a_bag_with_a_params_file_and_rejects_a_missing_bag(
     assert missing.returncode == 2
     assert missing.stderr.strip().startswith('camera_node: error:')
     assert len(missing.stderr.strip().splitlines()) == 1
+
+
+def test_pose_model_parameter(ros_graph):
+    node = CameraNode(
+        context=ros_graph.context,
+        parameter_overrides=[Parameter('pose_model', value='free')],
+    )
+    assert node.session.pose_model == 'free'
+    node.destroy_node()
+    with pytest.raises(LumpbeamError, match="pose model 'bent'"):
+        CameraNode(
+            context=ros_graph.context,
+            parameter_overrides=[Parameter('pose_model', value='bent')],
+        )
