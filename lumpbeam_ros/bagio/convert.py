@@ -113,6 +113,27 @@ def pose_stamped(ns: int, x: float, z: float, pitch: float, frame_id: str) -> An
     return message_class('geometry_msgs/msg/PoseStamped')(header=header(ns, frame_id), pose=pose)
 
 
+def pose_stamped_6dof(
+    ns: int,
+    position: tuple[float, float, float],
+    quaternion: tuple[float, float, float, float],
+    frame_id: str,
+) -> Any:
+    """Builds a ``geometry_msgs/msg/PoseStamped`` of a full pose.
+
+    Args:
+        ns: Stamp, ns.
+        position: ``(x, y, z)``, m.
+        quaternion: ``(x, y, z, w)``.
+        frame_id: The header's frame.
+    """
+    point = message_class('geometry_msgs/msg/Point')(*(float(v) for v in position))
+    qx, qy, qz, qw = (float(v) for v in quaternion)
+    orientation = message_class('geometry_msgs/msg/Quaternion')(x=qx, y=qy, z=qz, w=qw)
+    pose = message_class('geometry_msgs/msg/Pose')(position=point, orientation=orientation)
+    return message_class('geometry_msgs/msg/PoseStamped')(header=header(ns, frame_id), pose=pose)
+
+
 def pose_values(msg: Any) -> tuple[int, float, float, float, str]:
     """Returns ``(stamp_ns, x, z, pitch, frame_id)`` of a ``PoseStamped``."""
     p = msg.pose.position

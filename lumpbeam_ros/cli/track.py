@@ -79,6 +79,14 @@ def register(subparsers: Any) -> None:
         '--camera-info-topic', default='/camera/camera_info', help='(/camera/camera_info)'
     )
     parser.add_argument('--quiet', action='store_true', help='no progress bar')
+    parser.add_argument(
+        '--pose-model',
+        choices=('plane', 'free'),
+        default='plane',
+        help='plane: x, z, pitch in the plane of bending (default); free: the full 6-DoF pose '
+        "(torsion, a handheld check; with identity extrinsics, the camera's pose in the "
+        "board's frame)",
+    )
     parser.add_argument('--json', metavar='FILE', help='also write the summary as JSON')
     parser.set_defaults(handler=run)
 
@@ -141,6 +149,7 @@ def run(args: argparse.Namespace) -> int:
             summary = track_bag(
                 args.src, args.out, config, args.image_topic, args.camera_info_topic,
                 camera_info=info, camera_info_source=args.camera_info or '', progress=progress,
+                pose_model=args.pose_model,
             )  # fmt: skip
         else:
             stamps = None
@@ -155,7 +164,7 @@ def run(args: argparse.Namespace) -> int:
                 )
             summary = track_footage(
                 source, args.out, config, info, args.src, args.camera_info, source.total,
-                progress,
+                progress, args.pose_model,
             )  # fmt: skip
     finally:
         progress.close()

@@ -61,6 +61,7 @@ from lumpbeam_ros.paramfile import read_parameter_file
 from lumpbeam_ros.resources import config_path
 from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
 from lumpbeam_ros.vision.config import camera_config_from_parameters
+from lumpbeam_ros.vision.free_pose import rpy_quaternion
 from lumpbeam_ros.vision.messages import IMAGE_TYPES, decode_camera_info
 from lumpbeam_ros.vision.session import TrackingSession
 from lumpbeam_ros.vision.sources import (
@@ -102,6 +103,11 @@ NODE_PARAMETERS: dict[str, tuple[Any, str]] = {
         '',
         'read a live camera through OpenCV: device index (0), device path or URL; frames are '
         'stamped with the node clock on arrival (empty: off)',
+    ),
+    'pose_model': (
+        'plane',
+        'plane: x, z, pitch in the plane of bending; free: the full 6-DoF pose (with identity '
+        "extrinsics, the camera's pose in the board's frame)",
     ),
     'diagnostics_period_s': (1.0, 'period of /diagnostics, s'),
     'warning_period_s': (2.0, 'at most one warning per kind of problem in this period, s'),
@@ -154,7 +160,7 @@ class CameraNode(Node):
         url = str(self._param('camera_info_url'))
         if url:
             known = camera_info_from_url(url)
-        self.session = TrackingSession(self.config, known)
+        self.session = TrackingSession(self.config, known, str(self._param('pose_model')))
         #: Why the in-process source stopped early (empty: it did not).
         self.source_problem = ''
         self._warning_period = float(self._param('warning_period_s'))
@@ -322,12 +328,17 @@ class CameraNode(Node):
         msg.pose.position.x, msg.pose.position.z = x, z
         q = msg.pose.orientation
         q.x, q.y, q.z, q.w = pitch_to_quaternion(pitch)
+        if result.pose6 is not None:
+            msg.pose.position.y = float(result.pose6[1])
+            q.x, q.y, q.z, q.w = rpy_quaternion(*result.pose6[3:])
         self.pose_publisher.publish(msg)
         with_covariance = PoseWithCovarianceStamped(header=msg.header)
         with_covariance.pose.pose = msg.pose
         # y, roll and yaw are fixed by the planar model (zero variance): not free guesses.
         covariance = np.zeros((6, 6))
         covariance[np.ix_(_COVARIANCE_INDEX, _COVARIANCE_INDEX)] = result.covariance
+        if result.covariance6 is not None:
+            covariance = result.covariance6
         with_covariance.pose.covariance = covariance.ravel().tolist()
         self.covariance_publisher.publish(with_covariance)
 

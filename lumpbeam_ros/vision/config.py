@@ -62,6 +62,8 @@ class TrackerSettings:
     max_saturated_fraction: float = 0.2
     calibration_frames: int = 30
     calibration_min_step_m: float = 0.001
+    min_corners: int = 12
+    min_corner_spread: float = 0.5
 
 
 @dataclass(frozen=True)
@@ -227,6 +229,13 @@ def camera_config_from_parameters(params: Mapping[str, Any], source: str | Path)
             source,
             t.calibration_min_step_m,
             non_negative=True,
+        ),
+    )
+    tracker = replace(
+        tracker,
+        min_corners=get_int(params, 'tracker.min_corners', source, t.min_corners, minimum=6),
+        min_corner_spread=get_float(
+            params, 'tracker.min_corner_spread', source, t.min_corner_spread, positive=True
         ),
     )
     if tracker.window_fraction >= 0.5:

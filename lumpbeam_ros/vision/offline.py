@@ -33,6 +33,7 @@ from lumpbeam_ros.bagio.typestore import is_known
 from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import CameraConfig
+from lumpbeam_ros.vision.free_pose import rpy_quaternion
 from lumpbeam_ros.vision.messages import (
     IMAGE_TYPES,
     camera_info_from_data,
@@ -42,6 +43,7 @@ from lumpbeam_ros.vision.messages import (
 )
 from lumpbeam_ros.vision.session import TrackingSession
 from lumpbeam_ros.vision.sources import FootageError, FootageFrame
+from lumpbeam_ros.vision.tracker import TrackResult
 
 POSE_TOPIC = '/tip_pose'
 TRUTH_TOPIC = '/tip_pose_truth'
@@ -231,9 +233,7 @@ class _Run:
         result = self.session.process(pixels, convert.ns_to_seconds(stamp_ns), encoding)
         self.tracking_s += time.perf_counter() - start
         if result.ok:
-            x, z, pitch = (float(v) for v in result.pose)
-            msg = convert.pose_stamped(stamp_ns, x, z, pitch, 'beam_base')
-            self.writer.write_message(POSE_TOPIC, msg, log_time_ns)
+            self.writer.write_message(POSE_TOPIC, pose_message(stamp_ns, result), log_time_ns)
         else:
             self._note(label, result.status.value, result.reason)
         self._tick()
@@ -276,6 +276,17 @@ def _removing_on_error(out: Path, write: Callable[[], TrackSummary]) -> TrackSum
         raise
 
 
+def pose_message(stamp_ns: int, result: TrackResult) -> object:
+    """The ``/tip_pose`` message of a tracked frame (6-DoF with the free model)."""
+    if result.pose6 is not None:
+        p = result.pose6
+        return convert.pose_stamped_6dof(
+            stamp_ns, tuple(p[:3]), rpy_quaternion(*p[3:]), 'beam_base'
+        )
+    x, z, pitch = (float(v) for v in result.pose)
+    return convert.pose_stamped(stamp_ns, x, z, pitch, 'beam_base')
+
+
 def track_bag(
     bag: str | Path,
     out: str | Path,
@@ -285,6 +296,7 @@ def track_bag(
     camera_info: CameraInfo | None = None,
     camera_info_source: str = '',
     progress: ProgressCallback | None = None,
+    pose_model: str = 'plane',
 ) -> TrackSummary:
     """Tracks a bag's images and writes OUT = BAG + ``/tip_pose``.
 
@@ -300,6 +312,7 @@ def track_bag(
         camera_info: Intrinsics to use instead of the bag's (e.g. from a calibration file).
         camera_info_source: Where ``camera_info`` came from, for messages.
         progress: Called after each image.
+        pose_model: ``'plane'`` or ``'free'`` (the full 6-DoF pose is written).
 
     Returns:
         The summary.
@@ -326,7 +339,7 @@ def track_bag(
         except LumpbeamError as exc:
             raise BagError(f'{reader.path}: {camera_info_topic}: {exc}') from None
         camera_info_source = f'{camera_info_topic} of {reader.path}'
-    session = TrackingSession(config, camera_info)
+    session = TrackingSession(config, camera_info, pose_model)
 
     def write() -> TrackSummary:
         with BagWriter(out) as writer:
@@ -372,6 +385,7 @@ def track_footage(
     camera_info_source: str,
     total: int | None = None,
     progress: ProgressCallback | None = None,
+    pose_model: str = 'plane',
 ) -> TrackSummary:
     """Tracks a video's or an image folder's frames into OUT: ``/tip_pose`` and the intrinsics.
 
@@ -385,6 +399,7 @@ def track_footage(
         camera_info_source: Where the intrinsics came from, for messages.
         total: Frames expected, for the progress (``None``: unknown).
         progress: Called after each frame.
+        pose_model: ``'plane'`` or ``'free'`` (the full 6-DoF pose is written).
 
     Returns:
         The summary.
@@ -398,7 +413,7 @@ def track_footage(
     out = Path(out)
     if out.exists():
         raise BagError(f'{out} exists already; a bag is never overwritten')
-    session = TrackingSession(config, camera_info)
+    session = TrackingSession(config, camera_info, pose_model)
 
     def write() -> TrackSummary:
         with BagWriter(out) as writer:

@@ -98,18 +98,24 @@ class PlaneModel:
         """Fits ``(x, z, pitch)`` to measured corners by Gauss-Newton on reprojection error.
 
         Args:
-            pixels: Undistorted corner positions (N x 2), in the board's corner order.
+            pixels: Undistorted corner positions (N x 2), in the board's corner order; NaN
+                rows (corners not seen: a partial view) are left out.
             initial: Starting pose ``(x, z, pitch)``.
             max_iterations: Gauss-Newton iterations at most.
 
         Returns:
             The fitted pose with its covariance ``sigma^2 (J^T J)^-1``, where ``sigma^2`` is
-            the residual variance with 2N - 3 degrees of freedom.
+            the residual variance with 2N - 3 degrees of freedom (N corners seen).
         """
         pose = np.asarray(initial, dtype=float).copy()
+        seen = np.all(np.isfinite(pixels), axis=1)
+        if not np.all(seen):
+            pixels = pixels[seen]
         converged = False
         for _ in range(max_iterations):
             proj, jac = self.project_with_jacobian(pose)
+            if pixels.shape[0] != proj.shape[0]:
+                proj, jac = proj[seen], jac[seen]
             r = (proj - pixels).ravel()
             j = jac.reshape(-1, 3)
             jtj = j.T @ j

@@ -17,6 +17,7 @@ import numpy as np
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import CameraConfig
+from lumpbeam_ros.vision.free_pose import POSE_MODELS
 from lumpbeam_ros.vision.messages import IMAGE_TYPE, CameraFrame, decode_frame
 from lumpbeam_ros.vision.tracker import TipTracker, TrackResult, TrackStatus
 
@@ -61,14 +62,25 @@ class TrackingSession:
         config: Rig geometry and tracker settings.
         camera_info: The intrinsics if known now; otherwise frames are refused (status
             ``NO_CAMERA_INFO``) until :meth:`set_camera_info` is called.
+        pose_model: ``'plane'`` or ``'free'`` (see :class:`TipTracker`).
 
     Raises:
         LumpbeamError: ``camera_info`` and ``config`` cannot work together (see
-            :class:`~lumpbeam_ros.vision.tracker.TipTracker`).
+            :class:`~lumpbeam_ros.vision.tracker.TipTracker`), or an unknown pose model.
     """
 
-    def __init__(self, config: CameraConfig, camera_info: CameraInfo | None = None):
+    def __init__(
+        self,
+        config: CameraConfig,
+        camera_info: CameraInfo | None = None,
+        pose_model: str = 'plane',
+    ):
+        if pose_model not in POSE_MODELS:
+            raise LumpbeamError(
+                f'pose model {pose_model!r} is not one of {", ".join(POSE_MODELS)}'
+            )
         self.config = config
+        self.pose_model = pose_model
         self.stats = SessionStats()
         self._tracker: TipTracker | None = None
         if camera_info is not None:
@@ -102,7 +114,7 @@ class TrackingSession:
         """
         if self._tracker is not None and _same_camera(self._tracker.camera_info, info):
             return False
-        self._tracker = TipTracker(info, self.config)
+        self._tracker = TipTracker(info, self.config, self.pose_model)
         return True
 
     def process(self, pixels: object, stamp: float, encoding: str = 'mono8') -> TrackResult:

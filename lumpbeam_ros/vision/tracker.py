@@ -1,9 +1,11 @@
 """The tip tracker: camera frames in, tip poses in ``beam_base`` out.
 
 Per frame: predict the corners from the last two frames (constant velocity in pixels),
-refine them in small windows, verify them (all corners, one homography through them, a
-regular grid), and fit the tip's ``(x, z, pitch)`` to them with the plane-constrained model.
-When tracking fails, or there is nothing to track, the full detector searches the frame.
+refine them in small windows, verify each one (:mod:`lumpbeam_ros.vision.partial`: those out
+of view or occluded are dropped, so a partial view still gives a pose above a minimum), and
+fit the tip's ``(x, z, pitch)`` to them with the plane-constrained model, or the full 6-DoF
+pose with the free model (:mod:`lumpbeam_ros.vision.free_pose`). When tracking fails, or
+there is nothing to track, the full detector searches the frame (it needs the whole board).
 The first good frames also feed a one-off calibration of the rig's fixed unknowns.
 
 A node only converts messages and calls :meth:`TipTracker.process`; every problem with a
@@ -13,7 +15,7 @@ frame comes back as a status, never as an exception or a stale pose.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import Enum
 
 import cv2
@@ -30,6 +32,20 @@ from lumpbeam_ros.vision.corners import (
     refine_corners,
 )
 from lumpbeam_ros.vision.detect import detect_board
+from lumpbeam_ros.vision.free_pose import (
+    POSE_MODELS,
+    FreeFit,
+    FreeModel,
+    free_pose_from_board_pose,
+    planar_part,
+)
+from lumpbeam_ros.vision.partial import (
+    board_polarity,
+    coverage_problem,
+    labelling_is_unambiguous,
+    reject_outliers,
+    select_corners,
+)
 from lumpbeam_ros.vision.pose import (
     PlaneFit,
     PlaneModel,
@@ -52,6 +68,7 @@ class TrackStatus(str, Enum):
     BOARD_NOT_FOUND = 'board_not_found'
     CORNERS_REJECTED = 'corners_rejected'
     POSE_REJECTED = 'pose_rejected'
+    TOO_FEW_CORNERS = 'too_few_corners'
     NO_CAMERA_INFO = 'no_camera_info'
 
 
@@ -68,7 +85,13 @@ class TrackResult:
         rms_px: RMS reprojection error per corner, px (NaN without a fit).
         corners: The measured (distorted) corner pixels (N x 2), or ``None``.
         detected: Whether the full detector ran on this frame (tracking was lost or new).
-        calibrated: Whether the rig's fixed unknowns were already estimated.
+        calibrated: Whether the rig's fixed unknowns were already estimated (always in
+            the free model: it fits them in every frame).
+        corners_used: Corners the fit used (fewer than the board's in a partial view).
+        pose6: Free model only: ``(x, y, z, roll, pitch, yaw)`` of the tip in
+            ``beam_base`` (``pose`` is then its in-plane part); ``None`` in the plane model.
+        covariance6: Free model only: 6x6 covariance of ``pose6`` (PoseWithCovariance
+            order), or ``None``.
     """
 
     stamp: float
@@ -80,6 +103,9 @@ class TrackResult:
     corners: np.ndarray | None = None
     detected: bool = False
     calibrated: bool = False
+    corners_used: int = 0
+    pose6: np.ndarray | None = None
+    covariance6: np.ndarray | None = None
 
     @property
     def ok(self) -> bool:
@@ -98,13 +124,20 @@ class TipTracker:
         camera_info: The camera's intrinsics (from ``/camera/camera_info`` or the config).
         config: Rig geometry and tracker settings (``config/camera.yaml``); its own
             ``camera_info`` is not used.
+        pose_model: ``'plane'`` (the tip moves in the plane of bending: ``x, z, pitch``) or
+            ``'free'`` (the full 6-DoF pose; no rig calibration).
 
     Raises:
         LumpbeamError: The configuration is unusable: the board is behind the camera or not
-            in view at the rig's reference pose.
+            in view at the rig's reference pose (plane model), or an unknown pose model.
     """
 
-    def __init__(self, camera_info: CameraInfo, config: CameraConfig):
+    def __init__(self, camera_info: CameraInfo, config: CameraConfig, pose_model: str = 'plane'):
+        if pose_model not in POSE_MODELS:
+            raise LumpbeamError(
+                f'tracker: pose model {pose_model!r} is not one of {", ".join(POSE_MODELS)}'
+            )
+        self.pose_model = pose_model
         self.camera_info = camera_info
         self.config = config
         self.settings = config.tracker
@@ -117,21 +150,29 @@ class TipTracker:
 
     def _set_rig(self, rig) -> None:
         self._model = PlaneModel(rig, self.camera_info)
+        self._free = FreeModel(rig, self.camera_info)
         centre = rig.base_board.translation
         reference = np.array([centre[0], centre[2], 0.0])
         camera_board = camera_board_transform(rig, reference)
-        if camera_board.translation[2] <= 0:
+        # The free model needs no reference pose: with identity extrinsics (the camera's
+        # pose in the board's frame) the detector's corners set the window instead.
+        self._window_from_detection = camera_board.translation[2] <= 0
+        if self._window_from_detection and self.pose_model == 'plane':
             raise LumpbeamError('tracker: the configured board is behind the camera')
         self._expected_rotation = camera_board.rotation
         # Image directions of the board's axes (a fronto-parallel approximation suffices:
         # they only decide between labellings 180 degrees apart).
         self._expected_axes = camera_board.rotation[:2, :2].T.copy()
-        corners = self._model.project(reference)
+        self._half_window = 5
+        if not self._window_from_detection:
+            self._half_window = self._window_for(self._model.project(reference))
+
+    def _window_for(self, corners: np.ndarray) -> int:
         spacing = np.median(np.linalg.norm(np.diff(corners, axis=0), axis=1))
         # Beyond 5 px the window costs time without a gain worth it: 8 px gave 0.86 um z RMS
         # at 2048 x 2048, 5 px 1.06 um, at 60 % of the refinement time (the corner error is
         # dominated by the image, not the window).
-        self._half_window = int(np.clip(round(self.settings.window_fraction * spacing), 3, 5))
+        return int(np.clip(round(self.settings.window_fraction * spacing), 3, 5))
 
     @property
     def calibration(self) -> RigCalibration | None:
@@ -146,6 +187,10 @@ class TipTracker:
     def reset(self) -> None:
         """Forgets the tracking history (the next frame runs full detection)."""
         self._history: list[tuple[float, np.ndarray, np.ndarray]] = []
+        # How far the last tracked frame's corners were from their prediction, px (infinite
+        # after a detection): a partial view is trusted only after a close prediction.
+        self._prediction_error = math.inf
+        self._polarity: float | None = None
 
     def process(self, image: np.ndarray, stamp: float, encoding: str = 'mono8') -> TrackResult:
         """Measures the tip pose in one frame.
@@ -263,10 +308,13 @@ class TipTracker:
             return None, f'corners miss a homography by {residual:.2f} px'
         return ideal, ''
 
-    def _fit(self, ideal: np.ndarray, initial: np.ndarray) -> tuple[PlaneFit | None, str]:
-        fit = self._model.fit(ideal, initial)
+    def _fit(
+        self, ideal: np.ndarray, initial: np.ndarray
+    ) -> tuple[PlaneFit | FreeFit | None, str]:
+        model = self._free if self.pose_model == 'free' else self._model
+        fit = model.fit(ideal, initial)
         if not fit.converged or not np.all(np.isfinite(fit.pose)):
-            return None, 'plane-constrained fit did not converge'
+            return None, f'{self.pose_model} pose fit did not converge'
         # Until the rig's fixed unknowns are estimated the model itself may be off by a few
         # pixels; the homography check has already vouched for the corners then.
         if self._is_calibrated():
@@ -276,18 +324,54 @@ class TipTracker:
                 return None, f'a corner misses the fitted pose by {fit.max_px:.2f} px'
         return fit, ''
 
+    def _track_prediction(
+        self, gray: np.ndarray, stamp: float, guess: np.ndarray, pose_guess: np.ndarray
+    ) -> tuple[TrackResult | None, str]:
+        """Tracks from predicted corners, with those seen; the reason when too few are."""
+        corners = refine_corners(gray, guess, self._half_window)
+        pattern = self._board.pattern_size
+        selection = select_corners(
+            gray, corners, guess, pattern, self._half_window, self.settings.min_contrast_dn,
+            self._polarity,
+        )  # fmt: skip
+        ideal = np.full_like(corners, np.nan)
+        ideal[selection.mask] = self.camera_info.undistort_pixels(corners[selection.mask])
+        mask = reject_outliers(self._object_xy, ideal, selection.mask, self.settings.min_corners)
+        selection = replace(selection, mask=mask, outliers=selection.count - int(mask.sum()))
+        shortage = coverage_problem(
+            self._object_xy, mask, self.settings.min_corners,
+            self.settings.min_corner_spread, self._board.square_size_m,
+        )  # fmt: skip
+        if shortage:
+            # With no corner at all where the board should be, it is not a partial view.
+            return None, f'{shortage} ({selection.describe()})' if mask.any() else ''
+        error = float(np.median(np.linalg.norm(corners[mask] - guess[mask], axis=1)))
+        if not labelling_is_unambiguous(int(mask.sum()), pattern) and not (
+            self._prediction_error <= self._half_window / 2
+        ):
+            # Few corners after a poor prediction may be neighbours caught one square off.
+            return None, (
+                f'partial view ({selection.describe()}) right after a detection or a poor '
+                f'prediction ({self._prediction_error:.1f} px)'
+            )
+        ideal[~mask] = np.nan
+        corners = np.where(mask[:, None], corners, np.nan)
+        fit, _ = self._fit(ideal, pose_guess)
+        if fit is None:
+            return None, ''
+        result = self._accept(stamp, corners, ideal, fit, detected=False)
+        self._prediction_error = error
+        return result, ''
+
     def _track(self, gray: np.ndarray, stamp: float) -> TrackResult:
         prediction = self._predict(stamp)
+        shortage = ''
         if prediction is None:
             self.reset()
         else:
-            guess, pose_guess = prediction
-            corners = refine_corners(gray, guess, self._half_window)
-            ideal, _ = self._verify(gray, corners, homography=not self._is_calibrated())
-            if ideal is not None:
-                fit, _ = self._fit(ideal, pose_guess)
-                if fit is not None:
-                    return self._accept(stamp, corners, ideal, fit, detected=False)
+            result, shortage = self._track_prediction(gray, stamp, *prediction)
+            if result is not None:
+                return result
         # Nothing to track, or tracking failed: search the whole frame.
         corners = detect_board(
             gray,
@@ -298,6 +382,8 @@ class TipTracker:
         )
         if corners is None:
             self.reset()
+            if shortage:
+                return _failure(stamp, TrackStatus.TOO_FEW_CORNERS, shortage, detected=True)
             return _failure(
                 stamp, TrackStatus.BOARD_NOT_FOUND, 'no complete checkerboard in the frame',
                 detected=True,
@@ -317,7 +403,15 @@ class TipTracker:
                 stamp, TrackStatus.POSE_REJECTED, 'no valid PnP solution', corners=corners,
                 detected=True,
             )  # fmt: skip
-        fit, problem = self._fit(ideal, tip_pose_from_board_pose(self._model.rig, camera_board))
+        if self._window_from_detection:
+            self._half_window = self._window_for(corners)
+        self._polarity = board_polarity(gray, corners, self._board.pattern_size, self._half_window)
+        self._prediction_error = math.inf
+        if self.pose_model == 'free':
+            initial = free_pose_from_board_pose(self._model.rig, camera_board)
+        else:
+            initial = tip_pose_from_board_pose(self._model.rig, camera_board)
+        fit, problem = self._fit(ideal, initial)
         if fit is None:
             self.reset()
             return _failure(
@@ -326,23 +420,42 @@ class TipTracker:
         return self._accept(stamp, corners, ideal, fit, detected=True)
 
     def _accept(
-        self, stamp: float, corners: np.ndarray, ideal: np.ndarray, fit: PlaneFit, detected: bool
+        self,
+        stamp: float,
+        corners: np.ndarray,
+        ideal: np.ndarray,
+        fit: PlaneFit | FreeFit,
+        detected: bool,
     ) -> TrackResult:
         calibrated = self._is_calibrated()
-        self._history = [*self._history[-1:], (stamp, corners, fit.pose)]
-        if not calibrated and self._moved_since_last_pending(fit.pose):
+        seen = np.all(np.isfinite(corners), axis=1)
+        # Corners not seen are predicted from the pose, so the next frame looks for them.
+        model = self._free if self.pose_model == 'free' else self._model
+        filled = corners
+        if not np.all(seen):
+            projected = self.camera_info.project(model.camera_points(fit.pose))
+            filled = np.where(seen[:, None], corners, projected)
+        self._history = [*self._history[-1:], (stamp, filled, fit.pose)]
+        if not calibrated and np.all(seen) and self._moved_since_last_pending(fit.pose):
             self._pending.append((ideal, fit.pose))
             if len(self._pending) >= self.settings.calibration_frames:
                 self._calibrate()
+        pose, covariance, pose6, covariance6 = fit.pose, fit.covariance, None, None
+        if self.pose_model == 'free':
+            pose6, covariance6 = fit.pose, fit.covariance
+            pose, covariance = planar_part(fit.pose, fit.covariance)
         return TrackResult(
             stamp,
             TrackStatus.OK,
-            pose=fit.pose,
-            covariance=fit.covariance,
+            pose=pose,
+            covariance=covariance,
             rms_px=fit.rms_px,
             corners=corners,
             detected=detected,
             calibrated=calibrated,
+            corners_used=int(np.count_nonzero(seen)),
+            pose6=pose6,
+            covariance6=covariance6,
         )
 
     def _moved_since_last_pending(self, pose: np.ndarray) -> bool:
@@ -352,7 +465,11 @@ class TipTracker:
         return bool(step >= self.settings.calibration_min_step_m)
 
     def _is_calibrated(self) -> bool:
-        return self._calibration is not None or self.settings.calibration_frames == 0
+        return (
+            self._calibration is not None
+            or self.settings.calibration_frames == 0
+            or self.pose_model == 'free'
+        )
 
     def _calibrate(self) -> None:
         pixels = [p for p, _ in self._pending]

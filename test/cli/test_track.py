@@ -96,3 +96,24 @@ def test_bad_input_is_one_line_and_exit_2(bag, tmp_path, capsys, case):
         'out exists': 'exists already',
     }[case]
     assert expected in err
+
+
+def test_free_pose_model_writes_full_poses(bag, tmp_path, capsys):
+    out = tmp_path / 'free'
+    assert main(['track', str(bag), str(out), '--pose-model', 'free']) == 0
+    assert '415 frames, 415 poses, 0 lost' in capsys.readouterr().out
+    tracked, truth = read_tip_poses(out), read_tip_poses(out, '/tip_pose_truth')
+    # 6 DoF from a flat board at 320 x 240 are loose, but on the truth to a fraction of a mm.
+    assert np.sqrt(np.mean((tracked.z - truth.z) ** 2)) < 1e-3
+    assert np.sqrt(np.mean((tracked.pitch - truth.pitch) ** 2)) < 3e-3
+    messages = BagReader(out).messages('/tip_pose', 'geometry_msgs/msg/PoseStamped')
+    ys = [m.pose.position.y for _, m in messages]
+    assert np.max(np.abs(ys)) > 0 and np.max(np.abs(ys)) < 5e-3
+
+
+def test_unknown_pose_model_is_exit_2(bag, tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(['track', str(bag), str(tmp_path / 'o'), '--pose-model', 'bent'])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert '--pose-model' in err and 'bent' in err

@@ -15,7 +15,7 @@ from sensor_msgs.msg import Image
 
 from lumpbeam_ros.bagio import BagWriter, convert
 from lumpbeam_ros.bagio.typestore import serialize
-from lumpbeam_ros.errors import ConfigError
+from lumpbeam_ros.errors import ConfigError, LumpbeamError
 from lumpbeam_ros.nodes.camera_node import CameraNode
 from lumpbeam_ros.vision.accuracy import drop_test_trajectory, render_frames
 from lumpbeam_ros.vision.config import load_camera_config
@@ -70,7 +70,10 @@ class Feed:
 
 @pytest.fixture
 def node(ros_graph):
-    node = CameraNode(context=ros_graph.context)
+    # The tests publish diagnostics themselves; a periodic one on a slow machine would end
+    # the counting period in the middle of a test.
+    quiet = [Parameter('diagnostics_period_s', value=3600.0)]
+    node = CameraNode(context=ros_graph.context, parameter_overrides=quiet)
     ros_graph.add_node(node)
     return node
 
@@ -341,3 +344,17 @@ def test_main_refuses_unreadable_footage_in_one_line(ros_graph, tmp_path, calibr
     err = done.stderr.strip()
     assert err.startswith('camera_node: error:') and len(err.splitlines()) == 1
     assert 'clip.avi: OpenCV cannot open it as a video' in err
+
+
+def test_pose_model_parameter(ros_graph):
+    node = CameraNode(
+        context=ros_graph.context,
+        parameter_overrides=[Parameter('pose_model', value='free')],
+    )
+    assert node.session.pose_model == 'free'
+    node.destroy_node()
+    with pytest.raises(LumpbeamError, match="pose model 'bent'"):
+        CameraNode(
+            context=ros_graph.context,
+            parameter_overrides=[Parameter('pose_model', value='bent')],
+        )

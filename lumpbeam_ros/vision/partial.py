@@ -1,0 +1,333 @@
+"""Partial views: which predicted corners are really seen, and whether enough of them are.
+
+While tracking, the last poses predict every corner, including those out of the image or
+behind an occluder (a cable, a hand). Each corner whose refinement window lies inside the
+image is refined on its own and then has to pass two checks before it joins the fit:
+
+1. **Saddle check** (:func:`saddle_fit`): the pixels of its window, away from the two edge
+   lines through it, must look like a checkerboard corner: two grey levels on the two
+   diagonals, in the colour order the corner's parity requires, with little else. An
+   occluder anywhere in the window (the pixels ``cornerSubPix`` reads) changes some of
+   those pixels, so a corner whose refinement it could bias is dropped, not fitted.
+2. **Residual check** (:func:`reject_outliers`): a homography through the surviving
+   corners (exact for a flat board seen by a pinhole after undistortion, so it needs no
+   rig calibration and holds for any pose) must pass every corner within a few times the
+   corners' own scatter; the worst one is dropped until all do. This catches what the
+   saddle check cannot see: a thin line lying along an edge through the corner.
+
+What is left must clear a documented minimum (:func:`coverage_problem`) so the pose fit
+stays well conditioned: at least ``tracker.min_corners`` corners, spread at least
+``tracker.min_corner_spread`` squares (rms) across their weakest direction, which a single
+row or a diagonal line of corners is not.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from scipy.special import erf
+
+#: Blurs (Gaussian sigma, px) the saddle model tries: defocus from none to 1.5 px, plus the
+#: pixel's own footprint and the renderer's or lens's smoothing.
+BLURS_PX = (0.6, 0.9, 1.3, 1.8)
+
+#: Largest rms residual of the saddle model, as a fraction of its amplitude: clean corners
+#: measure 0.03 to 0.045 (2 DN noise, blur 0.8 to 1.6 px); with a 2 to 8 px bar of any grey
+#: level painted at any angle and offset across the window, the corners passing 0.08 were
+#: biased by at most 0.11 px (blur 0.8) and 0.18 px (blur 1.6), which the residual check
+#: then sees. A noisier or paler frame raises the limit to :data:`MISFIT_MEDIANS` times
+#: the frame's median corner misfit.
+MAX_SADDLE_MISFIT = 0.08
+
+#: See :data:`MAX_SADDLE_MISFIT`.
+MISFIT_MEDIANS = 2.5
+
+#: ... but never beyond this: in a frame of pure noise the median misfit is above 1, and
+#: a loose limit would let a few noise pixels pass for corners.
+MISFIT_CEILING = 0.25
+
+#: The saddle check's window reaches this far beyond the refinement's, px: an occluder
+#: at the edge of the refinement window, where ``cornerSubPix`` still reads it, needs
+#: pixels around it to show in the misfit.
+CHECK_MARGIN_PX = 2
+
+#: A corner further than this many times the median corner residual from the homography
+#: through the others is an outlier (the residual of a good corner is Rayleigh distributed:
+#: beyond 4 medians lies a fraction of 1e-5 of them).
+OUTLIER_MEDIANS = 4.0
+
+#: ... but never below this, px: at 0.1 px a corner shifts a 12-corner fit by 0.01 px.
+OUTLIER_FLOOR_PX = 0.1
+
+
+@dataclass(frozen=True)
+class CornerSelection:
+    """The corners a frame's fit may use.
+
+    Attributes:
+        mask: Per board corner, whether it is used.
+        outside: Corners whose refinement window leaves the image (or whose refinement did
+            not converge near the prediction).
+        occluded: Corners failing the saddle check (no contrast, wrong colours, an occluder
+            in the window).
+        outliers: Corners dropped for missing the homography through the others.
+    """
+
+    mask: np.ndarray
+    outside: int
+    occluded: int
+    outliers: int
+
+    @property
+    def count(self) -> int:
+        """Corners used."""
+        return int(np.count_nonzero(self.mask))
+
+    def describe(self) -> str:
+        """One line: how many corners are used and why the others are not."""
+        dropped = [
+            f'{n} {what}'
+            for n, what in (
+                (self.outside, 'out of view'),
+                (self.occluded, 'occluded'),
+                (self.outliers, 'outliers'),
+            )
+            if n
+        ]
+        return f'{self.count} of {self.mask.size} corners' + (
+            f' ({", ".join(dropped)})' if dropped else ''
+        )
+
+
+def grid_axes(grid: np.ndarray, pattern_size: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """Image vectors of one square along the board's x and y axes at every corner.
+
+    Args:
+        grid: All corners (N x 2, finite), row-major board order, e.g. a prediction.
+        pattern_size: ``(corners per row, rows)``.
+
+    Returns:
+        ``(along_x, along_y)``, each N x 2, by central differences (one-sided at the border).
+    """
+    cols, rows = pattern_size
+    g = grid.reshape(rows, cols, 2)
+    along_x = np.gradient(g, axis=1) if cols > 1 else np.zeros_like(g)
+    along_y = np.gradient(g, axis=0) if rows > 1 else np.zeros_like(g)
+    return along_x.reshape(-1, 2), along_y.reshape(-1, 2)
+
+
+def saddle_fit(
+    image: np.ndarray,
+    corners: np.ndarray,
+    along_x: np.ndarray,
+    along_y: np.ndarray,
+    radius: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Fits a blurred checkerboard corner to the window around each corner.
+
+    The model of a corner at ``c`` whose edges run along ``along_x`` and ``along_y`` is
+    ``I = m + A erf(s_x / sigma) erf(s_y / sigma)``, where ``s_x`` and ``s_y`` are a pixel's
+    signed distances (px) to the two edge lines: a Gaussian blur of the ideal saddle (exact
+    for square cells). ``m`` and ``A`` are fitted linearly for each blur in
+    :data:`BLURS_PX`, and the best blur is kept. The model is centred on the refined
+    corner, so an occluder that pulled the refinement off shows in the misfit twice: in
+    its own pixels and in the true edges, now off-centre.
+
+    Args:
+        image: Grey image (H x W).
+        corners: Refined corners (M x 2), finite.
+        along_x: Image vector of one square along the board's x axis at each corner (M x 2).
+        along_y: The same along y (M x 2).
+        radius: The window is ``2 radius + 1`` pixels square, centred on the corner.
+
+    Returns:
+        ``(amplitude, misfit)`` per corner: ``A`` (signed, DN; positive when the corner's
+        ``(+x, +y)`` quadrant is light), and the rms residual over ``|A|``.
+    """
+    corners = np.asarray(corners, dtype=float).reshape(-1, 2)
+    h, w = image.shape[:2]
+    offsets = np.arange(-radius, radius + 1)
+    oy, ox = np.meshgrid(offsets, offsets, indexing='ij')
+    centre = np.rint(corners).astype(np.int64)
+    px = np.clip(centre[:, 0, None] + ox.ravel(), 0, w - 1)
+    py = np.clip(centre[:, 1, None] + oy.ravel(), 0, h - 1)
+    values = image[py, px].astype(np.float64)
+    dx = px - corners[:, 0, None]
+    dy = py - corners[:, 1, None]
+    # Signed distance to the edge line along x (the board's y = const) and along y.
+    unit_x = along_x / np.maximum(np.linalg.norm(along_x, axis=1), 1e-9)[:, None]
+    unit_y = along_y / np.maximum(np.linalg.norm(along_y, axis=1), 1e-9)[:, None]
+    orient = np.sign(unit_x[:, 0] * unit_y[:, 1] - unit_x[:, 1] * unit_y[:, 0])[:, None]
+    s_y = (unit_x[:, 0, None] * dy - unit_x[:, 1, None] * dx) * orient
+    s_x = (dx * unit_y[:, 1, None] - dy * unit_y[:, 0, None]) * orient
+    n = values.shape[1]
+    best_misfit = np.full(len(corners), np.inf)
+    best_amplitude = np.zeros(len(corners))
+    for sigma in BLURS_PX:
+        shape = erf(s_x / (np.sqrt(2.0) * sigma)) * erf(s_y / (np.sqrt(2.0) * sigma))
+        # Linear least squares for m and A, per corner, in closed form.
+        mean_s, mean_v = shape.mean(axis=1), values.mean(axis=1)
+        var_s = (shape * shape).mean(axis=1) - mean_s**2
+        cov = (shape * values).mean(axis=1) - mean_s * mean_v
+        amplitude = cov / np.maximum(var_s, 1e-12)
+        level = mean_v - amplitude * mean_s
+        residual = values - level[:, None] - amplitude[:, None] * shape
+        with np.errstate(divide='ignore', invalid='ignore'):
+            misfit = np.sqrt(np.sum(residual**2, axis=1) / max(n - 2, 1)) / np.abs(amplitude)
+        misfit = np.where(np.isfinite(misfit), misfit, np.inf)
+        better = misfit < best_misfit
+        best_misfit = np.where(better, misfit, best_misfit)
+        best_amplitude = np.where(better, amplitude, best_amplitude)
+    return best_amplitude, best_misfit
+
+
+def corner_parity(pattern_size: tuple[int, int]) -> np.ndarray:
+    """+1 or -1 per corner: the sign of its saddle relative to corner 0 (they alternate)."""
+    cols, rows = pattern_size
+    r, c = np.divmod(np.arange(cols * rows), cols)
+    return np.where((r + c) % 2 == 0, 1.0, -1.0)
+
+
+def reject_outliers(
+    object_xy: np.ndarray, ideal: np.ndarray, mask: np.ndarray, min_corners: int
+) -> np.ndarray:
+    """Drops corners that miss a homography through the others, worst first.
+
+    Args:
+        object_xy: Board-plane corner coordinates (N x 2).
+        ideal: Undistorted corner pixels (N x 2; rows outside ``mask`` are ignored).
+        mask: Corners to consider.
+        min_corners: Stop dropping below this many (the caller then refuses the frame).
+
+    Returns:
+        The reduced mask.
+    """
+    mask = mask.copy()
+    while np.count_nonzero(mask) >= max(min_corners, 5):
+        index = np.flatnonzero(mask)
+        src = object_xy[index].astype(np.float64)
+        dst = ideal[index].astype(np.float64)
+        h, _ = cv2.findHomography(src, dst, 0)
+        if h is None or not np.all(np.isfinite(h)):
+            mask[:] = False
+            break
+        mapped = src @ h[:, :2].T + h[:, 2]
+        residual = np.linalg.norm(mapped[:, :2] / mapped[:, 2:3] - dst, axis=1)
+        worst = int(np.argmax(residual))
+        limit = max(OUTLIER_MEDIANS * float(np.median(residual)), OUTLIER_FLOOR_PX)
+        if residual[worst] <= limit:
+            break
+        mask[index[worst]] = False
+    return mask
+
+
+def coverage_problem(
+    object_xy: np.ndarray, mask: np.ndarray, min_corners: int, min_spread: float, square: float
+) -> str:
+    """Whether the used corners pin the pose down; the reason when they do not.
+
+    Args:
+        object_xy: Board-plane corner coordinates (N x 2), m.
+        mask: Corners used.
+        min_corners: Fewest corners accepted.
+        min_spread: Least rms spread of the corners across their weakest direction,
+            in squares (two adjacent full rows: 0.5).
+        square: Square size, m.
+
+    Returns:
+        ``''`` when enough, else one line.
+    """
+    n = int(np.count_nonzero(mask))
+    if n < min_corners:
+        return f'only {n} of {mask.size} corners seen, need {min_corners}'
+    points = object_xy[mask] / square
+    spread = float(np.sqrt(np.linalg.eigvalsh(np.cov(points.T, bias=True))[0]))
+    # Two full rows sit exactly at 0.5: a hair of tolerance for the rounding of the grid.
+    if spread < min_spread - 1e-9:
+        return (
+            f'the {n} corners seen lie along a line (spread {spread:.2f} squares across it, '
+            f'need {min_spread:g})'
+        )
+    return ''
+
+
+def select_corners(
+    image: np.ndarray,
+    refined: np.ndarray,
+    predicted: np.ndarray,
+    pattern_size: tuple[int, int],
+    radius: int,
+    min_contrast_dn: float,
+    polarity: float | None = None,
+) -> CornerSelection:
+    """Keeps the refined corners that pass the saddle check (before the residual check).
+
+    Args:
+        image: Grey image.
+        refined: Refined corners (N x 2; NaN where the window left the image or the
+            refinement did not converge near the prediction).
+        predicted: The prediction of every corner (N x 2, finite): gives the board's axes.
+        pattern_size: ``(corners per row, rows)``.
+        radius: The refinement window's half-size, px (the check reads
+            :data:`CHECK_MARGIN_PX` more).
+        min_contrast_dn: Least light-dark difference at a corner, DN.
+        polarity: The board's colour order (:func:`board_polarity` of a whole view), or
+            ``None`` to take the majority's. A labelling one square off flips it.
+
+    Returns:
+        The selection (``outliers`` is 0: see :func:`reject_outliers`).
+    """
+    found = np.all(np.isfinite(refined), axis=1)
+    mask = np.zeros(found.size, dtype=bool)
+    if not np.any(found):
+        return CornerSelection(mask, int(found.size), 0, 0)
+    along_x, along_y = grid_axes(predicted, pattern_size)
+    amplitude, misfit = saddle_fit(
+        image, refined[found], along_x[found], along_y[found], radius + CHECK_MARGIN_PX
+    )
+    signed = amplitude * corner_parity(pattern_size)[found]
+    # The board's colour order (dark or light square at corner 0) from the majority.
+    if polarity is None:
+        polarity = 1.0 if np.median(signed) >= 0 else -1.0
+    limit = min(max(MAX_SADDLE_MISFIT, MISFIT_MEDIANS * float(np.median(misfit))), MISFIT_CEILING)
+    good = (signed * polarity >= min_contrast_dn / 2.0) & (misfit <= limit)
+    mask[np.flatnonzero(found)[good]] = True
+    return CornerSelection(mask, int(np.count_nonzero(~found)), int(np.count_nonzero(~good)), 0)
+
+
+def board_polarity(
+    image: np.ndarray, corners: np.ndarray, pattern_size: tuple[int, int], radius: int
+) -> float:
+    """The board's colour order in a view of the whole board: +1 or -1.
+
+    Args:
+        image: Grey image.
+        corners: All corners (N x 2, finite), in board order.
+        pattern_size: ``(corners per row, rows)``.
+        radius: The refinement window's half-size, px.
+
+    Returns:
+        The sign of corner 0's saddle amplitude, by the majority of all corners.
+    """
+    along_x, along_y = grid_axes(corners, pattern_size)
+    amplitude, _ = saddle_fit(image, corners, along_x, along_y, radius + CHECK_MARGIN_PX)
+    return 1.0 if np.median(amplitude * corner_parity(pattern_size)) >= 0 else -1.0
+
+
+def labelling_is_unambiguous(count: int, pattern_size: tuple[int, int]) -> bool:
+    """Whether so many corners were found that the grid cannot be one square off.
+
+    A labelling shifted by a square leaves a whole row or column of predictions over the
+    board's blank margin, so it finds at most ``N - min(cols, rows)`` corners.
+
+    Args:
+        count: Corners found and verified.
+        pattern_size: ``(corners per row, rows)``.
+
+    Returns:
+        Whether ``count`` exceeds what any shifted labelling could find.
+    """
+    cols, rows = pattern_size
+    return count > cols * rows - min(cols, rows)
