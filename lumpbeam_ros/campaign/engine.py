@@ -8,7 +8,7 @@ is flushed at least once a second, so an interrupted campaign keeps what it comp
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
@@ -65,13 +65,16 @@ def pending_bags(
     return pending
 
 
-def start_client(scheduler: str | None, workers: int, stack: ExitStack) -> object:
+def start_client(
+    scheduler: str | None, workers: int, stack: ExitStack, timeout_s: float = CONNECT_TIMEOUT_S
+) -> object:
     """A Dask client: on ``scheduler``, or on a new local cluster of ``workers`` processes.
 
     Args:
         scheduler: Address of a running scheduler (``tcp://host:8786``), or ``None``.
         workers: Worker processes of a local cluster, one thread each.
         stack: Closes the client and the cluster when it exits.
+        timeout_s: How long to wait for ``scheduler`` to answer, s.
 
     Returns:
         A ``distributed.Client``.
@@ -98,12 +101,12 @@ def start_client(scheduler: str | None, workers: int, stack: ExitStack) -> objec
         )
         return stack.enter_context(Client(cluster))
     try:
-        client = Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+        client = Client(scheduler, timeout=timeout_s)
     except (OSError, TimeoutError, ValueError) as exc:
         reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise LumpbeamError(
             f'--scheduler {scheduler}: no Dask scheduler answered within '
-            f'{CONNECT_TIMEOUT_S:g} s ({reason})'
+            f'{timeout_s:g} s ({reason})'
         ) from None
     return stack.enter_context(client)
 
@@ -116,6 +119,7 @@ def run_campaign(
     scheduler: str | None = None,
     workers: int = 2,
     stream: TextIO | None = None,
+    timeout_s: float = CONNECT_TIMEOUT_S,
 ) -> CampaignRun:
     """Processes the pending bags on Dask and adds their rows to the store.
 
@@ -126,6 +130,7 @@ def run_campaign(
         scheduler: A scheduler's address, or ``None`` for a local cluster.
         workers: Worker processes of the local cluster.
         stream: Where the progress bar goes (stderr; drawn only on a terminal).
+        timeout_s: How long to wait for ``scheduler`` to answer, s.
 
     Returns:
         What the run did.
@@ -140,7 +145,7 @@ def run_campaign(
     with ExitStack() as stack:
         from distributed import as_completed
 
-        client = start_client(scheduler, workers, stack)
+        client = start_client(scheduler, workers, stack, timeout_s)
         n_workers = len(client.scheduler_info()['workers'])  # type: ignore[attr-defined]
         start = time.perf_counter()
         futures = {
@@ -176,19 +181,14 @@ def _collect(
     return failed
 
 
-def run_serial(
-    bags: Sequence[Path],
-    settings: CampaignSettings,
-    work: Callable[[str, CampaignSettings], Row] = process_bag,
-) -> list[Row]:
+def run_serial(bags: Sequence[Path], settings: CampaignSettings) -> list[Row]:
     """The same rows by a plain loop in this process (the baseline of ``lumpbeam bench``).
 
     Args:
         bags: The bag folders.
         settings: As for :func:`run_campaign`.
-        work: The per-bag function.
 
     Returns:
         One row per bag, in order.
     """
-    return [work(str(bag), settings) for bag in bags]
+    return [process_bag(str(bag), settings) for bag in bags]
