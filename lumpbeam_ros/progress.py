@@ -5,6 +5,10 @@ from __future__ import annotations
 import sys
 from typing import TextIO
 
+#: A job with more units than this draws its bar even when the stream is not a TTY (a
+#: bag of 200 000 poses takes long enough that a log wants to see it move).
+LONG_JOB_UNITS = 200_000
+
 
 class Progress:
     """A one-line progress bar on a stream, drawn only when it is a TTY or the job is long.
@@ -15,7 +19,7 @@ class Progress:
         stream: Where to draw (default ``sys.stderr``).
         width: Characters of the bar.
         long_job: A job with more units than this draws even when the stream is not a TTY
-            (``None``: only on a TTY).
+            (``None``: only on a TTY; default :data:`LONG_JOB_UNITS`).
     """
 
     def __init__(
@@ -24,7 +28,7 @@ class Progress:
         label: str,
         stream: TextIO | None = None,
         width: int = 30,
-        long_job: int | None = None,
+        long_job: int | None = LONG_JOB_UNITS,
     ):
         self.stream = stream or sys.stderr
         self.total = max(int(total), 1)

@@ -153,7 +153,10 @@ def run_campaign(
             for bag in pending
         }
         failed = _collect(
-            as_completed(futures), futures, store, Progress(len(pending), 'campaign', stream)
+            as_completed(futures),
+            futures,
+            store,
+            Progress(len(pending), 'campaign', stream, long_job=None),
         )
         seconds = time.perf_counter() - start
     return CampaignRun(store, len(pending), skipped, failed, seconds, n_workers)

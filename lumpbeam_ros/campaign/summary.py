@@ -104,7 +104,9 @@ class CampaignSummary:
                 f'm_b, measured {measured} Hz',
             ]
         for path, error in self.failed:
-            lines.append(f'failed: {path}: {error}')
+            lines.append(
+                f'failed: {error}' if error.startswith(path) else f'failed: {path}: {error}'
+            )
         return '\n'.join(lines)
 
 

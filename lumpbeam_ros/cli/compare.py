@@ -51,9 +51,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument('--camera-topic', default=CAMERA_TOPIC)
     parser.add_argument('--reference-topic', default=REFERENCE_TOPIC)
-    parser.add_argument(
-        '--report', metavar='FILE.html', help='write a self-contained HTML report'
-    )
+    parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
     parser.set_defaults(handler=run)
 
 

@@ -29,9 +29,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         '--write-model', metavar='FILE', help='write the augmented beam parameter file'
     )
-    parser.add_argument(
-        '--report', metavar='FILE.html', help='write a self-contained HTML report'
-    )
+    parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
     parser.set_defaults(handler=run)
 
 

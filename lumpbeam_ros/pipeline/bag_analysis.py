@@ -24,8 +24,6 @@ from lumpbeam_ros.progress import Progress
 POSE_TOPIC = '/tip_pose'
 LOAD_TOPIC = '/tip_load'
 BASE_FRAME = 'beam_base'
-#: A bag with more poses than this shows a progress bar even when stderr is not a TTY.
-LONG_BAG_POSES = 200_000
 
 #: The keys scripts rely on (doc/interfaces.md, "lumpbeam analyze"), each also with ``_std``.
 SPEC_KEYS = (
@@ -68,9 +66,7 @@ def read_window(bag: str | Path, show_progress: bool = True) -> PoseWindow:
         have = ', '.join(sorted(reader.topics)) or 'no topics'
         raise BagError(f'{bag}: no {POSE_TOPIC} in the bag (it has {have})')
     if show_progress:
-        reader.progress = Progress(
-            reader.topics[POSE_TOPIC].count, f'reading {POSE_TOPIC}', long_job=LONG_BAG_POSES
-        )
+        reader.progress = Progress(reader.topics[POSE_TOPIC].count, f'reading {POSE_TOPIC}')
     try:
         poses = read_tip_poses(reader, POSE_TOPIC)
     finally:
