@@ -16,7 +16,14 @@ from typing import TextIO
 
 from lumpbeam_ros.campaign.bags import fingerprint
 from lumpbeam_ros.campaign.store import ResultsStore
-from lumpbeam_ros.campaign.task import CampaignSettings, Row, error_line, process_bag, row_key
+from lumpbeam_ros.campaign.task import (
+    CampaignSettings,
+    Row,
+    error_line,
+    process_bag,
+    row_key,
+    warm_up,
+)
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.progress import Progress
 
@@ -147,6 +154,7 @@ def run_campaign(
 
         client = start_client(scheduler, workers, stack, timeout_s)
         n_workers = len(client.scheduler_info()['workers'])  # type: ignore[attr-defined]
+        client.run(warm_up)  # type: ignore[attr-defined]  # imports are not bag time
         start = time.perf_counter()
         futures = {
             client.submit(process_bag, bag, settings, pure=False): bag  # type: ignore[attr-defined]

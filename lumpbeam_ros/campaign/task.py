@@ -162,3 +162,9 @@ def process_bag(bag: str, settings: CampaignSettings) -> Row:
     row.setdefault('key', row_key(str(path), row['content_hash'], settings_hash))
     row['elapsed_s'] = time.perf_counter() - start
     return row
+
+
+def warm_up() -> None:
+    """Imports what :func:`process_bag` needs, so a worker's first bag is not timed with it."""
+    import lumpbeam_ros.diagnose.workflow  # noqa: F401
+    import lumpbeam_ros.pipeline.bag_analysis  # noqa: F401
