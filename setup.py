@@ -17,6 +17,12 @@ setup(
     ],
     package_data={PACKAGE: ['data/*.csv', 'data/*.xml']},
     install_requires=['setuptools', 'numpy', 'scipy', 'pyyaml', 'threadpoolctl'],
+    extras_require={
+        # lumpbeam campaign: the Dask cluster and the Parquet/CSV table.
+        'campaign': ['dask', 'distributed', 'pyarrow'],
+        # The report test drives the system's Chromium (apt: chromium chromium-driver).
+        'test': ['pytest', 'selenium'],
+    },
     zip_safe=True,
     maintainer='lumpbeam_ros maintainers',
     maintainer_email='lumpbeam@example.org',

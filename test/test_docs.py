@@ -19,6 +19,7 @@ from pathlib import Path
 import pytest
 
 from lumpbeam_ros.bench.result import BenchResult
+from lumpbeam_ros.campaign.task import ID_COLUMNS
 from lumpbeam_ros.cli.analyze import SPEC_KEYS
 from lumpbeam_ros.cli.main import COMMANDS, build_parser
 from lumpbeam_ros.diagnose.gap import Gap
@@ -147,6 +148,7 @@ def json_keys() -> dict[str, set[str]]:
         'track': dict_keys('cli/track.py', 'run'),
         'bench': dict_keys('cli/bench.py', 'run') | field_names(BenchResult),
         'demo': dict_keys('pipeline/demo.py', 'summarize'),
+        'campaign': set(ID_COLUMNS),
     }
 
 

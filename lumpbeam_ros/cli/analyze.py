@@ -3,37 +3,15 @@
 from __future__ import annotations
 
 import argparse
-import math
-from collections.abc import Iterator
-from dataclasses import replace
 from pathlib import Path
-from typing import Any
 
-from lumpbeam_ros.bagio import BagReader, read_load_events, read_tip_poses
 from lumpbeam_ros.cli.output import write_json
-from lumpbeam_ros.cli.progress import Progress
-from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.ident.config import load_identifier_config
-from lumpbeam_ros.ident.identify import identify
-from lumpbeam_ros.ident.result import Identification
-from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow, clean_loads, clean_window
 from lumpbeam_ros.model.parameters import load_beam_config
+from lumpbeam_ros.pipeline.bag_analysis import SPEC_KEYS, analyze_bag, read_window, result_json
+from lumpbeam_ros.progress import Progress
 
-POSE_TOPIC = '/tip_pose'
-LOAD_TOPIC = '/tip_load'
-BASE_FRAME = 'beam_base'
-#: A bag with more poses than this shows a progress bar even when stderr is not a TTY.
-LONG_BAG_POSES = 200_000
-
-#: SPEC section 5's keys, each also with ``_std``.
-SPEC_KEYS = (
-    'natural_frequency_hz',
-    'damped_frequency_hz',
-    'damping_ratio',
-    'stiffness_total_nm_per_rad',
-    'stiffness_vertical_n_per_m',
-    'damping_total',
-)
+__all__ = ['SPEC_KEYS', 'Progress', 'read_window', 'register', 'result_json', 'run']
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -46,78 +24,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         '--identifier-config', help='identifier parameter file (default: config/identifier.yaml)'
     )
+    parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
     parser.set_defaults(handler=run)
-
-
-class _CountingReader(BagReader):
-    """A bag reader that ticks a progress bar per message it deserializes."""
-
-    progress: Progress | None = None
-
-    def messages(self, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
-        for item in super().messages(topic, msgtype):
-            if self.progress is not None:
-                self.progress.tick()
-            yield item
-
-
-def read_window(bag: str | Path) -> PoseWindow:
-    """Reads ``/tip_pose`` (and ``/tip_load`` when present) into a cleaned window.
-
-    Args:
-        bag: The bag folder.
-
-    Returns:
-        The poses in ``beam_base`` with the load readings.
-
-    Raises:
-        BagError: Not a bag, no or an empty ``/tip_pose``, poses in another frame.
-    """
-    reader = _CountingReader(bag)
-    if POSE_TOPIC not in reader.topics:
-        have = ', '.join(sorted(reader.topics)) or 'no topics'
-        raise BagError(f'{bag}: no {POSE_TOPIC} in the bag (it has {have})')
-    count = reader.topics[POSE_TOPIC].count
-    reader.progress = Progress(count, f'reading {POSE_TOPIC}', long_job=LONG_BAG_POSES)
-    try:
-        poses = read_tip_poses(reader, POSE_TOPIC)
-    finally:
-        reader.progress.close()
-        reader.progress = None
-    if poses.t.size == 0:
-        raise BagError(f'{bag}: {POSE_TOPIC} holds no messages')
-    if poses.frame_id != BASE_FRAME:
-        raise BagError(
-            f'{bag}: {POSE_TOPIC} is in frame {poses.frame_id!r}, expected {BASE_FRAME!r}'
-        )
-    loads = LoadReadings()
-    if LOAD_TOPIC in reader.topics:
-        series = read_load_events(reader, LOAD_TOPIC)
-        loads = clean_loads(series.t, series.kg)
-    return clean_window(poses.t, poses.z, poses.pitch, loads)
-
-
-def result_json(result: Identification) -> dict[str, Any]:
-    """The JSON of SPEC section 5 (its keys first), then every other figure."""
-    data = result.as_dict()
-    head = {key: data[key] for key in SPEC_KEYS}
-    head.update({f'{key}_std': data[f'{key}_std'] for key in SPEC_KEYS})
-    head['release_time_s'] = data['release_time_s']
-    head['static_deflection_m'] = data['static_deflection_m']
-    return {**head, **{k: v for k, v in data.items() if k not in head}}
 
 
 def run(args: argparse.Namespace) -> int:
     """Reads the bag, identifies the whole record, prints a summary, writes JSON and plots."""
     beam, _ = load_beam_config(args.config)
     config = load_identifier_config(args.identifier_config)
-    window = read_window(args.bag)
-    # The whole record is one window: the fit may run to its end.
-    config = replace(config, max_fit_s=math.inf)
-    try:
-        result = identify(window, beam, config, strict=True)
-    except LumpbeamError as exc:
-        raise LumpbeamError(f'{args.bag}: {exc}') from None
+    analysis = analyze_bag(args.bag, beam, config)
+    window, result = analysis.window, analysis.result
     print(f'{args.bag}: {len(window)} poses over {window.end_s - window.start_s:.2f} s')
     print(result.summary())
     if args.json:
@@ -127,4 +43,8 @@ def run(args: argparse.Namespace) -> int:
 
         for path in write_analysis_plots(window, result, Path(args.plots)):
             print(f'wrote {path}')
+    if args.report:
+        from lumpbeam_ros.report.analysis import write_analysis_report
+
+        print(f'wrote {write_analysis_report(analysis, args.report)}')
     return 0 if result.ok else 1

@@ -51,6 +51,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument('--camera-topic', default=CAMERA_TOPIC)
     parser.add_argument('--reference-topic', default=REFERENCE_TOPIC)
+    parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
     parser.set_defaults(handler=run)
 
 
@@ -74,6 +75,10 @@ def run(args: argparse.Namespace) -> int:
         from lumpbeam_ros.plots.comparison import plot_comparison  # matplotlib only if asked
 
         print(f'figure: {plot_comparison(comparison, args.plots)}')
+    if args.report:
+        from lumpbeam_ros.report.comparison import write_comparison_report
+
+        print(f'report: {write_comparison_report(comparison, args.bag, args.report)}')
     return 0
 
 

@@ -29,6 +29,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument(
         '--write-model', metavar='FILE', help='write the augmented beam parameter file'
     )
+    parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
     parser.set_defaults(handler=run)
 
 
@@ -78,6 +79,10 @@ def run(args: argparse.Namespace) -> int:
 
         for path in plot_diagnosis(result, args.plots):
             print(f'  wrote {path}')
+    if args.report:
+        from lumpbeam_ros.report.diagnosis import write_diagnosis_report
+
+        print(f'  wrote {write_diagnosis_report(result, args.bag, args.report)}')
     if args.write_model:
         header = (
             f'Written by lumpbeam diagnose from {args.bag}: missing effect '

@@ -28,6 +28,7 @@ COMMANDS = (
     'play',
     'bench',
     'demo',
+    'campaign',
 )
 
 USAGE_ERROR = 2

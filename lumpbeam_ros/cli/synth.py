@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 
 from lumpbeam_ros.cli.output import non_negative_float, positive_float
-from lumpbeam_ros.model.parameters import load_beam_config
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, load_beam_config
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, parse_effect, write_drop_test_bag
 from lumpbeam_ros.synthetic.images import ImageOptions, parse_image_size
 from lumpbeam_ros.synthetic.tracker import TrackerOptions
@@ -15,6 +16,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Adds the ``synth`` subcommand."""
     parser = subparsers.add_parser('synth', help='write a synthetic drop-test bag')
     parser.add_argument('out', help='bag folder to create (must not exist)')
+    parser.add_argument(
+        '--loads',
+        metavar='KG,KG,...',
+        help='write a campaign: OUT becomes a folder of bags, one per load and seed',
+    )
+    parser.add_argument(
+        '--seeds', type=int, default=1, metavar='N', help='with --loads: bags per load (1)'
+    )
     parser.add_argument('--config', help='beam parameter file (default: config/paper_beam.yaml)')
     parser.add_argument('--duration', type=positive_float, default=12.0, help='seconds (12)')
     parser.add_argument('--rate', type=positive_float, default=180.0, help='pose rate, Hz (180)')
@@ -110,6 +119,8 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
         effects=effects,
     )
+    if args.loads is not None:
+        return _write_campaign(args, beam, drop, options)
     tracker = _tracker_options(args)
     images = None
     if args.images:
@@ -131,4 +142,21 @@ def run(args: argparse.Namespace) -> int:
         )
     if images is not None:
         print(f'  + {len(measured)} mono8 frames of {images.width}x{images.height} px')
+    return 0
+
+
+def _write_campaign(
+    args: argparse.Namespace, beam: BeamParameters, drop: DropTestConfig, options: SynthOptions
+) -> int:
+    """``--loads``: a folder of drop-test bags, one per load and seed."""
+    from lumpbeam_ros.synthetic.campaign import parse_loads, write_campaign
+
+    if args.tracker or args.images:
+        raise LumpbeamError('--loads writes pose-only bags: drop --tracker and --images')
+    loads = parse_loads(args.loads)
+    bags = write_campaign(args.out, beam, drop, options, loads, args.seeds)
+    print(
+        f'wrote {len(bags)} bags into {args.out}: loads {", ".join(f"{x:g}" for x in loads)} kg '
+        f'x {args.seeds} seeds from {args.seed}, {args.duration:g} s each'
+    )
     return 0

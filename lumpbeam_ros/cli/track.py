@@ -120,7 +120,7 @@ class _ProgressBar:
 
     def __call__(self, done: int, total: int | None) -> None:
         if self.bar is None:
-            from lumpbeam_ros.cli.progress import Progress
+            from lumpbeam_ros.progress import Progress
 
             # A video that does not declare its length gets no bar (no end to measure by).
             enabled = False if self.quiet or total is None else None

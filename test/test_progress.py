@@ -2,8 +2,7 @@ import io
 
 import pytest
 
-from lumpbeam_ros.cli.analyze import LONG_BAG_POSES
-from lumpbeam_ros.cli.progress import Progress
+from lumpbeam_ros.progress import LONG_JOB_UNITS, Progress
 
 
 class _Terminal(io.StringIO):
@@ -23,7 +22,7 @@ class _Terminal(io.StringIO):
 def test_progress_bar_only_for_a_tty_or_a_long_job(total, stream, enabled, shown):
     stream = stream()
     bar = Progress(total, 'reading', stream=stream, width=10, enabled=enabled,
-                   long_job=LONG_BAG_POSES)  # fmt: skip
+                   long_job=LONG_JOB_UNITS)  # fmt: skip
     for _ in range(total // 2):
         bar.tick()
     bar.close()

@@ -1,13 +1,17 @@
-"""A progress bar on stderr for the commands' long runs."""
+"""A one-line text progress bar for long jobs (reading a bag, tracking footage, a campaign)."""
 
 from __future__ import annotations
 
 import sys
 from typing import TextIO
 
+#: A job with more units than this draws its bar even when the stream is not a TTY (a
+#: bag of 200 000 poses takes long enough that a log wants to see it move).
+LONG_JOB_UNITS = 200_000
+
 
 class Progress:
-    """A one-line progress bar on a stream (stderr), drawn only where someone watches it.
+    """A one-line progress bar on a stream, drawn only where someone watches it.
 
     Args:
         total: Units of work expected.
@@ -27,7 +31,7 @@ class Progress:
         stream: TextIO | None = None,
         width: int = 30,
         enabled: bool | None = None,
-        long_job: int | None = None,
+        long_job: int | None = LONG_JOB_UNITS,
     ):
         self.stream = stream or sys.stderr
         self.total = max(int(total), 1)
@@ -39,15 +43,21 @@ class Progress:
             enabled = self.stream.isatty() or (long_job is not None and total > long_job)
         self.enabled = bool(enabled)
 
-    def tick(self, units: int = 1) -> None:
-        """Counts ``units`` of work; redraws at each whole per cent."""
+    def tick(self, units: int = 1, note: str = '') -> None:
+        """Counts ``units`` of work; redraws at each whole per cent (or when ``note`` is given).
+
+        Args:
+            units: Work done since the last call.
+            note: A short text drawn after the percentage (e.g. failures so far).
+        """
         self.done += units
         percent = min(100, 100 * self.done // self.total)
-        if self.enabled and percent != self._shown:
+        if self.enabled and (percent != self._shown or note):
             self._shown = percent
             filled = self.width * percent // 100
             bar = '#' * filled + '.' * (self.width - filled)
-            self.stream.write(f'\r{self.label} [{bar}] {percent:3d}%')
+            tail = f' {note}' if note else ''
+            self.stream.write(f'\r{self.label} [{bar}] {percent:3d}%{tail}')
             self.stream.flush()
 
     def close(self) -> None:
