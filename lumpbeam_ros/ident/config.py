@@ -34,6 +34,8 @@ class IdentifierConfig:
     assumed_load_kg: float = 4.5
     min_step_snr: float = 20.0
     min_quiet_s: float = 0.2
+    hint_late_s: float = 1.0
+    hint_early_s: float = 1.0
     skip_after_release_s: float = 0.02
     max_modes: int = 2
     drift: bool = False
@@ -63,6 +65,8 @@ PARAMETER_KEYS: dict[str, str] = {
     'assumed_load_kg': 'release.assumed_load_kg',
     'min_step_snr': 'release.min_step_snr',
     'min_quiet_s': 'release.min_quiet_s',
+    'hint_late_s': 'release.hint_late_s',
+    'hint_early_s': 'release.hint_early_s',
     'skip_after_release_s': 'fit.skip_after_release_s',
     'max_modes': 'fit.max_modes',
     'drift': 'fit.drift',

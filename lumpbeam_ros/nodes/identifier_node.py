@@ -171,12 +171,13 @@ class IdentifierNode(Node):
             )
 
     def _on_load(self, msg: Float64) -> None:
-        # Float64 has no stamp: the reading holds from now, on the node's (sim) clock.
+        # Float64 has no stamp: the reading only hints at a release, timed from the poses.
         now = self.get_clock().now().nanoseconds * 1e-9
-        if not self.window.push_load(now, msg.data):
+        stored, stamp = self.window.push_load_on_arrival(msg.data, now)
+        if not stored:
             self.get_logger().warning(
-                f'/tip_load {msg.data!r} at {now:.3f} s rejected (not a finite mass >= 0, or '
-                'older than the last reading)',
+                f'/tip_load {msg.data!r} at {stamp:.3f} s rejected (not a finite mass >= 0, '
+                'or older than the last reading)',
                 throttle_duration_sec=WARN_PERIOD_S,
             )
 
