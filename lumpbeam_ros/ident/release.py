@@ -160,7 +160,7 @@ def _from_hint(scan: _Scan, drop: LoadChange, config: IdentifierConfig) -> Relea
     quiet = scan.quiet_between(low, high)
     earlier = [s for s in scan.steps if s.rising and scan.t[s.departure] < low]
     if not quiet and earlier:
-        before = scan.t[earlier[-1].departure]
+        before = scan.t[earlier[-1].departure - 1]
         return Release(
             time_s=drop.time_s,
             confidence=_HINT_ONLY_CONFIDENCE,
