@@ -17,6 +17,7 @@ from lumpbeam_ros.ident.config import load_identifier_config
 from lumpbeam_ros.ident.identify import identify
 from lumpbeam_ros.ident.result import Identification
 from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow, clean_loads, clean_window
+from lumpbeam_ros.ident.segments import keep_release_segment
 from lumpbeam_ros.model.parameters import load_beam_config
 
 POSE_TOPIC = '/tip_pose'
@@ -148,6 +149,10 @@ def run(args: argparse.Namespace) -> int:
     beam, _ = load_beam_config(args.config)
     config = load_identifier_config(args.identifier_config)
     window = read_window(args.bag)
+    window, split = keep_release_segment(window, config)
+    for note in (window.counts.note(), split):
+        if note:
+            print(f'lumpbeam analyze: warning: {args.bag}: {POSE_TOPIC}: {note}', file=sys.stderr)
     # The whole record is one window: the fit may run to its end.
     config = replace(config, max_fit_s=math.inf)
     try:
