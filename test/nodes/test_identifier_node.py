@@ -138,7 +138,11 @@ def _replay(ros_graph, node, poses, arrival, rate):
 
 
 def _check_replay(statuses, batch, truth, arrival):
-    """The last update: OK, release within a frame, estimates within the batch's tolerances."""
+    """The last update: OK, release within a frame, estimates within the batch's tolerances.
+
+    Returns:
+        The release error in frames, and each estimate's (value - truth) / analyze's std.
+    """
     level, message, last = statuses[-1]
     assert level == 0, message
     release_error = float(last['release_time_s']) - RELEASE_S
@@ -179,27 +183,16 @@ def test_replayed_drop_test_gives_ok_estimates(ros_graph, drop_record, arrival):
 
 
 @pytest.mark.slow
-def test_release_matrix_of_arrivals_and_rates(ros_graph, drop_record, capsys):
-    """Every /tip_load arrival at every replay rate; prints the table (pytest -s -m slow)."""
+@pytest.mark.parametrize('rate', list(RATES))
+@pytest.mark.parametrize('arrival', list(ARRIVALS))
+def test_release_matrix_of_arrivals_and_rates(ros_graph, drop_record, arrival, rate):
+    """Every /tip_load arrival at every replay rate; each prints its row (-s -m slow)."""
     poses, batch, truth = drop_record
-    rows = []
-    for rate_name, rate in RATES.items():
-        for arrival_name, arrival in ARRIVALS.items():
-            node = _identifier(ros_graph)
-            statuses = _replay(ros_graph, node, poses, arrival, rate)
-            frames, errors = _check_replay(statuses, batch, truth, arrival)
-            rows.append((arrival_name, rate_name, frames, errors))
-            ros_graph.executor.remove_node(node)
-            node.destroy_node()
-    with capsys.disabled():
-        print('\n/tip_load        replay     release error   (estimate - truth) / analyze std')
-        print('                            frames          f_n      zeta     k_tE')
-        for arrival_name, rate_name, frames, errors in rows:
-            e = [errors[key] for key in ESTIMATES]
-            print(
-                f'{arrival_name:<16} {rate_name:<10} {frames:+8.3f}     '
-                f'{e[0]:+8.2f} {e[1]:+8.2f} {e[2]:+8.2f}'
-            )
+    node = _identifier(ros_graph)
+    statuses = _replay(ros_graph, node, poses, ARRIVALS[arrival], RATES[rate])
+    frames, errors = _check_replay(statuses, batch, truth, ARRIVALS[arrival])
+    sigmas = ' '.join(f'{errors[key]:+6.2f}' for key in ESTIMATES)
+    print(f'\nRELEASE_MATRIX {arrival:<12} {rate:<8} release {frames:+.3f} frames; ' + sigmas)
 
 
 def _pose(stamp, z, frame='beam_base', pitch_w=1.0, pitch=0.0, x=2.3):
@@ -251,6 +244,11 @@ def test_bad_input_gives_errors_not_crashes_or_garbage(ros_graph):
     assert {level for level, _, _ in statuses} == {2}
     assert all(math.isnan(float(values['natural_frequency_hz'])) for _, _, values in statuses)
     assert int(statuses[-1][2]['samples_wrong_frame']) == node.wrong_frame
+    # The status message says what was dropped, not only the counts.
+    non_finite = int(statuses[-1][2]['samples_non_finite'])
+    assert '/tip_pose: dropped ' in statuses[-1][1]
+    assert f'({non_finite} with a NaN or inf stamp, position or orientation; ' in statuses[-1][1]
+    assert 'with a repeated or out-of-order stamp)' in statuses[-1][1]
 
 
 def test_parameters_are_validated():
