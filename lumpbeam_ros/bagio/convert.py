@@ -78,10 +78,7 @@ def quaternion_to_pitch(x: float, y: float, z: float, w: float) -> float:
 
     The rotated x axis is ``d = R e_x``; the pitch is ``atan2(-d_z, d_x)``, so a pure rotation
     about +y gives back its angle and small roll or yaw leave it unchanged to first order.
-    The quaternion need not be normalized.
-
-    Raises:
-        BagError: A zero or non-finite quaternion.
+    The quaternion need not be normalized; a zero or non-finite one gives NaN.
     """
     return float(quaternions_to_pitch(np.array([[x, y, z, w]], dtype=float))[0])
 
@@ -89,19 +86,17 @@ def quaternion_to_pitch(x: float, y: float, z: float, w: float) -> float:
 def quaternions_to_pitch(xyzw: np.ndarray) -> np.ndarray:
     """:func:`quaternion_to_pitch` for an array of quaternions, shape (n, 4).
 
-    Raises:
-        BagError: A zero or non-finite quaternion (the first one is named).
+    A zero or non-finite quaternion gives a NaN pitch: the sample is then dropped and counted
+    like one with a NaN position (:func:`~lumpbeam_ros.ident.samples.clean_window`).
     """
     x, y, z, w = xyzw.T
     norm2 = x * x + y * y + z * z + w * w
     bad = ~np.isfinite(norm2) | (norm2 == 0.0)
-    if bad.any():
-        q = tuple(float(v) for v in xyzw[int(np.argmax(bad))])
-        raise BagError(f'invalid orientation quaternion {q}')
-    s = 2.0 / norm2
-    d_x = 1.0 - s * (y * y + z * z)
-    d_z = s * (x * z - w * y)
-    return np.arctan2(-d_z, d_x)
+    s = 2.0 / np.where(bad, 1.0, norm2)
+    with np.errstate(invalid='ignore', over='ignore'):
+        d_x = 1.0 - s * (y * y + z * z)
+        d_z = s * (x * z - w * y)
+        return np.where(bad, np.nan, np.arctan2(-d_z, d_x))
 
 
 def pose_stamped(ns: int, x: float, z: float, pitch: float, frame_id: str) -> Any:

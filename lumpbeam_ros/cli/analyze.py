@@ -3,12 +3,19 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from lumpbeam_ros.cli.output import write_json
 from lumpbeam_ros.ident.config import load_identifier_config
 from lumpbeam_ros.model.parameters import load_beam_config
-from lumpbeam_ros.pipeline.bag_analysis import SPEC_KEYS, analyze_bag, read_window, result_json
+from lumpbeam_ros.pipeline.bag_analysis import (
+    POSE_TOPIC,
+    SPEC_KEYS,
+    analyze_bag,
+    read_window,
+    result_json,
+)
 from lumpbeam_ros.progress import Progress
 
 __all__ = ['SPEC_KEYS', 'Progress', 'read_window', 'register', 'result_json', 'run']
@@ -34,6 +41,8 @@ def run(args: argparse.Namespace) -> int:
     config = load_identifier_config(args.identifier_config)
     analysis = analyze_bag(args.bag, beam, config)
     window, result = analysis.window, analysis.result
+    for note in analysis.notes:
+        print(f'lumpbeam analyze: warning: {args.bag}: {POSE_TOPIC}: {note}', file=sys.stderr)
     print(f'{args.bag}: {len(window)} poses over {window.end_s - window.start_s:.2f} s')
     print(result.summary())
     if args.json:

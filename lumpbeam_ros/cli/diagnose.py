@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from pathlib import Path
 
@@ -69,6 +70,8 @@ def run(args: argparse.Namespace) -> int:
     if not Path(args.bag).is_dir():
         raise LumpbeamError(f'{args.bag}: no such bag folder')
     record = read_record(args.bag)
+    for note in record.notes:
+        print(f'lumpbeam diagnose: warning: {args.bag}: {note}', file=sys.stderr)
     start = time.perf_counter()
     result = diagnose(record, beam)
     print(_summary(result, time.perf_counter() - start))

@@ -17,6 +17,11 @@ MIN_SAMPLES_AFTER_EVENT = 360
 #: A pause between poses longer than this many median periods is a tracking loss.
 TRACKING_LOSS_PERIODS = 1.5
 
+#: A pause or jump of the pose stamps longer than this (s) splits the record: the stretches
+#: do not belong to one experiment, and simulating across a jump of 1e6 s would take memory
+#: in proportion to it.
+MAX_GAP_S = 1.0
+
 #: A stretch of poses shorter than this between two losses joins the stretch after it: a
 #: tracker that holds the target for a few frames has not settled on a new solution.
 MIN_TRACKED_SAMPLES = 20
@@ -32,6 +37,7 @@ class Record:
         pitch: Tip slope, rad.
         initial_load_kg: The load hanging at the start; the beam is at rest with it.
         load_events: ``(time, kg)`` load changes after the start, in time order.
+        notes: What was trimmed from the poses given (stamp jumps), for the user.
     """
 
     t: np.ndarray
@@ -39,6 +45,7 @@ class Record:
     pitch: np.ndarray
     initial_load_kg: float
     load_events: tuple[tuple[float, float], ...]
+    notes: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return int(self.t.size)
@@ -127,6 +134,7 @@ def make_record(
     if t.size and np.any(np.diff(t) <= 0.0):
         unique = np.concatenate([[True], np.diff(t) > 0.0])
         t, z, pitch = t[unique], z[unique], pitch[unique]
+    t, z, pitch, note = _stretch_with_event(t, z, pitch, load_events)
     if t.size < MIN_SAMPLES_AFTER_EVENT:
         raise LumpbeamError(f'{source}: {t.size} valid tip poses, need a longer record')
     load = float(initial_load_kg)
@@ -151,7 +159,37 @@ def make_record(
             f'{source}: {after} poses after the last load change at {events[-1][0]:.3f} s, '
             f'need at least {MIN_SAMPLES_AFTER_EVENT}'
         )
-    return Record(t, z, pitch, load, tuple(events))
+    return Record(t, z, pitch, load, tuple(events), (note,) if note else ())
+
+
+def _stretch_with_event(
+    t: np.ndarray,
+    z: np.ndarray,
+    pitch: np.ndarray,
+    load_events: list[tuple[float, float]] | tuple[tuple[float, float], ...],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+    """The stretch of poses a diagnosis can use when the stamps pause or jump.
+
+    Increasing stamps are split at pauses over ``MAX_GAP_S``; the first stretch that holds
+    a load event is kept (else the longest).
+
+    Returns:
+        The kept ``t``, ``z``, ``pitch`` and what was dropped (``''``: nothing).
+    """
+    gaps = np.flatnonzero(np.diff(t) > MAX_GAP_S)
+    if gaps.size == 0:
+        return t, z, pitch, ''
+    bounds = [0, *(gaps + 1).tolist(), t.size]
+    stretches = list(zip(bounds[:-1], bounds[1:], strict=True))
+    times = [float(time) for time, _ in load_events]
+    holding = [(a, b) for a, b in stretches if any(t[a] < x < t[b - 1] for x in times)]
+    a, b = holding[0] if holding else max(stretches, key=lambda ab: ab[1] - ab[0])
+    jumps = ', '.join(f'by {t[g + 1] - t[g]:+.6g} s after {t[g]:.3f} s' for g in gaps)
+    note = (
+        f'/tip_pose stamps jump {jumps}: kept {t[a]:.3f} to {t[b - 1]:.3f} s ({b - a} poses), '
+        f'dropped {t.size - (b - a)}'
+    )
+    return t[a:b], z[a:b], pitch[a:b], note
 
 
 def record_from_trajectory(

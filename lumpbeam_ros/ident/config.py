@@ -30,10 +30,13 @@ class IdentifierConfig:
     window_s: float = 10.0
     max_rate_hz: float = 400.0
     reset_jump_back_s: float = 1.0
+    max_gap_s: float = 1.0
     publish_rate_hz: float = 2.0
     assumed_load_kg: float = 4.5
     min_step_snr: float = 20.0
     min_quiet_s: float = 0.2
+    hint_late_s: float = 1.0
+    hint_early_s: float = 1.0
     skip_after_release_s: float = 0.02
     max_modes: int = 2
     drift: bool = False
@@ -59,10 +62,13 @@ PARAMETER_KEYS: dict[str, str] = {
     'window_s': 'window.length_s',
     'max_rate_hz': 'window.max_rate_hz',
     'reset_jump_back_s': 'window.reset_jump_back_s',
+    'max_gap_s': 'window.max_gap_s',
     'publish_rate_hz': 'publish_rate_hz',
     'assumed_load_kg': 'release.assumed_load_kg',
     'min_step_snr': 'release.min_step_snr',
     'min_quiet_s': 'release.min_quiet_s',
+    'hint_late_s': 'release.hint_late_s',
+    'hint_early_s': 'release.hint_early_s',
     'skip_after_release_s': 'fit.skip_after_release_s',
     'max_modes': 'fit.max_modes',
     'drift': 'fit.drift',

@@ -160,7 +160,10 @@ def _identify(
     start = window.start_s
     if release.found and release.time_s >= window.start_s:
         start = release.time_s + config.skip_after_release_s
-    keep = (window.t >= start) & (window.t <= start + config.max_fit_s)
+        if math.isfinite(release.decay_start_s):
+            start = max(start, release.decay_start_s)
+    end = min(start + config.max_fit_s, release.decay_end_s)
+    keep = (window.t >= start) & (window.t <= end)
     t, z = window.t[keep], window.z[keep]
     if t.size < config.min_samples:
         return fail(
@@ -442,6 +445,7 @@ def _assemble(
         damping_total_std=damping_total_std,
         cycles=cycles,
         release_time_s=release.time_s,
+        release_time_s_std=release.time_std_s,
         static_deflection_m=deflection,
         static_deflection_m_std=deflection_std,
         release_confidence=release.confidence,

@@ -41,7 +41,9 @@ class Identification:
         window_start_s: First stamp analysed.
         window_end_s: Last stamp analysed.
         cycles: Damped periods in the fitted stretch.
-        release_time_s: When the load left (NaN when not in the window).
+        release_time_s: When the load left (NaN when not in the window), from the onset of
+            the free response in the tip poses.
+        release_time_s_std: Its standard deviation from the onset fit.
         static_deflection_m: delta_vE, the rise of the static tip level at the release.
         release_confidence: 0..1.
         release_source: ``tip_load``, ``data`` or ``none``.
@@ -91,6 +93,7 @@ class Identification:
     window_end_s: float = NAN
     cycles: float = 0.0
     release_time_s: float = NAN
+    release_time_s_std: float = NAN
     static_deflection_m: float = NAN
     static_deflection_m_std: float = NAN
     release_confidence: float = 0.0

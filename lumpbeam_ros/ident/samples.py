@@ -52,6 +52,21 @@ class SampleCounts:
         """Samples left after validation."""
         return self.received - self.non_finite - self.duplicates
 
+    def note(self) -> str:
+        """What validation did, in one line (``''`` when it changed nothing)."""
+        parts = []
+        if self.non_finite:
+            parts.append(f'{self.non_finite} with a NaN or inf stamp, position or orientation')
+        if self.duplicates:
+            parts.append(f'{self.duplicates} with a repeated or out-of-order stamp')
+        notes = []
+        if parts:
+            dropped = self.non_finite + self.duplicates
+            notes.append(f'dropped {dropped} of {self.received} poses ({"; ".join(parts)})')
+        if self.reordered:
+            notes.append('stamps out of order: sorted')
+        return '; '.join(notes)
+
 
 @dataclass(frozen=True)
 class PoseWindow:

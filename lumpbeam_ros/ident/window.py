@@ -120,7 +120,11 @@ class SlidingWindow:
         if stamp <= self._last:
             if stamp < self._last - self.reset_jump_back_s:
                 self._counts['resets'] += 1
+                # The mass hanging does not change because the clock jumped: keep it.
+                kept = self._load_kg[-1:] if self._load_kg else []
                 self.clear()
+                self._load_t.extend(stamp for _ in kept)
+                self._load_kg.extend(kept)
             elif stamp == self._last:
                 self._counts['duplicates'] += 1
                 return False
@@ -154,13 +158,35 @@ class SlidingWindow:
         if stamp < latest - self.reset_jump_back_s:
             self._load_t.clear()
             self._load_kg.clear()
-        elif stamp <= latest:
+        elif stamp == latest:
+            # Two readings within one pose period: the later one holds.
+            self._load_kg[-1] = float(kg)
+            return True
+        elif stamp < latest:
             self._counts['loads_rejected'] += 1
             return False
         self._load_t.append(float(stamp))
         self._load_kg.append(float(kg))
         self._prune_loads(max(stamp, self._last) - self.length_s)
         return True
+
+    def push_load_on_arrival(self, kg: float, clock_s: float) -> tuple[bool, float]:
+        """Adds a ``/tip_load`` reading that carries no stamp (``Float64``).
+
+        It is stamped with the newest pose's stamp (the data's own clock; the node's clock
+        may be another one, or run ahead of a backlog of poses), or ``clock_s`` before any
+        pose. The stamp is only a hint: the release itself is timed from the poses
+        (:func:`~lumpbeam_ros.ident.release.detect_release`).
+
+        Args:
+            kg: Mass at the tip, kg.
+            clock_s: The receiver's clock now, s.
+
+        Returns:
+            Whether the reading was stored, and the stamp it was given.
+        """
+        stamp = self._last if math.isfinite(self._last) else clock_s
+        return self.push_load(stamp, kg), stamp
 
     def snapshot(self) -> PoseWindow:
         """The poses of the last ``length_s`` seconds, oldest first, with their loads.

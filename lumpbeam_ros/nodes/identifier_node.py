@@ -53,6 +53,7 @@ from lumpbeam_ros.ident.config import (
 )
 from lumpbeam_ros.ident.identify import FitState, identify_from
 from lumpbeam_ros.ident.result import Identification, Status
+from lumpbeam_ros.ident.samples import SampleCounts
 from lumpbeam_ros.ident.window import SlidingWindow
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.resources import config_path
@@ -171,12 +172,13 @@ class IdentifierNode(Node):
             )
 
     def _on_load(self, msg: Float64) -> None:
-        # Float64 has no stamp: the reading holds from now, on the node's (sim) clock.
+        # Float64 has no stamp: the reading only hints at a release, timed from the poses.
         now = self.get_clock().now().nanoseconds * 1e-9
-        if not self.window.push_load(now, msg.data):
+        stored, stamp = self.window.push_load_on_arrival(msg.data, now)
+        if not stored:
             self.get_logger().warning(
-                f'/tip_load {msg.data!r} at {now:.3f} s rejected (not a finite mass >= 0, or '
-                'older than the last reading)',
+                f'/tip_load {msg.data!r} at {stamp:.3f} s rejected (not a finite mass >= 0, '
+                'or older than the last reading)',
                 throttle_duration_sec=WARN_PERIOD_S,
             )
 
@@ -203,6 +205,13 @@ class IdentifierNode(Node):
             A DiagnosticArray with one status, stamped now.
         """
         counts = self.window.counts
+        message = result.message
+        repeated = counts.out_of_order + counts.duplicates
+        received = counts.accepted + counts.non_finite + repeated
+        dropped = SampleCounts(received, counts.non_finite, repeated).note()
+        if dropped:
+            # The counts are also published as values; the message says it to a reader.
+            message = f'{message}; /tip_pose: {dropped}'
         pairs: Sequence[tuple[str, str]] = [
             *result.key_values(),
             ('samples_wrong_frame', str(self.wrong_frame)),
@@ -213,7 +222,7 @@ class IdentifierNode(Node):
         status = DiagnosticStatus(
             level=bytes([int(result.status)]),
             name=STATUS_NAME,
-            message=result.message,
+            message=message,
             hardware_id=self.hardware_id,
             values=[KeyValue(key=k, value=v) for k, v in pairs],
         )

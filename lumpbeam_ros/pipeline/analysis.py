@@ -23,6 +23,7 @@ from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.identify import identify
 from lumpbeam_ros.ident.result import Identification
 from lumpbeam_ros.ident.samples import clean_loads, clean_window
+from lumpbeam_ros.ident.segments import keep_release_segment
 from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.plots.demo import Residual, prediction_residual
 
@@ -187,6 +188,7 @@ def analyze_recording(
     loads = read_load_events(bag)
     readings = clean_loads(loads.t, loads.kg)
     window = clean_window(measured.t, measured.z, measured.pitch, readings)
+    window, _ = keep_release_segment(window, config or IdentifierConfig())
     identification = identify(window, beam, config, strict=True)
     live, level = last_live_status(bag)
     residual = prediction_residual(measured.t, measured.z, predicted.t, predicted.z)

@@ -18,6 +18,7 @@ from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.identify import FitState, identify_from
 from lumpbeam_ros.ident.result import Identification
 from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow, clean_loads, clean_window
+from lumpbeam_ros.ident.segments import keep_release_segment
 from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.progress import Progress
 
@@ -105,12 +106,15 @@ class BagAnalysis:
         window: The poses analysed.
         result: The identification.
         fit: The fitted decay and cross-checks (``None`` when the identification failed).
+        notes: What was dropped from the bag's poses and why (bad or repeated samples,
+            stretches cut off by a stamp gap), one line each, for the user to see.
     """
 
     bag: Path
     window: PoseWindow
     result: Identification
     fit: FitState | None
+    notes: tuple[str, ...] = ()
 
 
 def analyze_bag(
@@ -136,9 +140,11 @@ def analyze_bag(
         LumpbeamError: Too few samples, named with the bag.
     """
     window = read_window(bag, show_progress)
+    window, split = keep_release_segment(window, config)
+    notes = tuple(note for note in (window.counts.note(), split) if note)
     config = replace(config, max_fit_s=math.inf)
     try:
         result, fit = identify_from(window, beam, config, strict=True)
     except LumpbeamError as exc:
         raise LumpbeamError(f'{bag}: {exc}') from None
-    return BagAnalysis(Path(bag), window, result, fit)
+    return BagAnalysis(Path(bag), window, result, fit, notes)

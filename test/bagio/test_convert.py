@@ -21,11 +21,12 @@ def test_positive_pitch_points_the_tip_down():
     assert d_z == pytest.approx(-math.sin(0.3))
 
 
-def test_pitch_ignores_normalization_and_rejects_zero_quaternion():
+def test_pitch_ignores_normalization_and_a_broken_quaternion_is_nan():
     qx, qy, qz, qw = convert.pitch_to_quaternion(0.4)
     assert convert.quaternion_to_pitch(3 * qx, 3 * qy, 3 * qz, 3 * qw) == pytest.approx(0.4)
-    with pytest.raises(BagError, match='quaternion'):
-        convert.quaternion_to_pitch(0.0, 0.0, 0.0, 0.0)
+    assert math.isnan(convert.quaternion_to_pitch(0.0, 0.0, 0.0, 0.0))
+    pitch = convert.quaternions_to_pitch(np.array([[qx, qy, qz, qw], [math.nan, 0, 0, 1]]))
+    assert pitch[0] == pytest.approx(0.4) and math.isnan(pitch[1])
 
 
 def test_pose_survives_cdr():

@@ -102,3 +102,16 @@ def test_tracked_segments_start_after_each_loss(lost, starts):
     labels = tracked_segments(index / 180.0)
     assert np.all(np.diff(labels) >= 0)
     assert [int(index[np.argmax(labels == k)]) for k in range(labels.max() + 1)] == starts
+
+
+@pytest.mark.parametrize('jump_s', [100.0, 1e6])
+def test_a_stamp_jump_keeps_the_stretch_with_the_drop(jump_s):
+    t = np.arange(0.0, 12.0, 1.0 / 180.0)
+    t[t > 9.0] += jump_s
+    record = make_record(t, np.zeros(t.size), np.zeros(t.size), 4.5, [(2.0, 0.0)], 'bag')
+    # Simulating the record costs memory in proportion to its span: 9 s, not 1e6 s.
+    assert record.t[0] == 0.0 and record.t[-1] == pytest.approx(9.0, abs=0.01)
+    assert record.load_events == ((2.0, 0.0),)
+    (note,) = record.notes
+    assert note.startswith(f'/tip_pose stamps jump by {jump_s:+.3g}')
+    assert 'kept 0.000 to 9.000 s (1621 poses), dropped 539' in note

@@ -16,6 +16,8 @@ from functools import lru_cache
 import numpy as np
 import pytest
 
+from lumpbeam_ros.ident.samples import PoseWindow
+from lumpbeam_ros.ident.window import SlidingWindow
 from lumpbeam_ros.model import rules
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.modes import chain_modes
@@ -132,3 +134,40 @@ def make_drop_case(
 def drop_case() -> DropCase:
     """The drop-test generator (see :func:`make_drop_case`)."""
     return make_drop_case
+
+
+#: When ``/tip_load`` reports the release, relative to the release (None: never), s.
+HINT_ARRIVALS = {'late_100ms': 0.1, 'late_300ms': 0.3, 'early_100ms': -0.1, 'no_tip_load': None}
+
+
+def replay_window(
+    trajectory: TipTrajectory, release_s: float, arrival: float | None, load_kg: float = 4.5
+) -> PoseWindow:
+    """The window a live node holds after a replay, ``/tip_load`` stamped on its arrival.
+
+    The load reading goes in when the pose stream reaches ``release_s + arrival`` and is
+    stamped as the node stamps it (:meth:`SlidingWindow.push_load_on_arrival`); the initial
+    reading of ``load_kg`` arrives with the first pose.
+
+    Args:
+        trajectory: The poses, in order.
+        release_s: The true release.
+        arrival: Delay of the reading after the release, s (negative: early; None: never).
+        load_kg: The mass released.
+
+    Returns:
+        The window's snapshot, long enough for the whole record.
+    """
+    span = float(trajectory.t[-1] - trajectory.t[0]) + 1.0
+    window = SlidingWindow(length_s=span, max_rate_hz=400.0)
+    pending = None if arrival is None else release_s + arrival
+    for k, (t, z, pitch) in enumerate(
+        zip(trajectory.t, trajectory.z, trajectory.pitch, strict=True)
+    ):
+        if k == 0 and arrival is not None:
+            window.push_load_on_arrival(load_kg, float(t))
+        if pending is not None and t >= pending:
+            window.push_load_on_arrival(0.0, float(t))
+            pending = None
+        window.push(float(t), float(z), float(pitch))
+    return window.snapshot()

@@ -4,10 +4,14 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.ident.config import IdentifierConfig
-from lumpbeam_ros.ident.release import detect_release
+from lumpbeam_ros.ident.release import detect_release, load_changes
 from lumpbeam_ros.ident.samples import clean_loads, clean_window
+from lumpbeam_ros.model.parameters import DropTestConfig
+
+from .conftest import HINT_ARRIVALS, replay_window
 
 CONFIG = IdentifierConfig()
+FRAME_S = 1.0 / 180.0
 
 
 def _window(trajectory, loads=None):
@@ -18,27 +22,73 @@ def test_release_from_the_data(drop_case):
     trajectory, truth = drop_case()
     release = detect_release(_window(trajectory), CONFIG)
     assert release.source == 'data' and release.confidence == 1.0
-    assert abs(release.time_s - truth.release_time_s) < 1.0 / 180.0
+    assert abs(release.time_s - truth.release_time_s) < 0.1 * FRAME_S
+    assert 0.0 < release.time_std_s < 0.1 * FRAME_S
     assert release.level_before_m == pytest.approx(truth.level_before_m, abs=5e-6)
     assert release.level_before_std_m == pytest.approx(20e-6 / math.sqrt(360), rel=0.3)
     assert release.step_snr > 1000 and math.isnan(release.load_kg)
 
 
-def test_release_from_tip_load(drop_case):
-    trajectory, truth = drop_case()
-    loads = clean_loads([0.0, 1.0, 2.0, 3.0], [4.5, 4.5, 0.0, 0.0])
-    release = detect_release(_window(trajectory, loads), CONFIG)
-    assert release.source == 'tip_load' and release.time_s == 2.0
-    assert (release.load_kg, release.load_after_kg) == (4.5, 0.0)
+@pytest.mark.parametrize('frames', [0.0, 0.37, 0.81], ids=lambda f: f'release+{f}frame')
+@pytest.mark.parametrize('arrival', list(HINT_ARRIVALS.values()), ids=list(HINT_ARRIVALS))
+def test_release_is_timed_from_the_poses_whenever_tip_load_arrives(drop_case, frames, arrival):
+    release_s = 2.0 + frames * FRAME_S
+    trajectory, _ = drop_case(drop=DropTestConfig(release_time_s=release_s))
+    release = detect_release(replay_window(trajectory, release_s, arrival), CONFIG)
+    error_frames = (release.time_s - release_s) / FRAME_S
+    assert abs(error_frames) < 0.2, error_frames  # the brief asks for one frame
+    assert abs(release.time_s - release_s) < 4.0 * release.time_std_s + 0.02 * FRAME_S
+    assert release.confidence == 1.0 and release.message == ''
+    if arrival is None:
+        assert release.source == 'data' and math.isnan(release.load_kg)
+    else:
+        assert release.source == 'tip_load'
+        assert (release.load_kg, release.load_after_kg) == (4.5, 0.0)
 
 
-def test_tip_load_drop_the_tip_ignores_is_low_confidence(drop_case):
+@pytest.mark.parametrize(('noise_m', 'rate_hz'), [(5e-6, 180.0), (100e-6, 180.0), (20e-6, 90.0)])
+def test_onset_holds_across_noise_and_rate(drop_case, noise_m, rate_hz):
+    release_s = 2.0 + 0.5 / rate_hz
+    trajectory, _ = drop_case(
+        drop=DropTestConfig(release_time_s=release_s), noise_m=noise_m, rate_hz=rate_hz
+    )
+    release = detect_release(_window(trajectory), CONFIG)
+    assert abs(release.time_s - release_s) * rate_hz < 0.25
+
+
+def test_load_changes():
+    loads = clean_loads([0.0, 1.0, 2.0, 3.0, 4.0], [4.5, 4.5, 0.0, 0.0, 2.0])
+    changes = load_changes(loads)
+    assert [(c.time_s, c.released_kg) for c in changes] == [(2.0, 4.5), (4.0, -2.0)]
+
+
+def test_a_drop_the_tip_does_not_show_is_no_release(drop_case):
     trajectory, _ = drop_case()
     loads = clean_loads([0.0, 1.0], [4.5, 0.0])
     quiet = trajectory.slice_time(0.0, 1.9)
     release = detect_release(_window(quiet, loads), CONFIG)
-    assert release.source == 'tip_load' and release.confidence < CONFIG.min_release_confidence
-    assert 'rose only' in release.message
+    assert not release.found and release.source == 'none'
+    assert '/tip_load shows a release of 4.5 kg at 1.000 s, but the tip does not' in (
+        release.message
+    )
+
+
+def test_zero_kg_before_any_release_keeps_the_data_release_with_a_warning(drop_case):
+    trajectory, truth = drop_case()
+    loads = clean_loads(trajectory.t, np.zeros(trajectory.t.size))
+    release = detect_release(_window(trajectory, loads), CONFIG)
+    assert abs(release.time_s - truth.release_time_s) < 0.2 * FRAME_S
+    assert release.source == 'data' and release.confidence == 0.5
+    assert 'shows no drop (0 kg at the release)' in release.message
+
+
+def test_a_drop_far_from_the_tips_release_is_named(drop_case):
+    trajectory, truth = drop_case()
+    loads = clean_loads([0.0, 0.5], [4.5, 0.0])  # 1.5 s early: beyond release.hint_early_s
+    release = detect_release(_window(trajectory, loads), CONFIG)
+    assert abs(release.time_s - truth.release_time_s) < 0.2 * FRAME_S
+    assert release.confidence == 0.5 and release.load_kg == 4.5
+    assert '/tip_load dropped at 0.500 s, +1.500 s from the release' in release.message
 
 
 @pytest.mark.parametrize(
@@ -66,6 +116,13 @@ def test_falling_level_is_not_a_release(drop_case):
 def test_small_step_is_rejected():
     rng = np.random.default_rng(0)
     t = np.arange(0, 4, 1 / 180)
-    z = np.where(t < 2, 0.0, 1e-4) + rng.normal(0, 20e-6, t.size)
+    z = np.where(t < 2, 0.0, 2e-4) + rng.normal(0, 20e-6, t.size)
     release = detect_release(clean_window(t, z), CONFIG)
     assert not release.found and 'noise sigmas' in release.message
+
+
+def test_window_ending_before_the_first_peak_times_to_a_frame(drop_case):
+    trajectory, truth = drop_case()
+    release = detect_release(_window(trajectory.slice_time(0.0, 2.1)), CONFIG)
+    assert abs(release.time_s - truth.release_time_s) <= FRAME_S
+    assert 'before the first peak' in release.message

@@ -53,14 +53,16 @@ def test_clock_jumping_back_resets():
     assert w.push(0.0, 2.0)  # a bag loop
     assert w.counts.resets == 1 and len(w) == 1
     snap = w.snapshot()
-    assert snap.z.tolist() == [2.0] and len(snap.loads) == 0
+    # The load still hangs after the jump: its last reading holds from the new stamp on.
+    assert snap.z.tolist() == [2.0]
+    assert snap.loads.t.tolist() == [0.0] and snap.loads.kg.tolist() == [4.5]
 
 
 def test_loads_keep_the_reading_before_the_window():
     w = SlidingWindow(length_s=2.0, max_rate_hz=10.0)
     for stamp in np.arange(0.0, 10.0, 1.0):
         w.push_load(stamp, 4.5)
-    assert not w.push_load(9.0, 4.5) and not w.push_load(9.5, math.nan)
+    assert not w.push_load(8.5, 4.5) and not w.push_load(9.5, math.nan)
     assert not w.push_load(9.5, -1.0)
     w.push(9.9, 0.0)
     loads = w.snapshot().loads
@@ -92,3 +94,17 @@ def test_live_stream_identifies_like_a_batch(drop_case):
     assert result.stiffness_total_nm_per_rad == pytest.approx(
         truth.stiffness_total_nm_per_rad, rel=0.01
     )
+
+
+def test_a_second_reading_with_the_same_stamp_replaces_the_first():
+    w = SlidingWindow(length_s=2.0, max_rate_hz=10.0)
+    w.push(1.0, 0.0)
+    assert w.push_load_on_arrival(4.5, 100.0) == (True, 1.0)  # the newest pose's stamp
+    assert w.push_load_on_arrival(0.0, 100.1) == (True, 1.0)
+    loads = w.snapshot().loads
+    assert loads.t.tolist() == [1.0] and loads.kg.tolist() == [0.0]
+
+
+def test_a_reading_before_any_pose_takes_the_clock():
+    w = SlidingWindow(length_s=2.0, max_rate_hz=10.0)
+    assert w.push_load_on_arrival(4.5, 7.0) == (True, 7.0)

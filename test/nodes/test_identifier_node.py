@@ -1,21 +1,29 @@
 import math
 import subprocess
 import sys
-import threading
+import time
 from pathlib import Path
 
 import pytest
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import PoseStamped
 from harness import ros_env
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock
+from std_msgs.msg import Float64
 
-from lumpbeam_ros.bagio import BagReader
+from lumpbeam_ros.bagio import read_tip_poses
+from lumpbeam_ros.bagio.convert import pitch_to_quaternion
+from lumpbeam_ros.cli.analyze import read_window
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.identify import identify
+from lumpbeam_ros.model import rules
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.modes import chain_modes
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
+from lumpbeam_ros.model.statics import static_tip_deflection
 from lumpbeam_ros.nodes.identifier_node import STATUS_NAME, IdentifierNode
-from lumpbeam_ros.nodes.player import Player
 from lumpbeam_ros.resources import config_path
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 
@@ -32,48 +40,171 @@ def _statuses(messages):
     return out
 
 
-def test_replayed_drop_test_gives_ok_estimates(ros_graph, tmp_path):
-    bag = tmp_path / 'drop'
-    write_drop_test_bag(bag, BeamParameters(), DropTestConfig(), SynthOptions(duration_s=11.5))
-    truth = chain_modes(LumpedChain.from_beam(BeamParameters(), 0.0)).natural_frequency_hz[0]
+# A release between two frames, so the test can tell a fitted onset from a frame stamp.
+RELEASE_S = 2.0 + 0.37 / 180.0
+FRAME_S = 1.0 / 180.0
+#: When /tip_load says the load left, relative to the release, s (None: it never does).
+ARRIVALS = {'late_100ms': 0.1, 'late_300ms': 0.3, 'early_100ms': -0.1, 'no_tip_load': None}
+#: Replay speed against the bag's clock; inf: each message as soon as the node took the last.
+RATES = {'rate_0.5': 0.5, 'rate_1': 1.0, 'fastest': math.inf}
+ESTIMATES = ('natural_frequency_hz', 'damping_ratio', 'stiffness_total_nm_per_rad')
+
+
+@pytest.fixture(scope='module')
+def drop_record(tmp_path_factory):
+    """The synthetic drop test (release between frames), its analyze result and the truth."""
+    bag = tmp_path_factory.mktemp('identifier') / 'drop'
+    drop = DropTestConfig(release_time_s=RELEASE_S)
+    write_drop_test_bag(bag, BeamParameters(), drop, SynthOptions(duration_s=11.5))
+    poses = read_tip_poses(bag, '/tip_pose')
+    batch = identify(read_window(bag), BeamParameters(), IdentifierConfig(max_fit_s=math.inf))
+    return poses, batch, _truth(BeamParameters(), drop)
+
+
+def _truth(beam, drop):
+    """f_n and zeta of the unloaded chain; k_tE by B.12 from the model's two equilibria."""
+    modes = chain_modes(LumpedChain.from_beam(beam, 0.0))
+    deflection = static_tip_deflection(beam, drop.load_kg) - static_tip_deflection(beam, 0.0)
+    force = drop.load_kg * beam.gravity_mps2
+    return {
+        'natural_frequency_hz': float(modes.natural_frequency_hz[0]),
+        'damping_ratio': float(modes.damping_ratio[0]),
+        'stiffness_total_nm_per_rad': rules.total_stiffness_from_deflection(
+            force, beam.length_m, deflection
+        ),
+    }
+
+
+def _replay(ros_graph, node, poses, arrival, rate):
+    """Plays the poses with /clock and /tip_load (4.5 kg, then 0 kg at the release + arrival).
+
+    Each message waits for the node to have taken the one before (no queue can overflow, so
+    the node sees every pose whatever the machine's load); at a finite rate it is also held
+    back to its time on the bag's clock. After the last pose /clock runs on until the node
+    has published an update of the whole window.
+
+    Returns:
+        The statuses published.
+    """
+    params = ros_graph.collect('/beam_params', DiagnosticArray, 100)
+    latched = QoSProfile(
+        depth=1,
+        reliability=ReliabilityPolicy.RELIABLE,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    )
+    clock = Clock()
+
+    def tick(stamp):
+        clock.clock.sec, clock.clock.nanosec = divmod(int(round(stamp * 1e9)), 1_000_000_000)
+        ros_graph.publish('/clock', clock, qos=100)
+
+    def load(kg):
+        ros_graph.publish('/tip_load', Float64(data=kg), qos=latched)
+        taken = lambda: node.window.snapshot().loads.kg[-1:].tolist() == [kg]  # noqa: E731
+        assert ros_graph.spin_until(taken, 30.0)
+
+    tick(float(poses.t[0]))
+    ros_graph.publish('/tip_pose', _pose(-1.0, float(poses.z[0])), qos=1000)
+    topics = ['/clock', '/tip_pose']
+    if arrival is not None:
+        load(4.5)
+        topics.append('/tip_load')
+    for topic in topics:
+        assert ros_graph.wait_for_subscribers(topic, timeout=30.0)
+    pending = None if arrival is None else RELEASE_S + arrival
+    started = time.monotonic()
+    for t, x, z, pitch in zip(poses.t, poses.x, poses.z, poses.pitch, strict=True):
+        if math.isfinite(rate):
+            due = started + (t - poses.t[0]) / rate
+            ros_graph.spin_until(lambda due=due: time.monotonic() >= due, 60.0)
+        tick(float(t))
+        if pending is not None and t >= pending:
+            load(0.0)
+            pending = None
+        ros_graph.publish('/tip_pose', _pose(float(t), float(z), pitch=float(pitch), x=x))
+        assert ros_graph.spin_until(lambda t=t: node.window.newest_s >= t, 30.0)
+    last = float(poses.t[-1])
+
+    def whole_window_published():
+        statuses = _statuses(params)
+        return bool(statuses) and float(statuses[-1][2]['window_end_s']) == last
+
+    for k in range(1, 100):
+        tick(last + 0.05 * k)
+        if ros_graph.spin_until(whole_window_published, 1.0):
+            break
+    assert whole_window_published()
+    return _statuses(params)
+
+
+def _check_replay(statuses, batch, truth, arrival):
+    """The last update: OK, release within a frame, estimates within the batch's tolerances.
+
+    Returns:
+        The release error in frames, and each estimate's (value - truth) / analyze's std.
+    """
+    level, message, last = statuses[-1]
+    assert level == 0, message
+    release_error = float(last['release_time_s']) - RELEASE_S
+    assert abs(release_error) < FRAME_S, release_error
+    assert last['release_source'] == ('data' if arrival is None else 'tip_load')
+    errors = {}
+    for key in ESTIMATES:
+        value = float(last[key])
+        errors[key] = (value - truth[key]) / getattr(batch, f'{key}_std')
+        # lumpbeam analyze's own std on the whole record is the tolerance.
+        assert abs(errors[key]) < 3.0, (key, value, truth[key])
+    return release_error / FRAME_S, errors
+
+
+def _identifier(ros_graph):
     node = IdentifierNode(
         context=ros_graph.context,
-        parameter_overrides={'use_sim_time': True, 'publish_rate_hz': 4.0},
+        parameter_overrides={'use_sim_time': True, 'publish_rate_hz': 1.0},
     )
     ros_graph.add_node(node)
-    params = ros_graph.collect('/beam_params', DiagnosticArray, 100)
-    player = Player(
-        BagReader(bag), ['/tip_pose', '/tip_load'], rate=4.0, context=ros_graph.context
-    )
-    ros_graph.spin_for(0.5)  # discovery
-    thread = threading.Thread(target=player.play)
-    thread.start()
-    ros_graph.spin_until(lambda: not thread.is_alive(), 15.0)
-    thread.join()
-    ros_graph.spin_for(0.3)
-    statuses = _statuses(params)
-    assert len(statuses) >= 20  # 4 Hz on the bag's clock for 11.5 s
-    ok = [values for level, _, values in statuses if level == 0]
-    assert ok, [message for _, message, _ in statuses][-3:]
-    last = ok[-1]
-    assert abs(float(last['natural_frequency_hz']) / truth - 1.0) < 5e-3
-    assert float(last['release_time_s']) == pytest.approx(2.0, abs=0.02)
-    assert last['release_source'] == 'tip_load'
+    return node
+
+
+@pytest.mark.parametrize('arrival', ['late_300ms', 'no_tip_load'])
+def test_replayed_drop_test_gives_ok_estimates(ros_graph, drop_record, arrival):
+    poses, batch, truth = drop_record
+    node = _identifier(ros_graph)
+    statuses = _replay(ros_graph, node, poses, ARRIVALS[arrival], math.inf)
+    assert sum(level == 0 for level, _, _ in statuses) >= 5  # 1 Hz on the bag's clock
+    _check_replay(statuses, batch, truth, ARRIVALS[arrival])
+    last = statuses[-1][2]
     # SPEC section 3: every float is a repr, every key has its std.
-    for key in ('natural_frequency_hz', 'damping_ratio', 'stiffness_total_nm_per_rad'):
+    for key in ESTIMATES:
         assert repr(float(last[key])) == last[key] and float(last[f'{key}_std']) > 0
-    for key in ('window_start_s', 'window_end_s', 'cycles', 'method'):
+    for key in ('window_start_s', 'window_end_s', 'cycles', 'method', 'release_time_s_std'):
         assert key in last
     assert float(last['window_end_s']) <= 11.5 and last['samples_wrong_frame'] == '0'
 
 
-def _pose(stamp, z, frame='beam_base', pitch_w=1.0):
+@pytest.mark.slow
+@pytest.mark.parametrize('rate', list(RATES))
+@pytest.mark.parametrize('arrival', list(ARRIVALS))
+def test_release_matrix_of_arrivals_and_rates(ros_graph, drop_record, arrival, rate):
+    """Every /tip_load arrival at every replay rate; each prints its row (-s -m slow)."""
+    poses, batch, truth = drop_record
+    node = _identifier(ros_graph)
+    statuses = _replay(ros_graph, node, poses, ARRIVALS[arrival], RATES[rate])
+    frames, errors = _check_replay(statuses, batch, truth, ARRIVALS[arrival])
+    sigmas = ' '.join(f'{errors[key]:+6.2f}' for key in ESTIMATES)
+    print(f'\nRELEASE_MATRIX {arrival:<12} {rate:<8} release {frames:+.3f} frames; ' + sigmas)
+
+
+def _pose(stamp, z, frame='beam_base', pitch_w=1.0, pitch=0.0, x=2.3):
     msg = PoseStamped()
     msg.header.frame_id = frame
     msg.header.stamp.sec, nanosec = divmod(int(round(stamp * 1e9)), 1_000_000_000)
     msg.header.stamp.nanosec = nanosec
-    msg.pose.position.x, msg.pose.position.z = 2.3, z
-    msg.pose.orientation.w = pitch_w
+    msg.pose.position.x, msg.pose.position.z = float(x), z
+    q = msg.pose.orientation
+    q.x, q.y, q.z, q.w = pitch_to_quaternion(pitch)
+    if pitch_w != 1.0:
+        q.w = pitch_w
     return msg
 
 
@@ -113,6 +244,11 @@ def test_bad_input_gives_errors_not_crashes_or_garbage(ros_graph):
     assert {level for level, _, _ in statuses} == {2}
     assert all(math.isnan(float(values['natural_frequency_hz'])) for _, _, values in statuses)
     assert int(statuses[-1][2]['samples_wrong_frame']) == node.wrong_frame
+    # The status message says what was dropped, not only the counts.
+    non_finite = int(statuses[-1][2]['samples_non_finite'])
+    assert '/tip_pose: dropped ' in statuses[-1][1]
+    assert f'({non_finite} with a NaN or inf stamp, position or orientation; ' in statuses[-1][1]
+    assert 'with a repeated or out-of-order stamp)' in statuses[-1][1]
 
 
 def test_parameters_are_validated():

@@ -1,0 +1,61 @@
+"""Gaps and jumps in the pose stamps: the record split, the stretch with the release kept.
+
+A bag whose clock jumped (a recorder restarted, a replay looped, a stamp corrupted) holds
+stretches that do not belong to one experiment; analysed as one they give wrong estimates
+and, over a jump of 1e6 s, arrays sized by the jump. Every gap longer than
+``window.max_gap_s`` splits the window; the last stretch in which a release is found is
+kept (else the longest), and the split is named.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.release import detect_release
+from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow
+
+
+def _loads_within(loads: LoadReadings, start: float, end: float) -> LoadReadings:
+    """Readings from ``start`` to ``end``, with the last one before ``start``."""
+    first = max(int(np.searchsorted(loads.t, start, side='right')) - 1, 0)
+    last = int(np.searchsorted(loads.t, end, side='right'))
+    return LoadReadings(loads.t[first:last], loads.kg[first:last])
+
+
+def keep_release_segment(window: PoseWindow, config: IdentifierConfig) -> tuple[PoseWindow, str]:
+    """Splits a window at its stamp gaps and keeps the stretch holding the release.
+
+    Args:
+        window: Cleaned poses (stamps increasing).
+        config: ``max_gap_s`` and the release detection's settings.
+
+    Returns:
+        The kept stretch (``window`` itself when there is no gap) and a note naming the
+        gaps and what was dropped (``''`` when nothing was).
+    """
+    t = window.t
+    gaps = np.flatnonzero(np.diff(t) > config.max_gap_s)
+    if gaps.size == 0:
+        return window, ''
+    bounds = [0, *(gaps + 1).tolist(), t.size]
+    parts = [
+        PoseWindow(
+            t[a:b],
+            window.z[a:b],
+            window.pitch[a:b],
+            _loads_within(window.loads, t[a], t[b - 1]),
+            window.counts,
+        )
+        for a, b in zip(bounds[:-1], bounds[1:], strict=True)
+    ]
+    with_release = [p for p in parts if len(p) > 1 and detect_release(p, config).found]
+    kept = with_release[-1] if with_release else max(parts, key=len)
+    jumps = ', '.join(f'by {t[g + 1] - t[g]:+.6g} s after {t[g]:.3f} s' for g in gaps)
+    why = 'the release' if with_release else 'the most poses'
+    note = (
+        f'stamps jump {jumps}: kept {kept.start_s:.3f} to {kept.end_s:.3f} s ({len(kept)} '
+        f'poses, {why}), dropped {len(window) - len(kept)} poses in {len(parts) - 1} other '
+        f'stretch{"es" if len(parts) > 2 else ""}'
+    )
+    return kept, note
