@@ -258,11 +258,14 @@ _NODE = (
     _double(
         'warning_period_s',
         2.0,
-        'at most one warning per kind of problem in this period',
+        'at most one warning of each kind (camera_info, no pose, footage) in this period',
         's',
         _NON_NEGATIVE,
     ),
 )
+
+#: The parameters of ``config/camera.yaml`` (the camera configuration's keys).
+CONFIG_KEYS = tuple(spec.name for spec in (*_CAMERA, *_BOARD, *_SYNTHETIC, *_TRACKER))
 
 CAMERA_SCHEMA = ParameterSchema(
     node='camera_node',
