@@ -68,7 +68,7 @@ _BOARD = (
     _int('board.squares_x', 9, 'squares along the board x axis (differs from squares_y)', 3),
     _int('board.squares_y', 7, 'squares along the board y axis (differs from squares_x)', 3),
     _double('board.square_size_m', 0.06, 'edge of one square', 'm'),
-    _double('board.margin_squares', 1.0, 'white border around the squares, in squares'),
+    _double('board.margin_squares', 1.0, 'white border around the squares', 'squares'),
     _vector('board.xyz_m', (2.3107, 1.0, -0.01), 'position of the board frame in beam_base', 'm'),
     _vector(
         'board.rpy_rad',
@@ -178,8 +178,8 @@ _TRACKER = (
     _double(
         'tracker.min_corner_spread',
         0.5,
-        "a partial view's corners spread at least this far (rms, in squares) across their "
-        'weakest direction',
+        "a partial view's corners spread at least this far (rms) across their weakest direction",
+        'squares',
     ),
 )
 
@@ -270,9 +270,9 @@ CONFIG_KEYS = tuple(spec.name for spec in (*_CAMERA, *_BOARD, *_SYNTHETIC, *_TRA
 CAMERA_SCHEMA = ParameterSchema(
     node='camera_node',
     summary=(
-        'Camera frames in, the tip pose out. The camera.*, board.*, synthetic.* and tracker.* '
-        'values are those of config/camera.yaml (synthetic.* is read by `lumpbeam synth`, not '
-        'by the node). Every parameter is read-only: set it in the params file or with -p.'
+        'Camera frames in, the tip pose out. The `camera.*`, `board.*`, `synthetic.*` and '
+        '`tracker.*` values are those of config/camera.yaml (`synthetic.*` is read by '
+        '`lumpbeam synth`, not by the node). Every parameter is read-only: set it in the params file or with -p.'
     ),
     config_file='camera.yaml',
     parameters=(*_CAMERA, *_BOARD, *_SYNTHETIC, *_TRACKER, *_NODE),
