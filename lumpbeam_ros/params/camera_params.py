@@ -272,7 +272,8 @@ CAMERA_SCHEMA = ParameterSchema(
     summary=(
         'Camera frames in, the tip pose out. The `camera.*`, `board.*`, `synthetic.*` and '
         '`tracker.*` values are those of config/camera.yaml (`synthetic.*` is read by '
-        '`lumpbeam synth`, not by the node). Every parameter is read-only: set it in the params file or with -p.'
+        '`lumpbeam synth`, not by the node). Every parameter is read-only: set it in the '
+        'params file or with -p.'
     ),
     config_file='camera.yaml',
     parameters=(*_CAMERA, *_BOARD, *_SYNTHETIC, *_TRACKER, *_NODE),
