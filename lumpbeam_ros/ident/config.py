@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path
@@ -166,48 +165,3 @@ def load_identifier_config(path: str | Path | None = None) -> IdentifierConfig:
     """
     path = config_path('identifier.yaml') if path is None else Path(path)
     return config_from_parameters(read_parameter_file(path), path)
-
-
-def parameter_descriptions(path: str | Path | None = None) -> dict[str, str]:
-    """The comment above each key of an identifier parameter file, by dotted key.
-
-    The node declares its parameters with these as descriptions, so ``ros2 param describe``
-    shows the same text as the file; the file stays the one place they are written.
-
-    Args:
-        path: The YAML file (default: the package's ``config/identifier.yaml``).
-
-    Returns:
-        Dotted key -> its comment lines joined (keys without a comment are left out).
-
-    Raises:
-        ConfigError: The file cannot be read.
-    """
-    path = config_path('identifier.yaml') if path is None else Path(path)
-    try:
-        lines = path.read_text(encoding='utf-8').splitlines()
-    except OSError as exc:
-        raise ConfigError(path, '', f'cannot read: {exc.strerror}') from None
-    descriptions: dict[str, str] = {}
-    stack: list[tuple[int, str]] = []
-    comment: list[str] = []
-    for line in lines:
-        text = line.strip()
-        if text.startswith('#'):
-            comment.append(text.lstrip('#').strip())
-            continue
-        match = re.match(r'(\s*)([\w/*]+):\s*(\S.*)?$', line)
-        if not match:
-            comment = []
-            continue
-        indent, key, value = len(match[1]), match[2], match[3]
-        while stack and stack[-1][0] >= indent:
-            stack.pop()
-        if value is None:
-            stack.append((indent, key))
-        else:
-            dotted = '.'.join([k for _, k in stack if k not in ('/**', 'ros__parameters')] + [key])
-            if comment:
-                descriptions[dotted] = ' '.join(comment)
-        comment = []
-    return descriptions

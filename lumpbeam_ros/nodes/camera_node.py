@@ -29,13 +29,13 @@ The intrinsics come from ``/camera/camera_info``, or from a ROS camera calibrati
 given as ``camera_info_url`` (``file:///path/camera.yaml``, as camera_info_manager takes it),
 or from the ``camera.*`` parameters with ``use_config_camera_info``.
 
-Parameters: the keys of ``config/camera.yaml`` (read-only), plus the node's own (see
-:data:`NODE_PARAMETERS`). Run it with ``camera_node --ros-args --params-file camera.yaml``.
+Parameters: :data:`~lumpbeam_ros.params.camera_params.CAMERA_SCHEMA` (``doc/parameters.md``):
+the keys of ``config/camera.yaml`` plus the node's own, all read-only. Run it with
+``camera_node --ros-args --params-file camera.yaml``.
 """
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -45,7 +45,6 @@ import numpy as np
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
-from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
@@ -57,8 +56,8 @@ from sensor_msgs.msg import Image
 from lumpbeam_ros.bagio import BagReader
 from lumpbeam_ros.bagio.convert import NS_PER_S, pitch_to_quaternion
 from lumpbeam_ros.errors import BagError, LumpbeamError
-from lumpbeam_ros.paramfile import read_parameter_file
-from lumpbeam_ros.resources import config_path
+from lumpbeam_ros.nodes.parameters import declare_parameters
+from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
 from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
 from lumpbeam_ros.vision.config import camera_config_from_parameters
 from lumpbeam_ros.vision.free_pose import rpy_quaternion
@@ -73,52 +72,6 @@ from lumpbeam_ros.vision.sources import (
     open_footage,
 )
 from lumpbeam_ros.vision.tracker import TrackResult
-
-#: The node's own parameters: name -> (default, description).
-NODE_PARAMETERS: dict[str, tuple[Any, str]] = {
-    'frame_id': ('beam_base', 'header.frame_id of the published poses'),
-    'bag_path': ('', 'read frames from this bag in-process instead of subscribing (empty: off)'),
-    'bag_image_topic': ('/camera/image_raw', 'image topic read from bag_path'),
-    'bag_camera_info_topic': ('/camera/camera_info', 'camera info topic read from bag_path'),
-    'use_config_camera_info': (
-        False,
-        'track with the intrinsics of the camera.* parameters, without waiting for camera_info',
-    ),
-    'camera_info_url': (
-        '',
-        'ROS camera calibration YAML as file:///path.yaml: the intrinsics, without waiting '
-        'for camera_info (empty: off)',
-    ),
-    'footage_path': (
-        '',
-        'read frames from this video file or image folder in-process (empty: off)',
-    ),
-    'footage_fps': (0.0, 'frame rate stamping footage_path: t_i = footage_start_time_s + i / fps'),
-    'footage_start_time_s': (0.0, 'stamp of the first frame of footage_path with footage_fps, s'),
-    'footage_timestamps': (
-        '',
-        'timestamps file of footage_path instead of footage_fps: one stamp per line, s',
-    ),
-    'video_device': (
-        '',
-        'read a live camera through OpenCV: device index (0), device path or URL; frames are '
-        'stamped with the node clock on arrival (empty: off)',
-    ),
-    'pose_model': (
-        'plane',
-        'plane: x, z, pitch in the plane of bending; free: the full 6-DoF pose (with identity '
-        "extrinsics, the camera's pose in the board's frame)",
-    ),
-    'diagnostics_period_s': (1.0, 'period of /diagnostics, s'),
-    'warning_period_s': (2.0, 'at most one warning per kind of problem in this period, s'),
-}
-
-_GROUPS = {
-    'camera': 'camera intrinsics and mount',
-    'board': 'the checkerboard and its pose in beam_base',
-    'synthetic': 'synthetic camera rendering (not used by the node)',
-    'tracker': 'tracker settings',
-}
 
 #: ``/tip_pose`` keeps a few poses for a slow reliable subscriber; a pose is small.
 POSE_QOS = QoSProfile(depth=100)
@@ -150,11 +103,14 @@ class CameraNode(Node):
         parameter_overrides: Sequence[Parameter] | None = None,
     ):
         super().__init__(
-            'camera_node', context=context, parameter_overrides=list(parameter_overrides or [])
+            CAMERA_SCHEMA.node,
+            context=context,
+            parameter_overrides=list(parameter_overrides or []),
         )
-        config_keys = self._declare_parameters()
-        values = {key: self.get_parameter(key).value for key in config_keys}
-        self.config = camera_config_from_parameters(values, 'camera_node parameters')
+        values = declare_parameters(self, CAMERA_SCHEMA)
+        self.config = camera_config_from_parameters(
+            {key: values[key] for key in CONFIG_KEYS}, f'{self.get_name()} parameters'
+        )
         self.frame_id = str(self._param('frame_id'))
         known = self.config.camera_info if self._param('use_config_camera_info') else None
         url = str(self._param('camera_info_url'))
@@ -164,7 +120,6 @@ class CameraNode(Node):
         #: Why the in-process source stopped early (empty: it did not).
         self.source_problem = ''
         self._warning_period = float(self._param('warning_period_s'))
-        self._last_warning: dict[str, float] = {}
         self._period_counts = (0, 0)
         self._period_start = time.monotonic()
 
@@ -193,28 +148,6 @@ class CameraNode(Node):
 
     # -- parameters -------------------------------------------------------------------------
 
-    def _declare_parameters(self) -> list[str]:
-        """Declares the camera file's keys (defaults from the package's file) and the node's.
-
-        Returns:
-            The camera configuration keys.
-        """
-        defaults = read_parameter_file(config_path('camera.yaml'))
-        for key, value in sorted(defaults.items()):
-            group = _GROUPS.get(key.split('.')[0], 'camera configuration')
-            # Typed loosely: the configuration's own checks give the clearer error.
-            descriptor = ParameterDescriptor(
-                description=f'{group} (documented in config/camera.yaml)',
-                read_only=True,
-                dynamic_typing=True,
-            )
-            self.declare_parameter(key, value, descriptor)
-        for key, (value, description) in NODE_PARAMETERS.items():
-            self.declare_parameter(
-                key, value, ParameterDescriptor(description=description, read_only=True)
-            )
-        return sorted(defaults)
-
     def _param(self, name: str) -> Any:
         return self.get_parameter(name).value
 
@@ -232,7 +165,9 @@ class CameraNode(Node):
                 info = self.session.camera_info
                 self.get_logger().info(f'camera info: {info.width} x {info.height} px')
         except LumpbeamError as exc:
-            self.warn('camera_info', f'camera_info ignored: {exc}')
+            self.get_logger().warning(
+                f'camera_info ignored: {exc}', throttle_duration_sec=self._warning_period
+            )
 
     def on_image(self, data: bytes, msgtype: str = 'sensor_msgs/msg/Image') -> None:
         """Tracks one serialized image (``Image`` or ``CompressedImage``), publishes its pose."""
@@ -243,7 +178,9 @@ class CameraNode(Node):
         if stamp_ns is not None and result.ok:
             self.publish_pose(stamp_ns, result)
         else:
-            self.warn(result.status.value, f'no pose: {result.reason}')
+            self.get_logger().warning(
+                f'no pose: {result.reason}', throttle_duration_sec=self._warning_period
+            )
 
     def run_bag(self, should_stop: Callable[[], bool] = lambda: False) -> None:
         """Tracks every frame of ``bag_path`` in recording order, publishing the poses.
@@ -315,7 +252,9 @@ class CameraNode(Node):
                     break
         except FootageError as exc:
             self.source_problem = str(exc)
-            self.warn('source', f'footage stopped: {exc}')
+            self.get_logger().warning(
+                f'footage stopped: {exc}', throttle_duration_sec=self._warning_period
+            )
 
     # -- output -----------------------------------------------------------------------------
 
@@ -341,13 +280,6 @@ class CameraNode(Node):
             covariance = result.covariance6
         with_covariance.pose.covariance = covariance.ravel().tolist()
         self.covariance_publisher.publish(with_covariance)
-
-    def warn(self, kind: str, text: str) -> None:
-        """Logs a warning at most once per ``warning_period_s`` for each kind of problem."""
-        now = time.monotonic()
-        if now - self._last_warning.get(kind, -math.inf) >= self._warning_period:
-            self._last_warning[kind] = now
-            self.get_logger().warning(text)
 
     def diagnostic_status(self) -> DiagnosticStatus:
         """Builds the ``lumpbeam/camera`` status: counts since start and over the last period.

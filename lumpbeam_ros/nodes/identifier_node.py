@@ -7,7 +7,9 @@ a timer at ``publish_rate_hz`` identifies the window
 (:func:`~lumpbeam_ros.ident.identify.identify_from`, warm-started from the last update) and
 publishes one DiagnosticStatus ``lumpbeam/identifier`` (SPEC section 3).
 
-Run it with the package's settings, on sim time when a bag is replayed::
+Parameters: :data:`~lumpbeam_ros.params.identifier_params.IDENTIFIER_SCHEMA`
+(``doc/parameters.md``). Run it with the package's settings, on sim time when a bag is
+replayed::
 
     identifier_node --ros-args --params-file config/identifier.yaml -p use_sim_time:=true
 
@@ -27,14 +29,7 @@ import numpy as np
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
-from rcl_interfaces.msg import (
-    FloatingPointRange,
-    IntegerRange,
-    ParameterDescriptor,
-    ParameterType,
-)
 from rclpy.context import Context
-from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -43,52 +38,19 @@ from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio.convert import pose_values
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.config import (
-    NONLINEAR_CHOICES,
-    PARAMETER_KEYS,
-    IdentifierConfig,
-    config_from_parameters,
-    config_to_parameters,
-    parameter_descriptions,
-)
+from lumpbeam_ros.ident.config import PARAMETER_KEYS, IdentifierConfig, config_from_parameters
 from lumpbeam_ros.ident.identify import FitState, identify_from
 from lumpbeam_ros.ident.result import Identification, Status
 from lumpbeam_ros.ident.samples import SampleCounts
 from lumpbeam_ros.ident.window import SlidingWindow
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
-from lumpbeam_ros.resources import config_path
+from lumpbeam_ros.nodes.parameters import declare_parameters
+from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA
 
-NODE_NAME = 'identifier'
 STATUS_NAME = 'lumpbeam/identifier'
 BASE_FRAME = 'beam_base'
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0
-
-# Ranges ROS shows and enforces; config_from_parameters checks the rest (positivity).
-_RANGES: dict[str, FloatingPointRange | IntegerRange] = {
-    'effective_mass.beam_fraction': FloatingPointRange(from_value=0.0, to_value=1.0),
-    'quality.min_release_confidence': FloatingPointRange(from_value=0.0, to_value=1.0),
-    'fit.max_modes': IntegerRange(from_value=1, to_value=2, step=1),
-    'publish_rate_hz': FloatingPointRange(from_value=0.01, to_value=100.0),
-}
-
-
-def _descriptor(name: str, default: Any, description: str) -> ParameterDescriptor:
-    descriptor = ParameterDescriptor(name=name, description=description, read_only=True)
-    bound = _RANGES.get(name)
-    if isinstance(bound, FloatingPointRange):
-        descriptor.floating_point_range = [bound]
-    elif isinstance(bound, IntegerRange):
-        descriptor.integer_range = [bound]
-    if name == PARAMETER_KEYS['nonlinear']:
-        descriptor.additional_constraints = f'one of {", ".join(NONLINEAR_CHOICES)}'
-    descriptor.type = {
-        bool: ParameterType.PARAMETER_BOOL,
-        int: ParameterType.PARAMETER_INTEGER,
-        float: ParameterType.PARAMETER_DOUBLE,
-        str: ParameterType.PARAMETER_STRING,
-    }[type(default)]
-    return descriptor
 
 
 class IdentifierNode(Node):
@@ -109,11 +71,15 @@ class IdentifierNode(Node):
         parameter_overrides: Mapping[str, Any] | None = None,
     ):
         overrides = [Parameter(k, value=v) for k, v in (parameter_overrides or {}).items()]
-        super().__init__(NODE_NAME, context=context, parameter_overrides=overrides)
-        self.config = self._declare_config()
-        beam_file = self._declare('beam_config', str(config_path('paper_beam.yaml')), '')
-        self.beam: BeamParameters = load_beam_config(beam_file)[0]
-        self.hardware_id = self._declare('hardware_id', 'beam', 'DiagnosticStatus.hardware_id.')
+        super().__init__(IDENTIFIER_SCHEMA.node, context=context, parameter_overrides=overrides)
+        values = declare_parameters(self, IDENTIFIER_SCHEMA)
+        settings = {key: values[key] for key in PARAMETER_KEYS.values()}
+        self.config: IdentifierConfig = config_from_parameters(
+            settings, f'{self.get_name()} parameters'
+        )
+        beam_file = str(values['beam_config'])
+        self.beam: BeamParameters = load_beam_config(beam_file or None)[0]
+        self.hardware_id = str(values['hardware_id'])
         self.window = SlidingWindow.from_config(self.config)
         self._state: FitState | None = None
         self._resets = 0
@@ -128,24 +94,6 @@ class IdentifierNode(Node):
         )
         self.create_subscription(Float64, '/tip_load', self._on_load, latched)
         self.create_timer(1.0 / self.config.publish_rate_hz, self._on_timer)
-
-    def _declare(self, name: str, default: Any, description: str) -> Any:
-        try:
-            parameter = self.declare_parameter(
-                name, default, _descriptor(name, default, description)
-            )
-        except ParameterException as exc:
-            raise LumpbeamError(f'parameter {name}: {exc}') from None
-        return parameter.value
-
-    def _declare_config(self) -> IdentifierConfig:
-        """Declares the identifier's parameters (defaults: the dataclass) and reads them."""
-        descriptions = parameter_descriptions()
-        values = {
-            name: self._declare(name, default, descriptions.get(name, ''))
-            for name, default in config_to_parameters(IdentifierConfig()).items()
-        }
-        return config_from_parameters(values, f'node {self.get_name()} parameters')
 
     def _on_pose(self, msg: PoseStamped) -> None:
         if msg.header.frame_id != BASE_FRAME:

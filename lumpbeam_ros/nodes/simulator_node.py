@@ -5,8 +5,9 @@ Subscribes ``/tip_load`` (std_msgs/Float64, kg; reliable, transient local, depth
 publishes ``/tip_pose_predicted`` (geometry_msgs/PoseStamped in ``beam_base``). A steady
 timer advances a :class:`~lumpbeam_ros.model.stream.PredictionStream` to the node's clock
 (wall time, or ``/clock`` with ``use_sim_time``) and publishes the samples due since the last
-tick, each stamped with its model time. Parameters: ``config/simulator.yaml``, where each is
-documented; its values are the node's defaults.
+tick, each stamped with its model time. Parameters:
+:data:`~lumpbeam_ros.params.simulator_params.SIMULATOR_SCHEMA` (``doc/parameters.md``); their
+defaults are the values of ``config/simulator.yaml``, where each is documented.
 
 Run it::
 
@@ -18,19 +19,12 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseStamped
-from rcl_interfaces.msg import (
-    FloatingPointRange,
-    ParameterDescriptor,
-    ParameterType,
-    SetParametersResult,
-)
 from rclpy.clock import Clock, ClockType
 from rclpy.context import Context
 from rclpy.exceptions import ParameterException
@@ -47,8 +41,8 @@ from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.model.stream import PredictionStream
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.nodes.msgtypes import from_bag_qos
-from lumpbeam_ros.paramfile import read_parameter_file
-from lumpbeam_ros.resources import config_path
+from lumpbeam_ros.nodes.parameters import declare_parameters
+from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA
 
 FRAME_ID = 'beam_base'
 IDENTIFIER_STATUS = 'lumpbeam/identifier'
@@ -58,90 +52,6 @@ OK_LEVEL = 0
 WARN_PERIOD_S = 5.0
 #: Publisher depth: a late tick publishes several periods' samples in one burst.
 PREDICTION_DEPTH = 100
-
-
-@dataclass(frozen=True)
-class _Spec:
-    """A parameter's type, description and range (``None``: no range)."""
-
-    kind: int
-    description: str
-    low: float | None = None
-    high: float | None = None
-
-    def descriptor(self, name: str) -> ParameterDescriptor:
-        descriptor = ParameterDescriptor(name=name, type=self.kind, description=self.description)
-        if self.low is not None and self.high is not None:
-            descriptor.floating_point_range = [
-                FloatingPointRange(from_value=self.low, to_value=self.high, step=0.0)
-            ]
-        return descriptor
-
-
-#: The parameters (their defaults are in config/simulator.yaml, documented there).
-PARAMETERS: dict[str, _Spec] = {
-    'beam_config': _Spec(
-        ParameterType.PARAMETER_STRING,
-        "beam parameter file; empty: the package's paper_beam.yaml",
-    ),
-    'rate_hz': _Spec(
-        ParameterType.PARAMETER_DOUBLE, 'rate of /tip_pose_predicted, Hz', 1.0, 2000.0
-    ),
-    'tick_rate_hz': _Spec(
-        ParameterType.PARAMETER_DOUBLE,
-        'how often the model is advanced and published, Hz',
-        1.0,
-        1000.0,
-    ),
-    'initial_load_kg': _Spec(
-        ParameterType.PARAMETER_DOUBLE, 'load assumed until the first /tip_load, kg', 0.0, 1000.0
-    ),
-    'adopt_identified': _Spec(
-        ParameterType.PARAMETER_BOOL, 'adopt k_tE and the damping ratio from /beam_params'
-    ),
-    'reset_jump_back_s': _Spec(
-        ParameterType.PARAMETER_DOUBLE,
-        'a clock step back beyond this restarts at rest, s',
-        0.0,
-        3600.0,
-    ),
-    'max_catch_up_s': _Spec(
-        ParameterType.PARAMETER_DOUBLE,
-        'a clock jump ahead beyond this restarts at rest, s',
-        0.01,
-        3600.0,
-    ),
-}
-
-
-def default_parameters() -> dict[str, Any]:
-    """The node's defaults: the values of the package's ``config/simulator.yaml``.
-
-    Raises:
-        ConfigError: The file is missing or malformed.
-    """
-    return read_parameter_file(config_path('simulator.yaml'))
-
-
-def check_parameter(name: str, value: Any) -> str | None:
-    """Checks one parameter's value beyond what its descriptor's range enforces.
-
-    Args:
-        name: The parameter.
-        value: The value to set.
-
-    Returns:
-        ``None`` when acceptable, else the reason it is refused (one line).
-    """
-    spec = PARAMETERS.get(name)
-    if spec is None:
-        return None  # rclpy's own (use_sim_time) and undeclared ones are rclpy's business
-    if spec.low is not None and spec.high is not None:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            return f'{name} must be a number, got {value!r}'
-        if not math.isfinite(value) or not spec.low <= value <= spec.high:
-            return f'{name} must be in [{spec.low}, {spec.high}], got {value!r}'
-    return None
 
 
 def load_beam(path: str) -> BeamParameters:
@@ -162,8 +72,8 @@ class SimulatorNode(Node):
         parameter_overrides: Parameter values that replace the defaults (as ``-p`` would).
 
     Raises:
-        ConfigError: The beam file or ``config/simulator.yaml`` is missing or malformed.
-        rclpy.exceptions.ParameterException: A parameter outside its range.
+        ConfigError: The beam file is missing or malformed, or a parameter is of the wrong
+            type or out of range.
     """
 
     def __init__(
@@ -172,16 +82,11 @@ class SimulatorNode(Node):
         parameter_overrides: Sequence[Parameter] | None = None,
     ):
         super().__init__(
-            'simulator_node', context=context, parameter_overrides=list(parameter_overrides or [])
+            SIMULATOR_SCHEMA.node,
+            context=context,
+            parameter_overrides=list(parameter_overrides or []),
         )
-        defaults = default_parameters()
-        for name, spec in PARAMETERS.items():
-            self.declare_parameter(name, defaults[name], spec.descriptor(name))
-        values = {name: self.get_parameter(name).value for name in PARAMETERS}
-        for name, value in values.items():
-            reason = check_parameter(name, value)
-            if reason is not None:
-                raise LumpbeamError(reason)
+        values = declare_parameters(self, SIMULATOR_SCHEMA, self._on_change)
         self._settings = values
         self._base_beam = load_beam(values['beam_config'])
         self._stream: PredictionStream | None = None
@@ -189,8 +94,6 @@ class SimulatorNode(Node):
         self._load_seen = False
         self._adopted: tuple[float, float] | None = None
         self._adopted_beam: BeamParameters | None = None
-        self._warned_at: dict[str, float] = {}
-        self.add_on_set_parameters_callback(self._on_set_parameters)
 
         load_qos = from_bag_qos(default_profile('/tip_load', 'std_msgs/msg/Float64'))
         self._pose_out = self.create_publisher(
@@ -247,7 +150,9 @@ class SimulatorNode(Node):
     def _on_load(self, msg: Float64) -> None:
         kg = float(msg.data)
         if not math.isfinite(kg) or kg < 0.0:
-            self._warn_throttled('load', f'ignoring /tip_load of {kg!r} kg: not a mass')
+            self.get_logger().warning(
+                f'ignoring /tip_load of {kg!r} kg: not a mass', throttle_duration_sec=WARN_PERIOD_S
+            )
             return
         first = not self._load_seen
         self._load_seen = True
@@ -272,14 +177,19 @@ class SimulatorNode(Node):
                 k_total = float(values['stiffness_total_nm_per_rad'])
                 zeta = float(values['damping_ratio'])
             except (KeyError, ValueError) as exc:
-                self._warn_throttled('params', f'ignoring /beam_params: bad or missing {exc}')
+                self.get_logger().warning(
+                    f'ignoring /beam_params: bad or missing {exc}',
+                    throttle_duration_sec=WARN_PERIOD_S,
+                )
                 return
             if (k_total, zeta) == self._adopted:
                 return
             try:
                 beam = adopt_identified(self._base_beam, k_total, zeta)
             except LumpbeamError as exc:
-                self._warn_throttled('params', f'ignoring /beam_params: {exc}')
+                self.get_logger().warning(
+                    f'ignoring /beam_params: {exc}', throttle_duration_sec=WARN_PERIOD_S
+                )
                 return
             self._adopted, self._adopted_beam = (k_total, zeta), beam
             if self._stream is not None:
@@ -288,20 +198,16 @@ class SimulatorNode(Node):
                 f'adopted k_tE={k_total:.1f} N m/rad, zeta={zeta:.5f} (c_tE={beam.c_total:.4f})'
             )
 
-    def _on_set_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
-        changes = {p.name: p.value for p in parameters if p.name in PARAMETERS}
-        for name, value in changes.items():
-            reason = check_parameter(name, value)
-            if reason is not None:
-                return SetParametersResult(successful=False, reason=reason)
+    def _on_change(self, changes: Mapping[str, Any]) -> str | None:
+        """Applies parameter changes the schema accepted; refuses a beam file that fails."""
         new_beam = None
         if 'beam_config' in changes:
             try:
                 new_beam = load_beam(changes['beam_config'])
             except LumpbeamError as exc:
-                return SetParametersResult(successful=False, reason=str(exc))
+                return str(exc)
         self._apply(changes, new_beam)
-        return SetParametersResult(successful=True)
+        return None
 
     # -- helpers ------------------------------------------------------------------------------
 
@@ -352,12 +258,6 @@ class SimulatorNode(Node):
             q = msg.pose.orientation
             q.x, q.y, q.z, q.w = pitch_to_quaternion(float(samples.pitch[i]))
             self._pose_out.publish(msg)
-
-    def _warn_throttled(self, key: str, text: str) -> None:
-        now = self._steady.now().nanoseconds / NS_PER_S
-        if now - self._warned_at.get(key, -math.inf) >= WARN_PERIOD_S:
-            self._warned_at[key] = now
-            self.get_logger().warning(text)
 
 
 def _level(status: DiagnosticStatus) -> int:

@@ -173,7 +173,8 @@ def test_parameters_come_from_the_camera_file_and_are_checked(ros_graph):
     assert node.config.rig.board.squares_x == 9  # the file's default
     assert node.frame_id == 'base'
     descriptor = node.describe_parameter('tracker.max_rms_px')
-    assert descriptor.read_only and 'config/camera.yaml' in descriptor.description
+    assert descriptor.read_only and 'RMS reprojection error' in descriptor.description
+    assert descriptor.floating_point_range[0].from_value == 0.0
     node.destroy_node()
     with pytest.raises(ConfigError, match='board.squares_y'):
         CameraNode(
@@ -353,7 +354,7 @@ def test_pose_model_parameter(ros_graph):
     )
     assert node.session.pose_model == 'free'
     node.destroy_node()
-    with pytest.raises(LumpbeamError, match="pose model 'bent'"):
+    with pytest.raises(LumpbeamError, match="pose_model: must be one of plane, free, got 'bent'"):
         CameraNode(
             context=ros_graph.context,
             parameter_overrides=[Parameter('pose_model', value='bent')],

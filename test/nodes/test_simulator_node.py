@@ -5,18 +5,19 @@ import numpy as np
 import pytest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
-from rclpy.exceptions import ParameterException
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio.convert import quaternion_to_pitch
-from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.errors import ConfigError, LumpbeamError
 from lumpbeam_ros.model.adopt import first_mode
 from lumpbeam_ros.model.simulate import simulate_loads
 from lumpbeam_ros.nodes import simulator_node
-from lumpbeam_ros.nodes.simulator_node import PARAMETERS, SimulatorNode
+from lumpbeam_ros.nodes.simulator_node import SimulatorNode
+from lumpbeam_ros.paramfile import read_parameter_file
+from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA
 from lumpbeam_ros.resources import config_path
 
 LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -160,7 +161,7 @@ def test_valid_parameter_changes_take_effect(ros_graph, tmp_path):
 
 
 def test_invalid_override_fails_at_start(ros_graph):
-    with pytest.raises(ParameterException):
+    with pytest.raises(ConfigError, match='rate_hz: must be in'):
         SimulatorNode(
             context=ros_graph.context, parameter_overrides=[Parameter('rate_hz', value=0.0)]
         )
@@ -209,9 +210,9 @@ def test_adopts_identified_parameters_when_asked(ros_graph, adopt):
 
 def test_parameter_file_documents_every_parameter():
     text = config_path('simulator.yaml').read_text()
-    defaults = simulator_node.default_parameters()
-    assert set(defaults) == set(PARAMETERS)
-    for name in PARAMETERS:
+    defaults = read_parameter_file(config_path('simulator.yaml'))
+    assert defaults == SIMULATOR_SCHEMA.defaults()
+    for name in SIMULATOR_SCHEMA.names:
         before = text.split(f'\n    {name}:')[0].splitlines()
         assert before[-1].strip().startswith('#'), f'{name} has no comment'
 

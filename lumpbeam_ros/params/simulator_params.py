@@ -1,0 +1,76 @@
+"""The simulator node's parameters (values in ``config/simulator.yaml``, documented there)."""
+
+from __future__ import annotations
+
+from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec
+
+SIMULATOR_SCHEMA = ParameterSchema(
+    node='simulator_node',
+    summary=(
+        'The lumped beam run in step with the node clock, publishing the predicted tip pose. '
+        'Every parameter can be changed while it runs (`ros2 param set`).'
+    ),
+    config_file='simulator.yaml',
+    parameters=(
+        ParameterSpec(
+            'beam_config',
+            'string',
+            '',
+            "beam parameter file (as config/paper_beam.yaml); empty: the package's "
+            'paper_beam.yaml. Setting it at run time swaps the beam and keeps the motion',
+            read_only=False,
+        ),
+        ParameterSpec(
+            'rate_hz',
+            'double',
+            180.0,
+            'rate of /tip_pose_predicted; samples are stamped k / rate_hz',
+            'Hz',
+            Bounds(1.0, 2000.0),
+            read_only=False,
+        ),
+        ParameterSpec(
+            'tick_rate_hz',
+            'double',
+            50.0,
+            'how often the model is advanced and published',
+            'Hz',
+            Bounds(1.0, 1000.0),
+            read_only=False,
+        ),
+        ParameterSpec(
+            'initial_load_kg',
+            'double',
+            0.0,
+            'load assumed until the first /tip_load',
+            'kg',
+            Bounds(0.0, 1000.0),
+            read_only=False,
+        ),
+        ParameterSpec(
+            'adopt_identified',
+            'bool',
+            False,
+            'adopt k_tE and the damping ratio from /beam_params (status OK only)',
+            read_only=False,
+        ),
+        ParameterSpec(
+            'reset_jump_back_s',
+            'double',
+            0.1,
+            'a clock step back beyond this restarts the beam at rest',
+            's',
+            Bounds(0.0, 3600.0),
+            read_only=False,
+        ),
+        ParameterSpec(
+            'max_catch_up_s',
+            'double',
+            5.0,
+            'a clock jump ahead beyond this restarts the beam at rest',
+            's',
+            Bounds(0.01, 3600.0),
+            read_only=False,
+        ),
+    ),
+)
