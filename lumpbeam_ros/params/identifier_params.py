@@ -41,6 +41,13 @@ IDENTIFIER_SCHEMA = ParameterSchema(
             'a stamp this far before the newest one empties the window (a bag looping)',
             's',
         ),
+        _double(
+            'window.max_gap_s',
+            1.0,
+            'a record whose pose stamps pause or jump ahead by more than this is split there; '
+            'analysis keeps the stretch that holds the release and names the rest',
+            's',
+        ),
         ParameterSpec(
             'publish_rate_hz',
             'double',
@@ -67,6 +74,19 @@ IDENTIFIER_SCHEMA = ParameterSchema(
             'release.min_quiet_s',
             0.2,
             'the quiet stretch before a release found in the data lasts at least this long',
+            's',
+        ),
+        _double(
+            'release.hint_late_s',
+            1.0,
+            'a drop on /tip_load only hints that a release happened: the release is looked '
+            'for in the poses from this long before the reading (a late reading) ...',
+            's',
+        ),
+        _double(
+            'release.hint_early_s',
+            1.0,
+            '... to this long after it (a reading sent before the load actually left)',
             's',
         ),
         ParameterSpec(
