@@ -7,8 +7,9 @@ timer advances a :class:`~lumpbeam_ros.model.stream.PredictionStream` to the nod
 (wall time, or ``/clock`` with ``use_sim_time``) and publishes the samples due since the last
 tick, each stamped with its model time. Another, at ``markers_rate_hz``, publishes
 ``/beam_markers`` (visualization_msgs/MarkerArray, :mod:`lumpbeam_ros.viz.markers`): the
-model's latest shape, its tip, the last ``/tip_pose`` it received, the load and the board. Parameters: ``config/simulator.yaml``, where each is
-documented; its values are the node's defaults.
+model's latest shape, its tip, the last ``/tip_pose`` it received, the load and the board.
+Parameters: ``config/simulator.yaml``, where each is documented; its values are the node's
+defaults.
 
 Run it::
 

@@ -179,7 +179,9 @@ def write_drop_test_bag(
     drawn = set()
     if options.markers_rate_hz > 0.0:
         drawn = set(marker_sample_indices(truth.t, options.markers_rate_hz).tolist())
-        board = board_placement(load_camera_config(None if images is None else images.camera_config))
+        board = board_placement(
+            load_camera_config(None if images is None else images.camera_config)
+        )
         lifetime = lifetime_for_rate(options.markers_rate_hz)
     with BagWriter(out) as bag:
         loads = iter(load_messages(drop, options.duration_s))

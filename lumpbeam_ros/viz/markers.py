@@ -162,9 +162,7 @@ def joint_positions(segment_length_m: float, phi: np.ndarray) -> np.ndarray:
         (n_s + 1) x 3 points: joint 1 at the clamp (the origin), ..., the free end last.
     """
     phi = np.asarray(phi, dtype=float)
-    steps = segment_length_m * np.column_stack(
-        [np.cos(phi), np.zeros_like(phi), -np.sin(phi)]
-    )
+    steps = segment_length_m * np.column_stack([np.cos(phi), np.zeros_like(phi), -np.sin(phi)])
     return np.vstack([np.zeros((1, 3)), np.cumsum(steps, axis=0)])
 
 

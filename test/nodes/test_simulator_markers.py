@@ -52,9 +52,7 @@ def test_markers_draw_the_model_at_their_own_rate(ros_graph):
     x, z, _ = node.stream.equilibrium_pose()
     assert (beam.points[-1].x, beam.points[-1].z) == pytest.approx((x, z), abs=1e-9)
     assert (beam.points[0].x, beam.points[0].z) == (0.0, 0.0)
-    lengths = np.hypot(
-        np.diff([p.x for p in beam.points]), np.diff([p.z for p in beam.points])
-    )
+    lengths = np.hypot(np.diff([p.x for p in beam.points]), np.diff([p.z for p in beam.points]))
     np.testing.assert_allclose(lengths, node.beam.segment_length_m, rtol=1e-12)
     load = markers['load']
     assert load.type == Marker.CUBE and load.action == Marker.ADD
