@@ -13,7 +13,10 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE}']),
         (f'share/{PACKAGE}', ['package.xml']),
-        (f'share/{PACKAGE}/config', glob('config/*.yaml')),
+        (
+            f'share/{PACKAGE}/config',
+            glob('config/*.yaml') + glob('config/*.json') + glob('config/*.rviz'),
+        ),
     ],
     package_data={PACKAGE: ['data/*.csv', 'data/*.xml']},
     install_requires=['setuptools', 'numpy', 'scipy', 'pyyaml', 'threadpoolctl'],
