@@ -20,6 +20,8 @@ setup(
     ],
     package_data={PACKAGE: ['data/*.csv', 'data/*.xml']},
     install_requires=['setuptools', 'numpy', 'scipy', 'pyyaml', 'threadpoolctl'],
+    # `lumpbeam view`: the Foxglove SDK's WebSocket server (MIT); websockets for its test.
+    extras_require={'view': ['foxglove-sdk'], 'test': ['websockets']},
     zip_safe=True,
     maintainer='lumpbeam_ros maintainers',
     maintainer_email='lumpbeam@example.org',
