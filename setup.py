@@ -13,15 +13,21 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE}']),
         (f'share/{PACKAGE}', ['package.xml']),
-        (f'share/{PACKAGE}/config', glob('config/*.yaml')),
+        (
+            f'share/{PACKAGE}/config',
+            glob('config/*.yaml') + glob('config/*.json') + glob('config/*.rviz'),
+        ),
     ],
     package_data={PACKAGE: ['data/*.csv', 'data/*.xml']},
     install_requires=['setuptools', 'numpy', 'scipy', 'pyyaml', 'threadpoolctl'],
     extras_require={
         # lumpbeam campaign: the Dask cluster and the Parquet/CSV table.
         'campaign': ['dask', 'distributed', 'pyarrow'],
-        # The report test drives the system's Chromium (apt: chromium chromium-driver).
-        'test': ['pytest', 'selenium'],
+        # lumpbeam view: the Foxglove SDK's WebSocket server (MIT).
+        'view': ['foxglove-sdk'],
+        # The report test drives the system's Chromium (apt: chromium chromium-driver); the
+        # view test is a WebSocket client.
+        'test': ['pytest', 'selenium', 'websockets'],
     },
     zip_safe=True,
     maintainer='lumpbeam_ros maintainers',

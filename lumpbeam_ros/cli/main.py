@@ -27,6 +27,7 @@ COMMANDS = (
     'record',
     'play',
     'bench',
+    'view',
     'demo',
     'campaign',
 )

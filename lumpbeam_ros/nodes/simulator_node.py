@@ -5,9 +5,12 @@ Subscribes ``/tip_load`` (std_msgs/Float64, kg; reliable, transient local, depth
 publishes ``/tip_pose_predicted`` (geometry_msgs/PoseStamped in ``beam_base``). A steady
 timer advances a :class:`~lumpbeam_ros.model.stream.PredictionStream` to the node's clock
 (wall time, or ``/clock`` with ``use_sim_time``) and publishes the samples due since the last
-tick, each stamped with its model time. Parameters:
-:data:`~lumpbeam_ros.params.simulator_params.SIMULATOR_SCHEMA` (``doc/parameters.md``); their
-defaults are the values of ``config/simulator.yaml``, where each is documented.
+tick, each stamped with its model time. Another, at ``markers_rate_hz``, publishes
+``/beam_markers`` (visualization_msgs/MarkerArray, :mod:`lumpbeam_ros.viz.markers`): the
+model's latest shape, its tip, the last ``/tip_pose`` it received, the load and the board.
+Parameters: :data:`~lumpbeam_ros.params.simulator_params.SIMULATOR_SCHEMA`
+(``doc/parameters.md``); their defaults are the values of ``config/simulator.yaml``, where
+each is documented.
 
 Run it::
 
@@ -32,6 +35,7 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64
+from visualization_msgs.msg import MarkerArray
 
 from lumpbeam_ros.bagio.convert import NS_PER_S, pitch_to_quaternion, seconds_to_ns
 from lumpbeam_ros.bagio.qos import default_profile
@@ -43,6 +47,16 @@ from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.nodes.msgtypes import from_bag_qos
 from lumpbeam_ros.nodes.parameters import declare_parameters
 from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA
+from lumpbeam_ros.vision.config import load_camera_config
+from lumpbeam_ros.viz.markers import (
+    MARKERS_TOPIC,
+    BeamScene,
+    BoardPlacement,
+    TipPoint,
+    board_placement,
+    lifetime_for_rate,
+)
+from lumpbeam_ros.viz.messages import scene_cdr
 
 FRAME_ID = 'beam_base'
 IDENTIFIER_STATUS = 'lumpbeam/identifier'
@@ -52,6 +66,8 @@ OK_LEVEL = 0
 WARN_PERIOD_S = 5.0
 #: Publisher depth: a late tick publishes several periods' samples in one burst.
 PREDICTION_DEPTH = 100
+#: /beam_markers shows a measured tip only this close in time to the model's, s.
+MEASURED_MAX_AGE_S = 0.5
 
 
 def load_beam(path: str) -> BeamParameters:
@@ -62,6 +78,15 @@ def load_beam(path: str) -> BeamParameters:
     """
     beam, _ = load_beam_config(Path(path) if path else None)
     return beam
+
+
+def load_board(path: str) -> BoardPlacement:
+    """Reads the board of ``camera_config`` (empty: the package's ``camera.yaml``).
+
+    Raises:
+        ConfigError: The file is missing or malformed.
+    """
+    return board_placement(load_camera_config(path or None))
 
 
 class SimulatorNode(Node):
@@ -94,6 +119,10 @@ class SimulatorNode(Node):
         self._load_seen = False
         self._adopted: tuple[float, float] | None = None
         self._adopted_beam: BeamParameters | None = None
+        self._board = load_board(values['camera_config'])
+        self._latest: TipTrajectory | None = None  # the last samples published
+        self._measured: tuple[float, TipPoint] | None = None  # stamp, tip of /tip_pose
+        self._markers_stamp = -math.inf
 
         load_qos = from_bag_qos(default_profile('/tip_load', 'std_msgs/msg/Float64'))
         self._pose_out = self.create_publisher(
@@ -101,10 +130,13 @@ class SimulatorNode(Node):
         )
         self.create_subscription(Float64, '/tip_load', self._on_load, load_qos)
         self.create_subscription(DiagnosticArray, '/beam_params', self._on_beam_params, 10)
+        self._markers_out = self.create_publisher(MarkerArray, MARKERS_TOPIC, 10)
+        self.create_subscription(PoseStamped, '/tip_pose', self._on_measured, PREDICTION_DEPTH)
         # A steady timer: under use_sim_time the node must notice a stalled or jumping /clock,
         # which a timer on that clock would not fire to see.
         self._steady = Clock(clock_type=ClockType.STEADY_TIME)
         self._timer = self._make_timer(values['tick_rate_hz'])
+        self._markers_timer = self._make_markers_timer(values['markers_rate_hz'])
         sim = self.get_parameter('use_sim_time').value
         self.get_logger().info(
             f'simulator ready: n_s={self._base_beam.n_segments}, '
@@ -166,6 +198,37 @@ class SimulatorNode(Node):
         elif changed:
             self._stream.set_load(self._now(), kg)
 
+    def _on_measured(self, msg: PoseStamped) -> None:
+        p = msg.pose.position
+        tip = TipPoint(float(p.x), float(p.z))
+        if msg.header.frame_id != FRAME_ID or not tip.is_finite():
+            self.get_logger().warning(
+                f'ignoring /tip_pose in frame {msg.header.frame_id!r} at {tip}',
+                throttle_duration_sec=WARN_PERIOD_S,
+            )
+            return
+        self._measured = (msg.header.stamp.sec + msg.header.stamp.nanosec / NS_PER_S, tip)
+
+    def _publish_markers(self) -> None:
+        latest = self._latest
+        if latest is None or self._stream is None or latest.t[-1] == self._markers_stamp:
+            return  # nothing simulated yet, or nothing new since the last array
+        stamp = float(latest.t[-1])
+        measured = None
+        if self._measured is not None and abs(self._measured[0] - stamp) <= MEASURED_MAX_AGE_S:
+            measured = self._measured[1]
+        scene = BeamScene(
+            self._stream.beam.segment_length_m,
+            phi=None if latest.q is None else latest.q[-1],
+            measured=measured,
+            predicted=TipPoint(float(latest.x[-1]), float(latest.z[-1])),
+            load_kg=float(latest.load_kg[-1]),
+            board=self._board,
+        )
+        lifetime = lifetime_for_rate(self._settings['markers_rate_hz'])
+        self._markers_out.publish(scene_cdr(scene, seconds_to_ns(stamp), lifetime))
+        self._markers_stamp = stamp
+
     def _on_beam_params(self, msg: DiagnosticArray) -> None:
         if not self._settings['adopt_identified']:
             return
@@ -201,11 +264,13 @@ class SimulatorNode(Node):
     def _on_change(self, changes: Mapping[str, Any]) -> str | None:
         """Applies parameter changes the schema accepted; refuses a beam file that fails."""
         new_beam = None
-        if 'beam_config' in changes:
-            try:
+        try:
+            if 'beam_config' in changes:
                 new_beam = load_beam(changes['beam_config'])
-            except LumpbeamError as exc:
-                return str(exc)
+            if 'camera_config' in changes:
+                self._board = load_board(changes['camera_config'])
+        except LumpbeamError as exc:
+            return str(exc)
         self._apply(changes, new_beam)
         return None
 
@@ -216,6 +281,10 @@ class SimulatorNode(Node):
         if 'tick_rate_hz' in changes:
             self.destroy_timer(self._timer)
             self._timer = self._make_timer(changes['tick_rate_hz'])
+        if 'markers_rate_hz' in changes:
+            if self._markers_timer is not None:
+                self.destroy_timer(self._markers_timer)
+            self._markers_timer = self._make_markers_timer(changes['markers_rate_hz'])
         if 'adopt_identified' in changes and not changes['adopt_identified']:
             self._adopted, self._adopted_beam = None, None
             new_beam = new_beam or self._base_beam
@@ -244,10 +313,17 @@ class SimulatorNode(Node):
     def _make_timer(self, tick_rate_hz: float) -> Any:
         return self.create_timer(1.0 / tick_rate_hz, self._tick, clock=self._steady)
 
+    def _make_markers_timer(self, rate_hz: float) -> Any:
+        if rate_hz <= 0.0:
+            return None
+        return self.create_timer(1.0 / rate_hz, self._publish_markers, clock=self._steady)
+
     def _now(self) -> float:
         return self.get_clock().now().nanoseconds / NS_PER_S
 
     def _publish(self, samples: TipTrajectory) -> None:
+        if len(samples):
+            self._latest = samples
         for i in range(len(samples)):
             msg = PoseStamped()
             msg.header.frame_id = FRAME_ID

@@ -72,5 +72,23 @@ SIMULATOR_SCHEMA = ParameterSchema(
             Bounds(0.01, 3600.0),
             read_only=False,
         ),
+        ParameterSpec(
+            'markers_rate_hz',
+            'double',
+            30.0,
+            'rate of /beam_markers (the beam, its tip, the measured tip, the load, the board), '
+            'independent of rate_hz; 0 publishes none',
+            'Hz',
+            Bounds(0.0, 200.0),
+            read_only=False,
+        ),
+        ParameterSpec(
+            'camera_config',
+            'string',
+            '',
+            'camera parameter file whose checkerboard /beam_markers draws; empty: the '
+            "package's camera.yaml",
+            read_only=False,
+        ),
     ),
 )

@@ -26,6 +26,8 @@ from lumpbeam_ros.ident.samples import clean_loads, clean_window
 from lumpbeam_ros.ident.segments import keep_release_segment
 from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.plots.demo import Residual, prediction_residual
+from lumpbeam_ros.viz.markers import MARKERS_TOPIC
+from lumpbeam_ros.viz.messages import MARKER_ARRAY_TYPE
 
 IDENTIFIER_STATUS = 'lumpbeam/identifier'
 #: Pose topics a normalized recording keeps.
@@ -96,9 +98,9 @@ def read_clock(bag: str | Path) -> tuple[np.ndarray, np.ndarray]:
 def normalize_recording(recorded: str | Path, out: str | Path) -> Path:
     """Copies a recording with every message logged at its sim time.
 
-    Poses and ``/beam_params`` are logged at their header stamps; ``/tip_load`` readings at
-    the ``/clock`` shown when they were recorded (readings before the first ``/clock`` are
-    dropped: they have no sim time).
+    Poses, ``/beam_params`` and ``/beam_markers`` are logged at their header stamps;
+    ``/tip_load`` readings at the ``/clock`` shown when they were recorded (readings before
+    the first ``/clock`` are dropped: they have no sim time).
 
     Args:
         recorded: The bag the recorder wrote (with ``/clock``).
@@ -127,6 +129,12 @@ def normalize_recording(recorded: str | Path, out: str | Path) -> Path:
         if '/beam_params' in reader.topics:
             for _, msg in reader.messages('/beam_params', 'diagnostic_msgs/msg/DiagnosticArray'):
                 bag.write_message('/beam_params', msg, convert.time_ns(msg.header.stamp))
+        if MARKERS_TOPIC in reader.topics:
+            for _, msg in reader.messages(MARKERS_TOPIC, MARKER_ARRAY_TYPE):
+                if msg.markers:  # all stamped alike by the simulator node
+                    bag.write_message(
+                        MARKERS_TOPIC, msg, convert.time_ns(msg.markers[0].header.stamp)
+                    )
     return Path(out)
 
 

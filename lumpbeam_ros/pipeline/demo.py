@@ -46,6 +46,7 @@ from lumpbeam_ros.pipeline.graph import (
     python_command,
     wait_for_graph,
 )
+from lumpbeam_ros.viz.markers import MARKERS_TOPIC
 
 SIMULATOR_MODULE = 'lumpbeam_ros.nodes.simulator_node'
 IDENTIFIER_MODULE = 'lumpbeam_ros.nodes.identifier_node'
@@ -61,6 +62,7 @@ RECORDED_TOPICS = {
     '/tip_pose_predicted': 'geometry_msgs/msg/PoseStamped',
     '/beam_params': 'diagnostic_msgs/msg/DiagnosticArray',
     '/clock': 'rosgraph_msgs/msg/Clock',
+    '/beam_markers': 'visualization_msgs/msg/MarkerArray',
 }
 #: The player waits this long before its first message: its publishers must be discovered
 #: by the recorder's subscriptions first (a new process takes 1-3 s on a busy machine).
@@ -327,6 +329,23 @@ def figures(run: DemoRun) -> None:
     ]
     if run.with_camera:
         run.figures.append(_camera_figure(run, folder / 'tip_tracked_vs_truth.png'))
+    if MARKERS_TOPIC in BagReader(run.normalized_bag).topics:
+        run.figures.append(_beam_figure(run, folder / 'beam_markers.png'))
+
+
+def _beam_figure(run: DemoRun, path: Path) -> Path:
+    """Draws the recorded ``/beam_markers`` around the release (what a viewer shows)."""
+    from lumpbeam_ros.plots.beam import drop_snapshot_times, plot_beam_snapshots
+
+    f_n, _, _ = first_mode(run.beam, 0.0)
+    release = run.drop.release_time_s
+    return plot_beam_snapshots(
+        run.normalized_bag,
+        path,
+        times=drop_snapshot_times(release, 1.0 / f_n),
+        release_time_s=release,
+        title="The beam in the demo's recording, as /beam_markers draw it",
+    )
 
 
 def _camera_figure(run: DemoRun, path: Path) -> Path:

@@ -2,7 +2,8 @@
 
 The model is simulated under the drop-test load schedule and written as a rosbag2 MCAP bag:
 ``/tip_pose`` (the measurement: with pose noise and any hidden effects), ``/tip_pose_truth``
-(the exact pose of the beam at each stamp) and ``/tip_load`` (on change and at 1 Hz).
+(the exact pose of the beam at each stamp), ``/tip_load`` (on change and at 1 Hz) and
+``/beam_markers`` (the true beam, the measured tip, the load and the board, at 30 Hz).
 """
 
 from __future__ import annotations
@@ -21,6 +22,15 @@ from lumpbeam_ros.model.simulate import drop_test_events, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.synthetic.images import ImageOptions, ImageStream
 from lumpbeam_ros.synthetic.tracker import TrackerOptions, simulate_tracker, write_tracker_points
+from lumpbeam_ros.vision.config import load_camera_config
+from lumpbeam_ros.viz.markers import (
+    BeamScene,
+    TipPoint,
+    board_placement,
+    lifetime_for_rate,
+    marker_sample_indices,
+)
+from lumpbeam_ros.viz.messages import write_scene
 
 #: Pitch noise per metre of position noise: the camera sees the board about 1 m away.
 PITCH_NOISE_PER_M = 1.0
@@ -40,6 +50,7 @@ class SynthOptions:
             gets ``noise_m * PITCH_NOISE_PER_M`` rad.
         seed: Seed of the noise.
         effects: Hidden effects, SPEC section 6 name to parameter value.
+        markers_rate_hz: Rate of ``/beam_markers``, Hz; 0 writes none.
     """
 
     duration_s: float = 12.0
@@ -47,6 +58,7 @@ class SynthOptions:
     noise_m: float = 20e-6
     seed: int = 0
     effects: Mapping[str, float] = field(default_factory=dict)
+    markers_rate_hz: float = 30.0
 
 
 def parse_effect(text: str) -> tuple[str, float]:
@@ -164,6 +176,13 @@ def write_drop_test_bag(
         points = simulate_tracker(hidden, drop, options.duration_s, tracker)
     written = 0
     camera = None if images is None else ImageStream(measured, images)
+    drawn = set()
+    if options.markers_rate_hz > 0.0:
+        drawn = set(marker_sample_indices(truth.t, options.markers_rate_hz).tolist())
+        board = board_placement(
+            load_camera_config(None if images is None else images.camera_config)
+        )
+        lifetime = lifetime_for_rate(options.markers_rate_hz)
     with BagWriter(out) as bag:
         loads = iter(load_messages(drop, options.duration_s))
         pending = next(loads, None)
@@ -181,6 +200,15 @@ def write_drop_test_bag(
                 measured.pitch[i] + noise[2, i],
             )
             bag.write_pose('/tip_pose_truth', stamp, truth.x[i], truth.z[i], truth.pitch[i])
+            if i in drawn:
+                scene = BeamScene(
+                    beam.segment_length_m,
+                    phi=truth.q[i],
+                    measured=TipPoint(measured.x[i] + noise[0, i], measured.z[i] + noise[1, i]),
+                    load_kg=float(truth.load_kg[i]),
+                    board=board,
+                )
+                write_scene(bag, stamp, scene, lifetime)
             if camera is not None:
                 camera.write_next(bag)
         if points is not None:

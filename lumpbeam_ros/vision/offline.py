@@ -5,7 +5,9 @@ copied as its stored CDR bytes (never decoded), with its type, definition and of
 the images (``sensor_msgs/Image`` or ``sensor_msgs/CompressedImage``) are tracked on the way
 and each pose is written right after its image, stamped with the image's stamp and logged at
 the image's log time. A ``/tip_pose`` already in the bag is replaced by the tracked one (the
-summary says so). From a video or an image folder (:func:`track_footage`), OUT holds
+summary says so). ``/beam_markers`` (at most 30 Hz: the tracked tip and the checkerboard, for
+a viewer; :mod:`lumpbeam_ros.viz.markers`) is written beside the poses, replacing any the
+bag had. From a video or an image folder (:func:`track_footage`), OUT holds
 ``/tip_pose`` and the ``/camera/camera_info`` used, stamped as the footage's stamps say.
 The frames go through the same :class:`~lumpbeam_ros.vision.session.TrackingSession` as the
 camera node's.
@@ -44,12 +46,23 @@ from lumpbeam_ros.vision.messages import (
 from lumpbeam_ros.vision.session import TrackingSession
 from lumpbeam_ros.vision.sources import FootageError, FootageFrame
 from lumpbeam_ros.vision.tracker import TrackResult
+from lumpbeam_ros.viz.markers import (
+    MARKERS_TOPIC,
+    BeamScene,
+    TipPoint,
+    board_placement,
+    lifetime_for_rate,
+)
+from lumpbeam_ros.viz.messages import write_scene
 
 POSE_TOPIC = '/tip_pose'
 TRUTH_TOPIC = '/tip_pose_truth'
 IMAGE_TOPIC = '/camera/image_raw'
 COMPRESSED_IMAGE_TOPIC = '/camera/image_raw/compressed'
 CAMERA_INFO_TOPIC = '/camera/camera_info'
+
+#: Rate of ``/beam_markers`` in OUT, Hz: at most one array per period of it.
+MARKERS_RATE_HZ = 30.0
 
 #: Called after each frame with the frames done and the frames expected (``None``: unknown).
 ProgressCallback = Callable[[int, 'int | None'], None]
@@ -111,12 +124,12 @@ def _definitions(reader: BagReader) -> dict[str, tuple[str, str]]:
 
 
 def _declare_copies(reader: BagReader, out: BagWriter, summary: TrackSummary) -> set[str]:
-    """Declares BAG's topics (but ``/tip_pose``) in OUT; returns those to copy."""
+    """Declares BAG's topics (but ``/tip_pose``, ``/beam_markers``) in OUT; returns the copied."""
     definitions: dict[str, tuple[str, str]] | None = None
     copied = set()
     for name, entry in reader.topics.items():
-        if name == POSE_TOPIC:
-            continue
+        if name in (POSE_TOPIC, MARKERS_TOPIC):
+            continue  # written anew from the tracked poses
         msgdef = None
         if not is_known(entry.msgtype):
             definitions = _definitions(reader) if definitions is None else definitions
@@ -217,6 +230,8 @@ class _Run:
         self.tracking_s = 0.0
         self.done = 0
         writer.add_topic(POSE_TOPIC, 'geometry_msgs/msg/PoseStamped')
+        self._board = board_placement(session.config)
+        self._next_markers_ns = -1
 
     def track(
         self, label: str, stamp_ns: int, pixels: object, encoding: str, log_time_ns: int
@@ -234,9 +249,18 @@ class _Run:
         self.tracking_s += time.perf_counter() - start
         if result.ok:
             self.writer.write_message(POSE_TOPIC, pose_message(stamp_ns, result), log_time_ns)
+            if stamp_ns >= self._next_markers_ns:
+                self._write_markers(stamp_ns, result)
         else:
             self._note(label, result.status.value, result.reason)
         self._tick()
+
+    def _write_markers(self, stamp_ns: int, result: TrackResult) -> None:
+        x, z, _ = (float(v) for v in result.pose)  # the planar part, also of a 6-DoF fit
+        scene = BeamScene(0.0, measured=TipPoint(x, z), board=self._board)
+        stamp = convert.ns_to_seconds(stamp_ns)
+        write_scene(self.writer, stamp, scene, lifetime_for_rate(MARKERS_RATE_HZ))
+        self._next_markers_ns = stamp_ns + convert.seconds_to_ns(1.0 / MARKERS_RATE_HZ)
 
     def reject(self, label: str, reason: str) -> None:
         """Counts a frame that did not decode."""

@@ -117,3 +117,23 @@ def test_unknown_pose_model_is_exit_2(bag, tmp_path, capsys):
     assert exit_info.value.code == 2
     err = capsys.readouterr().err
     assert '--pose-model' in err and 'bent' in err
+
+
+def test_out_draws_the_tracked_tip_and_the_board(bag, tmp_path, capsys):
+    from lumpbeam_ros.viz.messages import read_marker_arrays
+
+    out = tmp_path / 'out'
+    assert main(['track', str(bag), str(out)]) == 0
+    tracked = read_tip_poses(out)
+    arrays = list(read_marker_arrays(out))
+    # At most 30 Hz of the 180 Hz poses; the bag's own markers (the synthetic truth's beam)
+    # are replaced, not mixed in.
+    assert 0.9 * 30 * 2.3 <= len(arrays) <= 30 * 2.3 + 1
+    for t, markers in arrays:
+        by_ns = {m.namespace: m for m in markers}
+        assert {'tip_measured', 'board'} <= set(by_ns) and 'beam' not in by_ns
+        i = int(np.argmin(np.abs(tracked.t - t)))
+        assert tracked.t[i] == pytest.approx(t, abs=1e-9)  # drawn at a tracked pose's stamp
+        tip = by_ns['tip_measured'].position
+        assert (tip[0], tip[2]) == pytest.approx((tracked.x[i], tracked.z[i]), abs=1e-12)
+        assert by_ns['board'].position == pytest.approx((2.3107, 1.0, -0.01))

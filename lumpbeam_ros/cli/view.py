@@ -1,0 +1,112 @@
+"""``lumpbeam view [--bag BAG] [--port 8765]``: the live graph, or a bag, served to Foxglove.
+
+Open Foxglove, connect to ``ws://localhost:8765`` (Open connection, Foxglove WebSocket) and
+import ``config/foxglove_layout.json``. No ROS installation is needed for a bag; the live
+graph is read with rclpy. Stops on Ctrl-C or SIGTERM (or after ``--duration``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import time
+from typing import Any
+
+from lumpbeam_ros.cli.output import positive_float
+
+
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'{text!r} is not a port number') from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f'port must be in 0..65535, got {value}')
+    return value
+
+
+def register(subparsers: Any) -> None:
+    """Adds the ``view`` subcommand."""
+    parser = subparsers.add_parser(
+        'view',
+        help='serve the live graph (or a bag) to Foxglove over its WebSocket protocol',
+        description='Serves the live ROS graph, or a bag replayed in its own timing, to '
+        'Foxglove at ws://HOST:PORT (messages as their CDR bytes, ros2msg schemas).',
+    )
+    parser.add_argument('--bag', help='replay this bag instead of the live graph')
+    parser.add_argument('--port', type=_port, default=8765, help='TCP port (0: any free one)')
+    parser.add_argument('--host', default='127.0.0.1', help='address to listen on')
+    parser.add_argument('--topics', nargs='+', metavar='TOPIC', help='only these topics')
+    parser.add_argument('--rate', type=positive_float, default=1.0, help='bag speed factor')
+    parser.add_argument('--loop', action='store_true', help='replay the bag again at its end')
+    parser.add_argument('--duration', type=positive_float, help='stop after this many seconds')
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Serves until stopped.
+
+    Returns:
+        0 when stopped by Ctrl-C, SIGTERM, ``--duration`` or the bag's end.
+
+    Raises:
+        LumpbeamError: The port is taken, the bag cannot be read or lacks a topic.
+    """
+    from lumpbeam_ros.bagio import BagReader
+    from lumpbeam_ros.viz.live import ChannelSink, open_bag_channels, replay_bag, start_server
+
+    reader = BagReader(args.bag) if args.bag is not None else None  # bad bag: before binding
+    stop = {'requested': False}
+    deadline = None if args.duration is None else time.monotonic() + args.duration
+
+    def should_stop() -> bool:
+        return stop['requested'] or (deadline is not None and time.monotonic() > deadline)
+
+    def request_stop(_signum: int, _frame: Any) -> None:
+        stop['requested'] = True
+
+    previous = {s: signal.signal(s, request_stop) for s in (signal.SIGINT, signal.SIGTERM)}
+    server = start_server(args.host, args.port)
+    sink = ChannelSink()
+    try:
+        if reader is not None:
+            topics = open_bag_channels(reader, sink, args.topics)
+            _announce(server.port, args.host, f'{reader.path} ({len(topics)} topics)')
+            replay_bag(
+                reader, sink, topics, rate=args.rate, loop=args.loop, should_stop=should_stop
+            )
+        else:
+            _announce(server.port, args.host, 'the live ROS graph')
+            _serve_graph(sink, args.topics, should_stop)
+    finally:
+        sink.close()
+        server.stop()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    print(f'lumpbeam view: stopped after {sum(sink.sent.values())} messages', flush=True)
+    return 0
+
+
+def _announce(port: int, host: str, what: str) -> None:
+    print(f'lumpbeam view: serving {what} at ws://{host}:{port}', flush=True)
+
+
+def _serve_graph(sink: Any, topics: list[str] | None, should_stop: Any) -> None:
+    """Forwards the live graph's topics as they appear (the recorder's discovery)."""
+    import rclpy
+    from rclpy.signals import SignalHandlerOptions
+
+    from lumpbeam_ros.nodes.recorder import Recorder
+
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    node = None
+    try:
+        node = Recorder(sink, topics)
+        while not should_stop():
+            rclpy.spin_once(node, timeout_sec=0.1)
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    print(f'lumpbeam view: forwarded {node.received if node else {}}', file=sys.stderr)

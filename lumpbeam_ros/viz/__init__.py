@@ -1,0 +1,1 @@
+"""What a viewer draws: the beam as markers, their messages and the live view to Foxglove."""

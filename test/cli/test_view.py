@@ -1,0 +1,132 @@
+"""``lumpbeam view``: a bag served to a real WebSocket client over Foxglove's protocol."""
+
+import asyncio
+import json
+import re
+import signal
+import socket
+import struct
+import subprocess
+import sys
+
+import pytest
+
+from lumpbeam_ros.bagio.typestore import deserialize
+from lumpbeam_ros.cli.main import main
+from lumpbeam_ros.model.parameters import load_beam_config
+from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+from lumpbeam_ros.viz.live import SUBPROTOCOL
+
+websockets = pytest.importorskip('websockets')
+
+#: Foxglove WebSocket v1: a server's binary message opcode for message data.
+MESSAGE_DATA = 0x01
+WANTED = {
+    '/tip_pose': 'geometry_msgs/msg/PoseStamped',
+    '/beam_markers': 'visualization_msgs/msg/MarkerArray',
+}
+
+
+@pytest.fixture(scope='module')
+def bag(tmp_path_factory):
+    path = tmp_path_factory.mktemp('view') / 'drop'
+    beam, drop = load_beam_config()
+    write_drop_test_bag(path, beam, drop, SynthOptions(duration_s=2.5))
+    return path
+
+
+@pytest.fixture
+def server(bag):
+    """``lumpbeam view --bag BAG --port 0 --loop`` in a child process, and its port."""
+    process = subprocess.Popen(
+        [sys.executable, '-m', 'lumpbeam_ros.cli.main', 'view', '--bag', str(bag)]
+        + ['--port', '0', '--loop', '--duration', '60'],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    line = process.stdout.readline()
+    match = re.search(r'at ws://127\.0\.0\.1:(\d+)', line)
+    assert match, f'no address announced: {line!r} {process.stderr.read() if not line else ""}'
+    yield process, int(match.group(1))
+    if process.poll() is None:
+        process.send_signal(signal.SIGINT)
+        process.wait(10)
+
+
+async def _watch(port, timeout_s=20.0):
+    """Connects, subscribes to WANTED and returns (channels, first payload per topic)."""
+    uri = f'ws://127.0.0.1:{port}'
+    async with websockets.connect(uri, subprotocols=[SUBPROTOCOL], max_size=None) as ws:
+        assert ws.subprotocol == SUBPROTOCOL
+        channels, payloads, subscriptions = {}, {}, {}
+        loop = asyncio.get_running_loop()
+        deadline = loop.time() + timeout_s
+        while len(payloads) < len(WANTED):
+            frame = await asyncio.wait_for(ws.recv(), deadline - loop.time())
+            if isinstance(frame, str):
+                message = json.loads(frame)
+                if message['op'] == 'advertise':
+                    channels.update({c['topic']: c for c in message['channels']})
+                    if not subscriptions and set(WANTED) <= set(channels):
+                        subscriptions = {i: t for i, t in enumerate(WANTED, start=1)}
+                        request = [
+                            {'id': i, 'channelId': channels[t]['id']}
+                            for i, t in subscriptions.items()
+                        ]
+                        await ws.send(json.dumps({'op': 'subscribe', 'subscriptions': request}))
+            elif frame[0] == MESSAGE_DATA:
+                subscription, _log_time = struct.unpack_from('<IQ', frame, 1)
+                payloads.setdefault(subscriptions[subscription], bytes(frame[13:]))
+        return channels, payloads
+
+
+def test_a_client_gets_the_channels_and_messages_of_a_bag(server):
+    process, port = server
+    channels, payloads = asyncio.run(_watch(port))
+    assert {'/tip_pose', '/tip_load', '/tip_pose_truth', '/beam_markers'} == set(channels)
+    for topic, msgtype in WANTED.items():
+        channel = channels[topic]
+        assert channel['encoding'] == 'cdr'
+        assert channel['schemaName'] == msgtype and channel['schemaEncoding'] == 'ros2msg'
+        message = deserialize(payloads[topic], msgtype)  # the bag's CDR bytes, unchanged
+        if topic == '/tip_pose':
+            assert message.header.frame_id == 'beam_base'
+        else:
+            assert {m.ns for m in message.markers} >= {'beam', 'tip_measured', 'board'}
+    process.send_signal(signal.SIGINT)
+    assert process.wait(10) == 0
+    assert 'stopped after' in process.stdout.read()
+
+
+def test_a_taken_port_is_one_line_and_exit_2(bag, capsys):
+    with socket.socket() as taken:
+        taken.bind(('127.0.0.1', 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        assert main(['view', '--bag', str(bag), '--port', str(port)]) == 2
+    err = capsys.readouterr().err
+    assert f'cannot serve on 127.0.0.1:{port}' in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    ('args', 'message'),
+    [
+        (['--bag', '/no/such/bag'], 'no such bag'),
+        (['--topics', '/nope'], 'no topic /nope'),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_2(bag, capsys, args, message):
+    argv = ['view', '--port', '0', *args]
+    if '--bag' not in args:
+        argv += ['--bag', str(bag)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_port_out_of_range_is_a_usage_error(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(['view', '--port', '70000'])
+    assert exit_info.value.code == 2
+    assert 'port must be in 0..65535' in capsys.readouterr().err.splitlines()[-1]
