@@ -61,10 +61,28 @@ def _check_page(driver, page: Path) -> int:
     return len(widths)
 
 
-def test_analyze_and_diagnose_reports_render(browser, minimal_bag, tmp_path):
+def test_analyze_report_renders(browser, minimal_bag, tmp_path):
     analyze_page = tmp_path / 'analyze.html'
     assert main(['analyze', str(minimal_bag), '--report', str(analyze_page)]) == 0
     assert _check_page(browser, analyze_page) == 4  # fit and residual + the three figures
+
+
+def test_diagnose_report_renders(browser, tmp_path):
+    bag = tmp_path / 'late'
+    assert main(['synth', str(bag), '--duration', '6', '--effect', 'sensor_latency=0.015']) == 0
+    page = tmp_path / 'diagnose.html'
+    assert main(['diagnose', str(bag), '--report', str(page)]) == 0
+    assert _check_page(browser, page) >= 2
+    text = page.read_text()
+    assert 'sensor_latency' in text and 'gap' in text
+
+
+def test_compare_report_renders(browser, tmp_path):
+    bag = tmp_path / 'tracked'
+    assert main(['synth', str(bag), '--duration', '5', '--tracker']) == 0
+    page = tmp_path / 'compare.html'
+    assert main(['compare', str(bag), '--report', str(page)]) == 0
+    assert _check_page(browser, page) >= 1
 
 
 def test_a_broken_figure_is_caught(browser, tmp_path):
