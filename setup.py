@@ -6,6 +6,17 @@ from setuptools import find_packages, setup
 
 PACKAGE = 'lumpbeam_ros'
 
+#: What the offline commands need (reproduce, synth, analyze, diagnose, compare).
+REQUIRES = ['setuptools', 'numpy', 'scipy', 'pyyaml', 'threadpoolctl', 'rosbags', 'mcap']
+
+#: The rest, by what it serves (lumpbeam_ros/cli/dependencies.py names them when missing).
+EXTRAS = {
+    'vision': ['opencv-python-headless'],
+    'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
+    'plots': ['matplotlib'],
+}
+EXTRAS['all'] = sorted({req for reqs in EXTRAS.values() for req in reqs})
+
 setup(
     name=PACKAGE,
     version='0.1.0',
@@ -16,7 +27,8 @@ setup(
         (f'share/{PACKAGE}/config', glob('config/*.yaml')),
     ],
     package_data={PACKAGE: ['data/*.csv', 'data/*.xml']},
-    install_requires=['setuptools', 'numpy', 'scipy', 'pyyaml', 'threadpoolctl'],
+    install_requires=REQUIRES,
+    extras_require=EXTRAS,
     zip_safe=True,
     maintainer='lumpbeam_ros maintainers',
     maintainer_email='lumpbeam@example.org',

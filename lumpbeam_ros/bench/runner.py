@@ -8,7 +8,7 @@ from collections.abc import Iterable
 from lumpbeam_ros.bench.result import BenchResult
 
 #: Suite modules under :mod:`lumpbeam_ros.bench`.
-SUITES = ('model', 'tracker', 'ident', 'bagio', 'diagnose')
+SUITES = ('model', 'tracker', 'ident', 'bagio', 'diagnose', 'cli')
 
 
 def available_suites() -> list[str]:

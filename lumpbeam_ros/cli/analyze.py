@@ -36,19 +36,6 @@ SPEC_KEYS = (
 )
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Adds the ``analyze`` subcommand."""
-    parser = subparsers.add_parser('analyze', help='identify frequency, damping and stiffness')
-    parser.add_argument('bag', help='rosbag2 folder with /tip_pose (and /tip_load)')
-    parser.add_argument('--json', help='write the result as JSON to this file')
-    parser.add_argument('--plots', help='write figures (PNG) into this folder')
-    parser.add_argument('--config', help='beam parameter file (default: config/paper_beam.yaml)')
-    parser.add_argument(
-        '--identifier-config', help='identifier parameter file (default: config/identifier.yaml)'
-    )
-    parser.set_defaults(handler=run)
-
-
 class Progress:
     """A one-line progress bar on a stream, drawn only when it is a TTY or the job is long.
 

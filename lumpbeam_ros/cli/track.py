@@ -4,30 +4,10 @@ from __future__ import annotations
 
 import argparse
 import math
-from typing import Any
 
 from lumpbeam_ros.cli.output import write_json
 from lumpbeam_ros.vision.config import load_camera_config
-from lumpbeam_ros.vision.offline import CAMERA_INFO_TOPIC, IMAGE_TOPIC, TrackSummary, track_bag
-
-
-def register(subparsers: Any) -> None:
-    """Adds the ``track`` subcommand."""
-    parser = subparsers.add_parser(
-        'track',
-        help="track the tip in a bag's images, offline",
-        description='Writes OUT: a copy of BAG plus /tip_pose tracked from its images '
-        '(a /tip_pose already in BAG is replaced).',
-    )
-    parser.add_argument('bag', help='rosbag2 folder (MCAP) with images and camera info')
-    parser.add_argument('out', help='bag folder to create (must not exist)')
-    parser.add_argument('--config', help='camera file (default: config/camera.yaml)')
-    parser.add_argument('--image-topic', default=IMAGE_TOPIC, help=f'({IMAGE_TOPIC})')
-    parser.add_argument(
-        '--camera-info-topic', default=CAMERA_INFO_TOPIC, help=f'({CAMERA_INFO_TOPIC})'
-    )
-    parser.add_argument('--json', metavar='FILE', help='also write the summary as JSON')
-    parser.set_defaults(handler=run)
+from lumpbeam_ros.vision.offline import TrackSummary, track_bag
 
 
 def summary_lines(summary: TrackSummary, bag: str, out: str) -> list[str]:
