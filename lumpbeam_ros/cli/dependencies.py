@@ -9,11 +9,10 @@ packages, for ``record``, ``play``, ``demo`` and the nodes), ``[plots]`` (matplo
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 
-@dataclass(frozen=True)
-class OptionalPackage:
+class OptionalPackage(NamedTuple):
     """A package that only some commands need.
 
     Attributes:
