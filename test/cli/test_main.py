@@ -10,7 +10,6 @@ import sys
 
 import pytest
 
-from lumpbeam_ros.cli.dependencies import missing_package_message
 from lumpbeam_ros.cli.main import COMMANDS, build_parser, load_target
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
@@ -107,15 +106,6 @@ def test_a_missing_optional_package_is_one_line_and_exit_2(
     result = lumpbeam(*filled, blocked=(blocked,))
     assert result.returncode == 2
     assert result.stderr == f'lumpbeam {arguments[0]} {message}\n'
-
-
-def test_a_missing_core_module_is_not_called_optional():
-    error = ModuleNotFoundError("No module named 'scipy'", name='scipy')
-    assert missing_package_message('analyze', error) is None
-    nested = ModuleNotFoundError("No module named 'cv2.aruco'", name='cv2.aruco')
-    assert missing_package_message('track', nested) == (
-        "lumpbeam track needs OpenCV: pip install 'lumpbeam_ros[vision]'"
-    )
 
 
 def test_a_missing_core_module_is_a_broken_install_not_a_hint():
