@@ -1,5 +1,6 @@
 # The two commands a newcomer needs: `make demo` and `make test`.
-# Both create .venv on first use and install the package with its dependencies from PyPI.
+# Both create .venv on first use and install the package with every extra, plus the test
+# tools (requirements-dev.txt), from PyPI.
 # Nothing is cached outside this folder: pip, matplotlib and ROS logs live under .cache/.
 
 PYTHON ?= python3
@@ -17,11 +18,10 @@ export PYTHONDONTWRITEBYTECODE :=
 
 .PHONY: venv demo test test-slow lint bench clean
 
-$(STAMP): setup.py setup.cfg package.xml requirements.txt
+$(STAMP): setup.py setup.cfg package.xml requirements.txt requirements-dev.txt
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -r requirements.txt
-	$(BIN)/python -m pip install -q --no-deps -e .
+	$(BIN)/python -m pip install -q -r requirements-dev.txt
 	@touch $@
 
 venv: $(STAMP)

@@ -6,6 +6,21 @@ from setuptools import find_packages, setup
 
 PACKAGE = 'lumpbeam_ros'
 
+#: What the offline commands need (reproduce, synth, analyze, diagnose, compare).
+REQUIRES = ['setuptools', 'numpy', 'scipy', 'pyyaml', 'threadpoolctl', 'rosbags', 'mcap']
+
+#: The rest, by what it serves (lumpbeam_ros/cli/dependencies.py names them when missing).
+EXTRAS = {
+    'vision': ['opencv-python-headless'],
+    'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
+    'plots': ['matplotlib'],
+    # lumpbeam campaign: the Dask cluster and the Parquet/CSV table.
+    'campaign': ['dask', 'distributed', 'pyarrow'],
+    # lumpbeam view: the Foxglove SDK's WebSocket server (MIT).
+    'view': ['foxglove-sdk'],
+}
+EXTRAS['all'] = sorted({req for reqs in EXTRAS.values() for req in reqs})
+
 setup(
     name=PACKAGE,
     version='0.1.0',
@@ -19,16 +34,8 @@ setup(
         ),
     ],
     package_data={PACKAGE: ['data/*.csv', 'data/*.xml']},
-    install_requires=['setuptools', 'numpy', 'scipy', 'pyyaml', 'threadpoolctl'],
-    extras_require={
-        # lumpbeam campaign: the Dask cluster and the Parquet/CSV table.
-        'campaign': ['dask', 'distributed', 'pyarrow'],
-        # lumpbeam view: the Foxglove SDK's WebSocket server (MIT).
-        'view': ['foxglove-sdk'],
-        # The report test drives the system's Chromium (apt: chromium chromium-driver); the
-        # view test is a WebSocket client.
-        'test': ['pytest', 'selenium', 'websockets'],
-    },
+    install_requires=REQUIRES,
+    extras_require=EXTRAS,
     zip_safe=True,
     maintainer='lumpbeam_ros maintainers',
     maintainer_email='lumpbeam@example.org',

@@ -18,21 +18,7 @@ from lumpbeam_ros.pipeline.bag_analysis import (
 )
 from lumpbeam_ros.progress import Progress
 
-__all__ = ['SPEC_KEYS', 'Progress', 'read_window', 'register', 'result_json', 'run']
-
-
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Adds the ``analyze`` subcommand."""
-    parser = subparsers.add_parser('analyze', help='identify frequency, damping and stiffness')
-    parser.add_argument('bag', help='rosbag2 folder with /tip_pose (and /tip_load)')
-    parser.add_argument('--json', help='write the result as JSON to this file')
-    parser.add_argument('--plots', help='write figures (PNG) into this folder')
-    parser.add_argument('--config', help='beam parameter file (default: config/paper_beam.yaml)')
-    parser.add_argument(
-        '--identifier-config', help='identifier parameter file (default: config/identifier.yaml)'
-    )
-    parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
-    parser.set_defaults(handler=run)
+__all__ = ['SPEC_KEYS', 'Progress', 'read_window', 'result_json', 'run']
 
 
 def run(args: argparse.Namespace) -> int:

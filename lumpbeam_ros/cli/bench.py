@@ -9,17 +9,6 @@ from lumpbeam_ros.cli.output import write_json
 from lumpbeam_ros.errors import LumpbeamError
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Adds the ``bench`` subcommand."""
-    parser = subparsers.add_parser('bench', help='speed benchmarks against same-run baselines')
-    parser.add_argument(
-        '--only', action='append', metavar='SUITE', help='run only this suite (repeatable)'
-    )
-    parser.add_argument('--quick', action='store_true', help='small inputs (a smoke test)')
-    parser.add_argument('--json', metavar='FILE', help='write the results as JSON')
-    parser.set_defaults(handler=run)
-
-
 def run(args: argparse.Namespace) -> int:
     """Runs the chosen suites and prints their table."""
     suites = available_suites()

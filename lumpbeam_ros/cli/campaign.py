@@ -5,8 +5,6 @@ from __future__ import annotations
 import argparse
 import sys
 
-from lumpbeam_ros.cli.output import positive_float
-
 
 def _workers(text: str) -> int:
     try:
@@ -16,37 +14,6 @@ def _workers(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f'must be 1 or more, got {text!r}')
     return value
-
-
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Adds the ``campaign`` subcommand."""
-    parser = subparsers.add_parser(
-        'campaign',
-        help='analyze (and diagnose) many bags on a Dask cluster',
-        description='Runs lumpbeam analyze (and with --diagnose, lumpbeam diagnose) over '
-        'many bags on Dask, one row per bag in RESULTS/results.parquet and .csv, then fits '
-        "the beam's EI and mass across the campaign (RESULTS/report.html). A rerun skips "
-        'the bags already done.',
-    )
-    parser.add_argument('bags', nargs='+', metavar='BAG', help='bag folders or glob patterns')
-    parser.add_argument('--out', required=True, metavar='RESULTS', help='results folder')
-    parser.add_argument('--diagnose', action='store_true', help='also run lumpbeam diagnose')
-    parser.add_argument(
-        '--scheduler', metavar='ADDRESS', help='a running Dask scheduler (tcp://host:8786)'
-    )
-    parser.add_argument(
-        '--connect-timeout',
-        type=positive_float,
-        default=10.0,
-        metavar='S',
-        help='seconds to wait for --scheduler to answer (10)',
-    )
-    parser.add_argument(
-        '--workers', type=_workers, default=2, metavar='N', help='local cluster workers (2)'
-    )
-    parser.add_argument('--config', help='beam parameter file (default: config/paper_beam.yaml)')
-    parser.add_argument('--identifier-config', help='identifier parameter file')
-    parser.set_defaults(handler=run)
 
 
 def run(args: argparse.Namespace) -> int:

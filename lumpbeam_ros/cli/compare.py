@@ -8,51 +8,15 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from lumpbeam_ros.cli.output import positive_float, write_json
+from lumpbeam_ros.cli.output import write_json
 from lumpbeam_ros.compare.align import AlignOptions
 from lumpbeam_ros.compare.bag import (
-    CAMERA_TOPIC,
     LOAD_TOPIC,
-    REFERENCE_TOPIC,
     read_comparison_input,
 )
 from lumpbeam_ros.compare.comparison import Comparison, compare_sensors
 from lumpbeam_ros.ident.config import load_identifier_config
 from lumpbeam_ros.model.parameters import load_beam_config
-
-
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Adds the ``compare`` subcommand."""
-    parser = subparsers.add_parser(
-        'compare',
-        help='camera poses against a reference sensor (/tracker/point)',
-        description='Aligns a reference sensor (a laser tracker on the tip) to the camera in '
-        'time and space from the data alone, then reports their difference, the clock '
-        'offset (tracker_stamp = camera_stamp + offset) and the frequency and damping '
-        'identified from each.',
-    )
-    parser.add_argument('bag', help='bag folder with /tip_pose and /tracker/point')
-    parser.add_argument('--json', metavar='FILE', help='write the result as JSON')
-    parser.add_argument('--plots', metavar='DIR', help='write compare.png (Fig. B.8) here')
-    parser.add_argument('--config', help='beam parameter file (default: config/paper_beam.yaml)')
-    parser.add_argument('--identifier-config', help='identifier parameter file')
-    parser.add_argument(
-        '--max-offset',
-        type=positive_float,
-        default=1.0,
-        metavar='S',
-        help='largest clock offset searched, s (1)',
-    )
-    parser.add_argument(
-        '--max-gap',
-        type=positive_float,
-        metavar='S',
-        help='longest reference dropout bridged, s (2.5 reference periods)',
-    )
-    parser.add_argument('--camera-topic', default=CAMERA_TOPIC)
-    parser.add_argument('--reference-topic', default=REFERENCE_TOPIC)
-    parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
-    parser.set_defaults(handler=run)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -3,49 +3,8 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
-from typing import Any
 
-from lumpbeam_ros.cli.output import positive_float, write_json
-
-
-def register(subparsers: Any) -> None:
-    """Adds the ``demo`` subcommand."""
-    parser = subparsers.add_parser(
-        'demo',
-        help='the whole pipeline on the built-in synthetic experiment',
-        description='Synthesizes a drop test, replays it through the live node graph '
-        '(player, simulator, identifier, recorder as separate processes on a private ROS '
-        'domain), analyzes the recording and draws measured against predicted.',
-    )
-    parser.add_argument('--out', type=Path, default=Path('results'), help='output folder')
-    parser.add_argument(
-        '--duration', type=positive_float, default=12.0, help='record length, s (default 12)'
-    )
-    parser.add_argument('--seed', type=int, default=0, help='seed of the pose noise')
-    parser.add_argument(
-        '--adopt', action='store_true', help='the simulator adopts the live identified values'
-    )
-    parser.add_argument('--domain-id', type=int, help='ROS domain (default: a random one)')
-    parser.add_argument('--config', type=Path, help='beam parameter file')
-    parser.add_argument('--json', type=Path, help='also write the summary here')
-    parser.add_argument(
-        '--image-size',
-        default='640x480',
-        metavar='WxH',
-        help='synthetic camera frames, tracked by the camera node (default 640x480)',
-    )
-    parser.add_argument(
-        '--no-images', action='store_true', help="play the bag's /tip_pose, no camera node"
-    )
-    parser.add_argument(
-        '--effect',
-        action='append',
-        metavar='NAME=VALUE',
-        help='effect hidden in the data for the diagnosis (repeatable; default '
-        'sensor_latency=0.015); --effect none hides nothing',
-    )
-    parser.set_defaults(handler=run)
+from lumpbeam_ros.cli.output import write_json
 
 
 def run(args: argparse.Namespace) -> int:

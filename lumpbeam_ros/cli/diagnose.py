@@ -14,26 +14,6 @@ from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.parameters import load_beam_config, write_beam_config
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Adds the ``diagnose`` subcommand."""
-    parser = subparsers.add_parser(
-        'diagnose',
-        help='find the effect the model misses, add it, show the gap shrink',
-        description='Fits the nominal beam and each effect of SPEC section 6 to a drop-test '
-        'bag (/tip_pose, /tip_load), names the missing effect (or none, or unexplained) and '
-        'reports the gap between model and measurement before and after adding it.',
-    )
-    parser.add_argument('bag', help='bag folder with /tip_pose and /tip_load')
-    parser.add_argument('--config', help='nominal beam file (default: config/paper_beam.yaml)')
-    parser.add_argument('--json', metavar='FILE', help='write the result as JSON')
-    parser.add_argument('--plots', metavar='DIR', help='write figures (PNG) to this folder')
-    parser.add_argument(
-        '--write-model', metavar='FILE', help='write the augmented beam parameter file'
-    )
-    parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
-    parser.set_defaults(handler=run)
-
-
 def _summary(d: Diagnosis, seconds: float) -> str:
     lines = [
         f'missing effect: {d.missing_effect}'

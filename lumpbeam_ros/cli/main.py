@@ -1,9 +1,11 @@
-"""Entry point of the ``lumpbeam`` command (SPEC section 5).
+"""Entry point of the ``lumpbeam`` command (doc/interfaces.md, "The lumpbeam command").
 
-Each subcommand lives in its own module under :mod:`lumpbeam_ros.cli` with a
-``register(subparsers)`` function that adds its parser and sets ``handler``: a function of
-the parsed arguments returning the exit code. This module only dispatches and turns a
-:class:`~lumpbeam_ros.errors.LumpbeamError` into one line on stderr and exit code 2.
+Each subcommand is registered here by name with the function that declares its arguments
+(:mod:`lumpbeam_ros.cli.arguments`, standard library only) and the ``'module:function'``
+that runs it, imported only once the command is chosen: ``lumpbeam --help`` and
+``lumpbeam COMMAND --help`` load no numpy, OpenCV or ROS. This module only dispatches: a
+:class:`~lumpbeam_ros.errors.LumpbeamError` or a missing optional package becomes one line
+on stderr and exit code 2.
 """
 
 from __future__ import annotations
@@ -11,35 +13,54 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import NamedTuple
 
 from lumpbeam_ros import __version__
+from lumpbeam_ros.cli import arguments
+from lumpbeam_ros.cli.dependencies import missing_package_message
 from lumpbeam_ros.errors import LumpbeamError
-
-#: Subcommand modules, in the order ``lumpbeam --help`` lists them.
-COMMANDS = (
-    'reproduce',
-    'synth',
-    'track',
-    'analyze',
-    'diagnose',
-    'compare',
-    'record',
-    'play',
-    'bench',
-    'view',
-    'demo',
-    'campaign',
-)
 
 USAGE_ERROR = 2
 
 
+class Command(NamedTuple):
+    """A subcommand (a named tuple: dataclasses would double the start-up's imports).
+
+    Attributes:
+        name: What the user types.
+        declare: Adds the subcommand's parser to the top-level subparsers.
+        target: ``'module:function'`` of the function that runs it: parsed arguments in,
+            exit code out.
+    """
+
+    name: str
+    declare: Callable[[arguments.Subparsers], argparse.ArgumentParser]
+    target: str
+
+
+#: The subcommands, in the order ``lumpbeam --help`` lists them.
+COMMANDS = (
+    Command('reproduce', arguments.add_reproduce, 'lumpbeam_ros.cli.reproduce:run'),
+    Command('synth', arguments.add_synth, 'lumpbeam_ros.cli.synth:run'),
+    Command('track', arguments.add_track, 'lumpbeam_ros.cli.track:run'),
+    Command('analyze', arguments.add_analyze, 'lumpbeam_ros.cli.analyze:run'),
+    Command('diagnose', arguments.add_diagnose, 'lumpbeam_ros.cli.diagnose:run'),
+    Command('compare', arguments.add_compare, 'lumpbeam_ros.cli.compare:run'),
+    Command('record', arguments.add_record, 'lumpbeam_ros.cli.record:run'),
+    Command('play', arguments.add_play, 'lumpbeam_ros.cli.play:run'),
+    Command('bench', arguments.add_bench, 'lumpbeam_ros.cli.bench:run'),
+    Command('demo', arguments.add_demo, 'lumpbeam_ros.cli.demo:run'),
+    Command('campaign', arguments.add_campaign, 'lumpbeam_ros.cli.campaign:run'),
+    Command('view', arguments.add_view, 'lumpbeam_ros.cli.view:run'),
+)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    """Builds the parser with every available subcommand.
+    """Builds the parser with every subcommand, importing none of them.
 
     Returns:
-        The top-level parser.
+        The top-level parser; a parse sets ``target`` to the chosen command's function.
     """
     parser = argparse.ArgumentParser(
         prog='lumpbeam',
@@ -47,15 +68,25 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument('--version', action='version', version=f'%(prog)s {__version__}')
     subparsers = parser.add_subparsers(dest='command', metavar='COMMAND', required=True)
-    for name in COMMANDS:
-        try:
-            module = importlib.import_module(f'lumpbeam_ros.cli.{name}')
-        except ModuleNotFoundError as exc:
-            if exc.name != f'lumpbeam_ros.cli.{name}':
-                raise
-            continue  # not built yet
-        module.register(subparsers)
+    for command in COMMANDS:
+        command.declare(subparsers).set_defaults(target=command.target)
     return parser
+
+
+def load_target(target: str) -> Callable[[argparse.Namespace], int | None]:
+    """Imports the function that runs a subcommand.
+
+    Args:
+        target: ``'module:function'``.
+
+    Returns:
+        The function.
+
+    Raises:
+        ModuleNotFoundError: The module or one of its dependencies is not installed.
+    """
+    module, _, function = target.partition(':')
+    return getattr(importlib.import_module(module), function)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -65,14 +96,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         argv: Arguments without the program name; ``sys.argv[1:]`` when ``None``.
 
     Returns:
-        The exit code: 0 on success, 2 for a user's mistake, else the subcommand's code.
+        The exit code: 0 on success, 2 for a user's mistake or a missing optional package,
+        else the subcommand's code.
     """
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    args = build_parser().parse_args(argv)
     try:
-        return int(args.handler(args) or 0)
+        return int(load_target(args.target)(args) or 0)
     except LumpbeamError as exc:
         print(f'lumpbeam {args.command}: error: {exc}', file=sys.stderr)
+        return USAGE_ERROR
+    except ModuleNotFoundError as exc:
+        message = missing_package_message(args.command, exc)
+        if message is None:
+            raise
+        print(message, file=sys.stderr)
         return USAGE_ERROR
     except KeyboardInterrupt:
         print(f'lumpbeam {args.command}: interrupted', file=sys.stderr)

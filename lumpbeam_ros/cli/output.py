@@ -8,12 +8,13 @@ import math
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from lumpbeam_ros.errors import LumpbeamError
 
 
 def _plain(value: Any) -> Any:
+    # numpy is imported here: the argument types below serve `--help`, which must stay light.
+    import numpy as np
+
     if isinstance(value, dict):
         return {str(k): _plain(v) for k, v in value.items()}
     if isinstance(value, list | tuple):

@@ -7,29 +7,6 @@ import signal
 import sys
 from typing import Any
 
-from lumpbeam_ros.cli.output import positive_float
-
-
-def register(subparsers: Any) -> None:
-    """Adds the ``play`` subcommand."""
-    parser = subparsers.add_parser(
-        'play',
-        help='replay a bag into the live graph with /clock',
-        description='Publishes a bag with its original relative timing and /clock '
-        '(for nodes run with use_sim_time). Stops at the end, on Ctrl-C or on SIGTERM.',
-    )
-    parser.add_argument('bag', help='rosbag2 folder (MCAP)')
-    parser.add_argument('--rate', type=positive_float, default=1.0, help='speed factor')
-    parser.add_argument('--loop', action='store_true', help='start again at the end')
-    parser.add_argument('--topics', nargs='+', metavar='TOPIC', help='only these topics')
-    parser.add_argument(
-        '--delay',
-        type=positive_float,
-        default=0.5,
-        help='wait this long before the first message, for subscribers to connect (s)',
-    )
-    parser.set_defaults(handler=run)
-
 
 def run(args: argparse.Namespace) -> int:
     """Plays the bag.

@@ -7,29 +7,7 @@ import signal
 import time
 from typing import Any
 
-from lumpbeam_ros.cli.output import positive_float
 from lumpbeam_ros.errors import LumpbeamError
-
-
-def register(subparsers: Any) -> None:
-    """Adds the ``record`` subcommand."""
-    parser = subparsers.add_parser(
-        'record',
-        help='record topics from the live graph into a bag',
-        description='Records topics into a new rosbag2 bag (MCAP, CDR). Stops on Ctrl-C, '
-        'SIGTERM or after --duration; a killed recorder loses at most the last flush period.',
-    )
-    parser.add_argument('out', help='bag folder to create (never overwritten)')
-    parser.add_argument('topics', nargs='*', metavar='TOPIC', help='topics to record')
-    parser.add_argument('--all', action='store_true', help='record every topic that appears')
-    parser.add_argument('--duration', type=positive_float, help='stop after this many seconds')
-    parser.add_argument(
-        '--flush-period',
-        type=positive_float,
-        default=0.5,
-        help='longest time a message stays in memory, s (default 0.5)',
-    )
-    parser.set_defaults(handler=run)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -16,16 +16,6 @@ from lumpbeam_ros.model.reproduce import (
 )
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
-    """Adds the ``reproduce`` subcommand."""
-    parser = subparsers.add_parser(
-        'reproduce', help="the paper's Tables B.1, B.2, frequencies and static deflections"
-    )
-    parser.add_argument('--config', help='beam parameter file (default: config/paper_beam.yaml)')
-    parser.add_argument('--json', metavar='FILE', help='write the results as JSON')
-    parser.set_defaults(handler=run)
-
-
 def _format(rows: list[Comparison]) -> str:
     lines = [f'{"quantity":<30} {"model":>10} {"paper":>10} {"diff":>10} {"limit":>9}']
     for row in rows:

@@ -13,8 +13,6 @@ import sys
 import time
 from typing import Any
 
-from lumpbeam_ros.cli.output import positive_float
-
 
 def _port(text: str) -> int:
     try:
@@ -24,24 +22,6 @@ def _port(text: str) -> int:
     if not 0 <= value <= 65535:
         raise argparse.ArgumentTypeError(f'port must be in 0..65535, got {value}')
     return value
-
-
-def register(subparsers: Any) -> None:
-    """Adds the ``view`` subcommand."""
-    parser = subparsers.add_parser(
-        'view',
-        help='serve the live graph (or a bag) to Foxglove over its WebSocket protocol',
-        description='Serves the live ROS graph, or a bag replayed in its own timing, to '
-        'Foxglove at ws://HOST:PORT (messages as their CDR bytes, ros2msg schemas).',
-    )
-    parser.add_argument('--bag', help='replay this bag instead of the live graph')
-    parser.add_argument('--port', type=_port, default=8765, help='TCP port (0: any free one)')
-    parser.add_argument('--host', default='127.0.0.1', help='address to listen on')
-    parser.add_argument('--topics', nargs='+', metavar='TOPIC', help='only these topics')
-    parser.add_argument('--rate', type=positive_float, default=1.0, help='bag speed factor')
-    parser.add_argument('--loop', action='store_true', help='replay the bag again at its end')
-    parser.add_argument('--duration', type=positive_float, help='stop after this many seconds')
-    parser.set_defaults(handler=run)
 
 
 def run(args: argparse.Namespace) -> int:

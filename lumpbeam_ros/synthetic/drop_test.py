@@ -12,6 +12,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -20,7 +21,6 @@ from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters, DropTestConfig
 from lumpbeam_ros.model.simulate import drop_test_events, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
-from lumpbeam_ros.synthetic.images import ImageOptions, ImageStream
 from lumpbeam_ros.synthetic.tracker import TrackerOptions, simulate_tracker, write_tracker_points
 from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.viz.markers import (
@@ -31,6 +31,9 @@ from lumpbeam_ros.viz.markers import (
     marker_sample_indices,
 )
 from lumpbeam_ros.viz.messages import write_scene
+
+if TYPE_CHECKING:
+    from lumpbeam_ros.synthetic.images import ImageOptions
 
 #: Pitch noise per metre of position noise: the camera sees the board about 1 m away.
 PITCH_NOISE_PER_M = 1.0
@@ -175,7 +178,12 @@ def write_drop_test_bag(
         hidden = with_effects(beam, options.effects)
         points = simulate_tracker(hidden, drop, options.duration_s, tracker)
     written = 0
-    camera = None if images is None else ImageStream(measured, images)
+    camera = None
+    if images is not None:
+        # OpenCV only when filming: the pose-only bag needs none (`pip install lumpbeam_ros`).
+        from lumpbeam_ros.synthetic.images import ImageStream
+
+        camera = ImageStream(measured, images)
     drawn = set()
     if options.markers_rate_hz > 0.0:
         drawn = set(marker_sample_indices(truth.t, options.markers_rate_hz).tolist())

@@ -131,8 +131,9 @@ def test_every_kind_of_footage_is_tracked_against_the_truth(kind, tmp_path, foot
     assert rms[1] < z_limit and rms[2] < pitch_limit
     medium = kind.split()[0]
     if medium != 'bag':
-        # OUT of a video or a folder: the poses and the intrinsics used.
-        assert set(BagReader(out).topics) == {'/tip_pose', '/camera/camera_info'}
+        # OUT of a video or a folder: the poses, the intrinsics used and the markers to view.
+        topics = set(BagReader(out).topics)
+        assert topics == {'/tip_pose', '/camera/camera_info', '/beam_markers'}
         np.testing.assert_array_equal(read_camera_info(out).k, info.k)
 
 

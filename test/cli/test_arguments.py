@@ -1,0 +1,47 @@
+import argparse
+
+import pytest
+
+from lumpbeam_ros.cli import arguments
+from lumpbeam_ros.cli.main import build_parser
+from lumpbeam_ros.compare import bag as compare_bag
+from lumpbeam_ros.synthetic.tracker import TrackerOptions
+from lumpbeam_ros.vision import offline
+
+TRACKER = TrackerOptions()
+
+
+@pytest.mark.parametrize(
+    ('command', 'option', 'core'),
+    [
+        # None: the raw images, else the compressed ones, else the bag's only image topic.
+        (['track', 'in', 'out'], 'image_topic', None),
+        (['track', 'in', 'out'], 'camera_info_topic', offline.CAMERA_INFO_TOPIC),
+        (['compare', 'bag'], 'camera_topic', compare_bag.CAMERA_TOPIC),
+        (['compare', 'bag'], 'reference_topic', compare_bag.REFERENCE_TOPIC),
+        (['synth', 'out'], 'tracker_rate', TRACKER.rate_hz),
+        (['synth', 'out'], 'tracker_noise', TRACKER.noise_m),
+        (['synth', 'out'], 'tracker_offset', TRACKER.clock_offset_s),
+        (['synth', 'out'], 'tracker_pose', (*TRACKER.position_m, *TRACKER.rotation_deg)),
+        (['synth', 'out'], 'tracker_lever', TRACKER.lever_m),
+    ],
+)
+def test_defaults_are_the_cores(command, option, core):
+    assert getattr(build_parser().parse_args(command), option) == core
+
+
+def test_tracker_pose_reads_six_numbers():
+    assert arguments.tracker_pose('1,2,3,4,5,6') == (1.0, 2.0, 3.0, 4.0, 5.0, 6.0)
+
+
+@pytest.mark.parametrize('text', ['1,2,3', '1,2,3,4,5,x', ''])
+def test_tracker_pose_rejects_anything_else(text):
+    with pytest.raises(argparse.ArgumentTypeError):
+        arguments.tracker_pose(text)
+
+
+def test_a_bad_tracker_pose_is_a_usage_error(capsys):
+    with pytest.raises(SystemExit) as exit_:
+        build_parser().parse_args(['synth', 'out', '--tracker-pose', '1,2'])
+    assert exit_.value.code == 2
+    assert "expected 6 comma-separated numbers, got '1,2'" in capsys.readouterr().err

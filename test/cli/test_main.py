@@ -1,0 +1,114 @@
+"""The lazy dispatch of ``lumpbeam``: light help, offline commands without the optional packages.
+
+Each check runs ``lumpbeam`` in a fresh interpreter (this one has long imported everything);
+a meta-path finder installed before the CLI refuses the optional packages, as on a machine
+where they are not installed.
+"""
+
+import subprocess
+import sys
+
+import pytest
+
+from lumpbeam_ros.cli.main import COMMANDS, build_parser, load_target
+from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
+from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+
+OPTIONAL = ('cv2', 'rclpy', 'matplotlib')
+#: What `--help` must not load: the optional packages and the heavy core dependencies.
+HEAVY = (*OPTIONAL, 'numpy', 'scipy', 'rosbags', 'mcap', 'yaml')
+OFFLINE = ('reproduce', 'analyze', 'diagnose', 'compare')
+
+BLOCKER = """
+import importlib.abc
+import sys
+
+class Refuse(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path=None, target=None):
+        if name.partition('.')[0] in {blocked!r}:
+            raise ModuleNotFoundError(f'No module named {{name!r}} (blocked)', name=name)
+        return None
+
+sys.meta_path.insert(0, Refuse())
+"""
+RUN_CLI = """
+import atexit
+atexit.register(lambda: print('loaded:', sorted(m for m in {heavy!r} if m in sys.modules)))
+from lumpbeam_ros.cli.main import main
+sys.exit(main())
+"""
+
+
+def lumpbeam(*arguments: str, blocked: tuple[str, ...] = OPTIONAL) -> subprocess.CompletedProcess:
+    """Runs ``lumpbeam ARGUMENTS`` in a fresh interpreter with ``blocked`` not importable."""
+    code = BLOCKER.format(blocked=set(blocked)) + RUN_CLI.format(heavy=HEAVY)
+    return subprocess.run(
+        [sys.executable, '-c', code, *arguments], capture_output=True, text=True, timeout=300
+    )
+
+
+@pytest.fixture(scope='module')
+def small_bag(tmp_path_factory):
+    bag = tmp_path_factory.mktemp('main') / 'drop'
+    write_drop_test_bag(bag, BeamParameters(), DropTestConfig(), SynthOptions(duration_s=4.0))
+    return bag
+
+
+@pytest.mark.parametrize('command', [[]] + [[c.name] for c in COMMANDS], ids=lambda c: str(c))
+def test_help_loads_no_heavy_package(command):
+    result = lumpbeam(*command, '--help')
+    assert result.returncode == 0, result.stderr
+    assert 'usage: lumpbeam' in result.stdout
+    assert result.stdout.rstrip().endswith('loaded: []')
+
+
+def test_every_command_is_listed_in_the_help():
+    text = build_parser().format_help()
+    assert all(command.name in text for command in COMMANDS)
+
+
+def test_every_target_exists():
+    for command in COMMANDS:
+        assert command.target == f'lumpbeam_ros.cli.{command.name}:run'
+        assert callable(load_target(command.target))
+
+
+def test_reproduce_and_analyze_run_without_optional_packages(small_bag):
+    reproduce = lumpbeam('reproduce')
+    assert reproduce.returncode == 0, reproduce.stderr
+    assert 'numbers within tolerance' in reproduce.stdout
+    analyze = lumpbeam('analyze', str(small_bag))
+    assert analyze.returncode == 0, analyze.stderr
+    assert 'status: OK' in analyze.stdout
+
+
+@pytest.mark.parametrize(
+    ('arguments', 'blocked', 'message'),
+    [
+        (
+            ['track', '{bag}', '{tmp}/out'],
+            'cv2',
+            "needs OpenCV: pip install 'lumpbeam_ros[vision]'",
+        ),
+        (['play', '{bag}'], 'rclpy', "needs ROS 2 (rclpy): pip install 'lumpbeam_ros[ros]'"),
+        (
+            ['analyze', '{bag}', '--plots', '{tmp}/plots'],
+            'matplotlib',
+            "needs matplotlib: pip install 'lumpbeam_ros[plots]'",
+        ),
+    ],
+    ids=['track-cv2', 'play-rclpy', 'analyze-plots-matplotlib'],
+)
+def test_a_missing_optional_package_is_one_line_and_exit_2(
+    small_bag, tmp_path, arguments, blocked, message
+):
+    filled = [a.format(bag=small_bag, tmp=tmp_path) for a in arguments]
+    result = lumpbeam(*filled, blocked=(blocked,))
+    assert result.returncode == 2
+    assert result.stderr == f'lumpbeam {arguments[0]} {message}\n'
+
+
+def test_a_missing_core_module_is_a_broken_install_not_a_hint():
+    result = lumpbeam('reproduce', blocked=('numpy',))
+    assert result.returncode == 1
+    assert "ModuleNotFoundError: No module named 'numpy" in result.stderr
