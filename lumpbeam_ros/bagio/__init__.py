@@ -14,7 +14,7 @@ Reading::
 
 from lumpbeam_ros.bagio.convert import CameraInfoData, Status
 from lumpbeam_ros.bagio.reader import BagReader, RawMessage, open_bag
-from lumpbeam_ros.bagio.repair import reindex
+from lumpbeam_ros.bagio.repair import RepairSummary, reindex, repair_bag
 from lumpbeam_ros.bagio.series import (
     ImageFrame,
     LoadSeries,
@@ -39,6 +39,7 @@ __all__ = [
     'PointSeries',
     'PoseSeries',
     'RawMessage',
+    'RepairSummary',
     'Status',
     'iter_images',
     'open_bag',
@@ -49,4 +50,5 @@ __all__ = [
     'read_points',
     'read_tip_poses',
     'reindex',
+    'repair_bag',
 ]

@@ -8,7 +8,11 @@ defaults, used for synthetic bags and by the player when a bag has none:
 - ``/tip_load``: reliable, transient local, keep last 1. It changes rarely (a drop), so a
   node that starts after the last change still needs the current load; a transient-local
   publisher also serves volatile subscribers, so nobody is excluded;
-- everything else: reliable, volatile, keep last 10.
+- everything else (poses, ``/beam_params``, ``/clock``): reliable, volatile, keep last
+  :data:`STREAM_DEPTH`. Nothing of these may be lost: a reliable keep-last writer drops its
+  oldest sample for a reader that has not acknowledged it once the history is full, and a
+  reader's history drops its oldest sample when its executor falls behind, so the depth is
+  the stall either side can absorb.
 """
 
 from __future__ import annotations
@@ -28,6 +32,15 @@ from rosbags.interfaces import (
 #: How rosbag2 writes an infinite duration (``RMW_DURATION_INFINITE``).
 INFINITE = QosTime(2147483647, 4294967295)
 ZERO = QosTime(0, 0)
+
+#: History of the reliable streams: 400 samples are 2.2 s of 180 Hz poses. A second of data
+#: (180) covers a subscriber whose process is off the CPU for a second on a loaded core;
+#: the margin covers bursts (the simulator publishes the samples of a late tick at once, the
+#: player publishes ``/clock`` beside every message, doubling the rate). A PoseStamped is
+#: about 100 bytes, so a history costs some 40 kB per endpoint.
+STREAM_DEPTH = 400
+#: History of the sensor-data profile (images, camera info).
+SENSOR_DEPTH = 5
 
 SENSOR_TYPES = ('sensor_msgs/msg/Image', 'sensor_msgs/msg/CameraInfo')
 LATCHED_TOPICS = ('/tip_load',)
@@ -60,10 +73,10 @@ def profile(reliable: bool, transient_local: bool, depth: int) -> Qos:
 def default_profile(topic: str, msgtype: str) -> Qos:
     """Returns the project's profile for a topic (see the module docstring)."""
     if msgtype in SENSOR_TYPES:
-        return profile(reliable=False, transient_local=False, depth=5)
+        return profile(reliable=False, transient_local=False, depth=SENSOR_DEPTH)
     if topic in LATCHED_TOPICS:
         return profile(reliable=True, transient_local=True, depth=1)
-    return profile(reliable=True, transient_local=False, depth=10)
+    return profile(reliable=True, transient_local=False, depth=STREAM_DEPTH)
 
 
 def from_dict(entry: Mapping[str, Any]) -> Qos:

@@ -70,9 +70,11 @@ class BagReader:
             if self._probe(file) is None:
                 self.truncated.append(file)
                 _log.warning(
-                    '%s: %s has no closing index (recording was cut?); reading what is readable',
+                    '%s: %s has no closing index (recording was cut?); reading what is '
+                    'readable. `lumpbeam repair %s` makes it whole for every reader',
                     self.path,
                     file.name,
+                    self.path,
                 )
 
     @property
@@ -103,16 +105,75 @@ class BagReader:
         Yields:
             The messages.
         """
+        for schema, channel, message in self.iter_records(topics):
+            yield _raw(schema, channel, message)
+
+    def iter_records(
+        self, topics: Iterable[str] | None = None
+    ) -> Iterator[tuple[Schema | None, Channel, Message]]:
+        """Iterates over the MCAP records of the messages, with their schema and channel.
+
+        What :meth:`iter_raw` reads, with what a copy of the bag needs besides (the schema's
+        message definition, the channel's metadata). A read that comes up short of the
+        metadata's counts warns (:meth:`check_count`).
+
+        Args:
+            topics: Topics to read; all when ``None``.
+
+        Yields:
+            ``(schema, channel, message)``, in log-time order within each data file.
+        """
         wanted = None if topics is None else set(topics)
+        read = dict.fromkeys(self.topics if wanted is None else wanted, 0)
         for file in self.info.files:
             with file.open('rb') as stream:
                 if file in self.truncated:
-                    for schema, channel, message in stream_messages(stream, str(file), wanted):
-                        yield _raw(schema, channel, message)
+                    messages = stream_messages(stream, str(file), wanted)
                 else:
-                    reader = SeekingReader(stream)
-                    for schema, channel, message in reader.iter_messages(topics=wanted):
-                        yield _raw(schema, channel, message)
+                    messages = SeekingReader(stream).iter_messages(topics=wanted)
+                try:
+                    for schema, channel, message in messages:
+                        read[channel.topic] = read.get(channel.topic, 0) + 1
+                        yield schema, channel, message
+                except _READ_ERRORS as exc:
+                    # A damaged record: what came before it is kept, the loss is counted below.
+                    _log.warning(
+                        '%s: %s is damaged after byte %d (%s); reading stops there',
+                        self.path,
+                        file.name,
+                        stream.tell(),
+                        type(exc).__name__,
+                    )
+        for topic, count in read.items():
+            self.check_count(topic, count)
+
+    def check_count(self, topic: str, read: int) -> bool:
+        """Warns when fewer messages of a topic were read than the bag's metadata lists.
+
+        A damaged stretch of an MCAP file (overwritten bytes, a bad chunk) makes readers skip
+        what it held; the metadata's count is the bag's own record of what it should hold.
+
+        Args:
+            topic: The topic read in full.
+            read: Messages read.
+
+        Returns:
+            Whether every listed message was read (``True`` for a topic the metadata lacks).
+        """
+        entry = self.topics.get(topic)
+        if entry is None or read >= entry.count:
+            return True
+        _log.warning(
+            '%s: %s: read %d of the %d messages that metadata.yaml lists; %d lost to damaged '
+            'data (`lumpbeam repair %s` keeps what is readable in a whole bag)',
+            self.path,
+            topic,
+            read,
+            entry.count,
+            entry.count - read,
+            self.path,
+        )
+        return False
 
     def messages(self, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
         """Iterates over the deserialized messages of one topic.

@@ -1,20 +1,24 @@
-"""Rebuilding ``metadata.yaml`` from a bag's MCAP data (``ros2 bag reindex`` for MCAP).
+"""Making a damaged bag whole: a new copy (``mcap recover``), or new metadata (``reindex``).
 
 :class:`~lumpbeam_ros.bagio.writer.BagWriter` keeps ``metadata.yaml`` current to its last
-flush, so a killed recording opens as it is. This covers the rest: a metadata file that was
-deleted or damaged, or counts that lag behind the data after a crash.
+flush, so a killed recording opens with this package's reader as it is. Other readers
+(rosbags, ``ros2 bag``, the mcap tools) need the MCAP file's closing summary, which a killed
+writer never wrote: :func:`repair_bag` copies every readable message into a new bag with a
+summary and exact counts. :func:`reindex` covers a metadata file that was deleted or damaged.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import yaml
 
 from lumpbeam_ros.bagio import metadata
 from lumpbeam_ros.bagio.qos import from_dict
-from lumpbeam_ros.bagio.reader import stream_messages
+from lumpbeam_ros.bagio.reader import BagReader, stream_messages
 from lumpbeam_ros.bagio.typestore import is_known, type_description
+from lumpbeam_ros.bagio.writer import BagWriter
 from lumpbeam_ros.errors import BagError
 
 
@@ -70,3 +74,78 @@ def reindex(path: str | Path) -> int:
     except OSError as exc:
         raise BagError(f'{folder}: cannot reindex: {exc.strerror or exc}') from None
     return sum(counts.values())
+
+
+@dataclass
+class RepairSummary:
+    """What :func:`repair_bag` kept.
+
+    Attributes:
+        out: The repaired bag.
+        listed: Messages per topic that the damaged bag's metadata listed.
+        kept: Messages per topic copied into the repaired bag.
+        truncated: Whether the damaged bag had data files without their closing summary.
+    """
+
+    out: Path
+    listed: dict[str, int] = field(default_factory=dict)
+    kept: dict[str, int] = field(default_factory=dict)
+    truncated: bool = False
+
+
+def default_repair_path(bag: str | Path) -> Path:
+    """Where ``lumpbeam repair BAG`` writes when no OUT is given: ``BAG-repaired`` beside it."""
+    path = Path(bag)
+    return path.with_name(f'{path.name}-repaired')
+
+
+def repair_bag(bag: str | Path, out: str | Path | None = None) -> RepairSummary:
+    """Copies every readable message of a bag into a new, complete bag.
+
+    The copy has one MCAP file with chunk indexes, statistics and summary, its messages in
+    log-time order, and a ``metadata.yaml`` whose counts are those of the copy. Topics keep
+    their types, message definitions, type hashes and offered QoS. Messages after an
+    incomplete or damaged record are lost (the reader warns, naming the topic and count).
+
+    Args:
+        bag: The damaged bag folder (e.g. a recording whose recorder was killed).
+        out: The bag folder to create; :func:`default_repair_path` when ``None``.
+
+    Returns:
+        What was kept.
+
+    Raises:
+        BagError: ``bag`` cannot be opened, ``out`` exists, or a write fails.
+    """
+    reader = BagReader(bag)
+    target = Path(out) if out is not None else default_repair_path(reader.path)
+    summary = RepairSummary(
+        target,
+        listed={name: entry.count for name, entry in reader.topics.items()},
+        truncated=bool(reader.truncated),
+    )
+    with BagWriter(target) as writer:
+        for schema, channel, message in reader.iter_records():
+            topic = channel.topic
+            if not writer.has_topic(topic):
+                _declare(writer, reader, topic, schema)
+                summary.kept[topic] = 0
+            writer.write_raw(topic, message.log_time, message.data)
+            summary.kept[topic] += 1
+        for name, entry in reader.topics.items():
+            if not writer.has_topic(name) and is_known(entry.msgtype):
+                writer.add_topic(name, entry.msgtype, qos=[from_dict(p) for p in entry.qos])
+                summary.kept[name] = 0
+    return summary
+
+
+def _declare(writer: BagWriter, reader: BagReader, topic: str, schema: object) -> None:
+    """Declares a topic in the copy as the damaged bag had it."""
+    entry = reader.topics.get(topic)
+    msgtype = getattr(schema, 'name', '') or (entry.msgtype if entry else '')
+    msgdef = None
+    if getattr(schema, 'encoding', '') == 'ros2msg':
+        msgdef = bytes(schema.data).decode()  # type: ignore[attr-defined]
+    qos = [from_dict(p) for p in entry.qos] if entry is not None and entry.qos else None
+    type_hash = entry.type_hash if entry is not None and entry.type_hash else None
+    writer.add_topic(topic, msgtype, qos=qos, msgdef=msgdef, type_hash=type_hash)

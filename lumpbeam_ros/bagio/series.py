@@ -121,6 +121,7 @@ def _fast_scan(reader: BagReader, topic: str) -> tuple[list[int], list[bytes]] |
             return None
         log_times += part[0]
         payloads += part[1]
+    reader.check_count(topic, len(payloads))
     return log_times, payloads
 
 

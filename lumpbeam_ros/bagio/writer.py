@@ -11,7 +11,12 @@ adds what a recorder needs on top of it:
   every chunk before it stays readable (:mod:`lumpbeam_ros.bagio.reader` reads a file
   without its closing index, with a warning);
 - an I/O error (disk full, file too large) raises :class:`~lumpbeam_ros.errors.BagError`
-  after refreshing the metadata, so what was flushed stays readable.
+  after refreshing the metadata, so what was flushed stays readable;
+- messages are in log-time order within the file, as MCAP readers (``mcap doctor``, players
+  that merge chunks) expect: the messages written since the last flush are held and go to
+  the file sorted by log time (ties in the order they were written). A message older than
+  what an earlier flush wrote cannot be put in order any more: it is written with a warning,
+  so a writer whose sources are out of order merges them first.
 
 Messages' log time is the recording time; for synthetic bags it equals the header stamp
 (SPEC section 2: stamps are measurement time).
@@ -19,6 +24,8 @@ Messages' log time is the recording time; for synthetic bags it equals the heade
 
 from __future__ import annotations
 
+import logging
+import operator
 import time
 from collections.abc import Iterable, Sequence
 from pathlib import Path
@@ -33,6 +40,11 @@ from lumpbeam_ros.bagio import convert, metadata
 from lumpbeam_ros.bagio.qos import default_profile
 from lumpbeam_ros.bagio.typestore import serialize, type_description
 from lumpbeam_ros.errors import BagError
+
+_log = logging.getLogger(__name__)
+
+#: Bytes of pending messages that trigger a flush (rosbags closes its chunks at 1 MiB too).
+PENDING_LIMIT_BYTES = 1 << 20
 
 
 class BagWriter:
@@ -72,7 +84,12 @@ class BagWriter:
         self._qos: dict[str, list[Qos]] = {}
         self._failed = False
         self._closed = False
-        self._dirty = False  # messages written since the last flush
+        # Messages since the last flush: (log time, sequence, connection, data).
+        self._pending: list[tuple[int, int, Connection, bytes | memoryview]] = []
+        self._pending_bytes = 0
+        self._sequence = 0
+        self._flushed_log_time = -1  # the latest log time in the file
+        self._warned_order = False
         self._last_flush = time.monotonic()
         self._flushed_snapshot = self._metadata()
         self._guard(self._flush_storage)  # the MCAP magic and header, so the file is one
@@ -128,6 +145,9 @@ class BagWriter:
             log_time_ns: Recording time, ns since the epoch.
             data: The CDR bytes.
 
+        A log time before what an earlier flush wrote is written all the same, with a
+        warning (once per bag): the file is then out of log-time order.
+
         Raises:
             BagError: Undeclared topic, a closed bag, or an I/O error (what was flushed before
                 stays readable).
@@ -137,10 +157,27 @@ class BagWriter:
             raise BagError(f'topic {topic!r} was not declared in {self.path}')
         if log_time_ns < 0:
             raise BagError(f'log time must be >= 0 ns, got {log_time_ns}')
+        if log_time_ns < self._flushed_log_time and not self._warned_order:
+            self._warned_order = True
+            _log.warning(
+                '%s: %s message logged at %d ns comes after one logged at %d ns was flushed; '
+                'the file is out of log-time order from here (write in log-time order, give '
+                'or take one flush period)',
+                self.path,
+                topic,
+                log_time_ns,
+                self._flushed_log_time,
+            )
         self._check_open()
-        self._guard(lambda: self._writer.write(connection, int(log_time_ns), data))
-        self._dirty = True
-        if time.monotonic() - self._last_flush >= self._flush_period:
+        # Held until the next flush: a view into a buffer its owner reuses must be copied.
+        held = bytes(data) if isinstance(data, memoryview) else data
+        self._pending.append((int(log_time_ns), self._sequence, connection, held))
+        self._sequence += 1
+        self._pending_bytes += len(data)
+        if (
+            self._pending_bytes >= PENDING_LIMIT_BYTES
+            or time.monotonic() - self._last_flush >= self._flush_period
+        ):
             self.flush()
 
     def write_message(self, topic: str, message: Any, log_time_ns: int) -> None:
@@ -225,8 +262,8 @@ class BagWriter:
 
     @property
     def message_count(self) -> int:
-        """Messages written so far."""
-        return sum(self._writer.counts.values())
+        """Messages written so far (flushed or pending)."""
+        return sum(self._writer.counts.values()) + len(self._pending)
 
     def flush(self) -> None:
         """Puts every message written so far into the file and refreshes ``metadata.yaml``.
@@ -238,13 +275,13 @@ class BagWriter:
             BagError: An I/O error.
         """
         self._check_open()
-        if not self._dirty:
+        if not self._pending:
             return
+        self._guard(self._write_pending)
         self._guard(self._flush_storage)
         self._flushed_snapshot = self._metadata()
         self._guard(lambda: metadata.write(self.path, self._flushed_snapshot))
         self._last_flush = time.monotonic()
-        self._dirty = False
 
     def close(self) -> None:
         """Writes the MCAP summary and the final ``metadata.yaml``; idempotent.
@@ -254,6 +291,7 @@ class BagWriter:
         """
         if self._closed or self._failed:
             return
+        self._guard(self._write_pending)
         self._guard(self._writer.close)
         self._closed = True
 
@@ -270,6 +308,15 @@ class BagWriter:
         self.close()
 
     # -- internals --------------------------------------------------------------------------
+
+    def _write_pending(self) -> None:
+        """Hands the pending messages to the MCAP writer in log-time order."""
+        pending, self._pending, self._pending_bytes = self._pending, [], 0
+        pending.sort(key=operator.itemgetter(0, 1))
+        for log_time, _, connection, data in pending:
+            self._writer.write(connection, log_time, data)
+        if pending:
+            self._flushed_log_time = max(self._flushed_log_time, pending[-1][0])
 
     def _flush_storage(self) -> None:
         # rosbags' McapWriter exposes its pending chunk and file object as public attributes;

@@ -24,13 +24,16 @@ import sys
 import threading
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from lumpbeam_ros.resources import large_frames_profile
 
+#: Longest wait for the consumer processes to start and be discovered, s (a node importing
+#: OpenCV and scipy on a busy machine takes a while).
+STARTUP_TIMEOUT_S = 60.0
 #: Domains the bench uses (Fast DDS ports are valid for any participant count; 0 is left to
 #: a developer's own graph, the test harness cycles through the same range).
 _DOMAINS = (*range(1, 102), *range(215, 233))
@@ -45,12 +48,16 @@ class StreamFigures:
         received: Poses received.
         duration_s: Publishing time, s.
         latency_ms: Per received pose, receive time minus image stamp, ms.
+        params_latency_ms: Per ``/beam_params`` message (when an identifier node runs),
+            its publication stamp minus the stamp of the newest frame in its window
+            (``window_end_s``), ms.
     """
 
     published: int
     received: int
     duration_s: float
     latency_ms: np.ndarray
+    params_latency_ms: np.ndarray = field(default_factory=lambda: np.empty(0))
 
     def percentile_ms(self, q: float) -> float:
         """A latency percentile, ms (NaN without poses)."""
@@ -179,6 +186,7 @@ def measure(
     rate_hz: float,
     duration_s: float,
     large_frames: bool = True,
+    downstream: Sequence[str] = (),
 ) -> StreamFigures:
     """Runs a consumer process (the camera node or the echo) against the publisher process.
 
@@ -189,6 +197,8 @@ def measure(
         rate_hz: Offered frame rate, Hz.
         duration_s: Publishing time, s.
         large_frames: Give the publisher and the consumer :data:`LARGE_FRAMES_PROFILE`.
+        downstream: A process fed by the consumer that publishes ``/beam_params`` (the
+            identifier node); empty for none.
 
     Returns:
         The figures.
@@ -197,11 +207,13 @@ def measure(
         RuntimeError: A process failed or discovery never completed.
     """
     import rclpy
+    from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import PoseStamped
     from rclpy.context import Context
     from rclpy.executors import SingleThreadedExecutor
 
     from lumpbeam_ros.nodes.camera_node import POSE_QOS
+    from lumpbeam_ros.nodes.msgtypes import topic_qos
 
     domain = _DOMAINS[(os.getpid() * 13 + int(time.time())) % len(_DOMAINS)]
     env = _env(domain, large_frames)
@@ -214,7 +226,26 @@ def measure(
         stamp_ns = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
         latencies.append((time.time_ns() - stamp_ns) * 1e-6)
 
+    params_latencies: list[float] = []
+
+    def on_params(msg: DiagnosticArray) -> None:
+        published_ns = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+        for status in msg.status:
+            values = {kv.key: kv.value for kv in status.values}
+            try:
+                newest_s = float(values['window_end_s'])
+            except (KeyError, ValueError):
+                continue
+            if np.isfinite(newest_s):
+                params_latencies.append(published_ns * 1e-6 - newest_s * 1e3)
+
     node.create_subscription(PoseStamped, '/tip_pose', on_pose, POSE_QOS)
+    node.create_subscription(
+        DiagnosticArray,
+        '/beam_params',
+        on_params,
+        topic_qos('/beam_params', 'diagnostic_msgs/msg/DiagnosticArray'),
+    )
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
     stop = threading.Event()
@@ -228,10 +259,13 @@ def measure(
     processes = []
     try:
         processes.append(subprocess.Popen(consumer, env=env, stdout=subprocess.DEVNULL))
-        deadline = time.monotonic() + 20.0
-        while node.count_publishers('/tip_pose') < 1:
-            if time.monotonic() > deadline or processes[0].poll() is not None:
-                raise RuntimeError(f'consumer {consumer[-1]} never published /tip_pose')
+        if downstream:
+            processes.append(subprocess.Popen(downstream, env=env, stdout=subprocess.DEVNULL))
+        deadline = time.monotonic() + STARTUP_TIMEOUT_S
+        wanted = ['/tip_pose', '/beam_params'] if downstream else ['/tip_pose']
+        while unheard := [t for t in wanted if node.count_publishers(t) < 1]:
+            if time.monotonic() > deadline or any(p.poll() is not None for p in processes):
+                raise RuntimeError(f'no publisher of {", ".join(unheard)} appeared')
             time.sleep(0.05)
         args = ['publish', str(width), str(height), str(rate_hz), str(duration_s)]
         publisher = subprocess.Popen(
@@ -257,13 +291,26 @@ def measure(
         node.destroy_node()
         rclpy.shutdown(context=context)
     return StreamFigures(
-        int(result['published']), len(latencies), float(result['duration_s']), np.array(latencies)
+        int(result['published']),
+        len(latencies),
+        float(result['duration_s']),
+        np.array(latencies),
+        np.array(params_latencies),
     )
 
 
 def camera_node_command() -> list[str]:
     """The camera node as a process, taking its intrinsics from the stream."""
     return [sys.executable, '-m', 'lumpbeam_ros.nodes.camera_node']
+
+
+def identifier_command(publish_rate_hz: float) -> list[str]:
+    """The identifier node as a process, on wall time, publishing at ``publish_rate_hz``."""
+    from lumpbeam_ros.pipeline.graph import node_command
+
+    return node_command(
+        'lumpbeam_ros.nodes.identifier_node', '-p', f'publish_rate_hz:={publish_rate_hz}'
+    )
 
 
 def echo_command() -> list[str]:

@@ -9,7 +9,7 @@ from collections.abc import Iterable
 from lumpbeam_ros.bench.result import BenchResult
 
 #: Suite modules under :mod:`lumpbeam_ros.bench`.
-SUITES = ('model', 'tracker', 'ident', 'bagio', 'diagnose', 'campaign', 'cli')
+SUITES = ('model', 'tracker', 'ident', 'bagio', 'diagnose', 'campaign', 'cli', 'live_graph')
 
 
 def available_suites() -> list[str]:

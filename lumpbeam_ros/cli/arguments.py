@@ -344,6 +344,28 @@ def add_record(subparsers: Subparsers) -> argparse.ArgumentParser:
     return parser
 
 
+def add_repair(subparsers: Subparsers) -> argparse.ArgumentParser:
+    """Declares ``lumpbeam repair BAG [OUT]``.
+
+    Args:
+        subparsers: The top-level parser's subcommands.
+
+    Returns:
+        The subcommand's parser.
+    """
+    parser = subparsers.add_parser(
+        'repair',
+        help='copy the readable messages of a damaged bag into a whole one',
+        description='Copies every readable message of a bag whose recorder was killed (or '
+        'whose data file is damaged) into a new bag with a complete MCAP summary and exact '
+        'counts in metadata.yaml, so that rosbags, ros2 bag and the mcap tools open it '
+        '(as `mcap recover` does for a bare MCAP file). The damaged bag is left as it is.',
+    )
+    parser.add_argument('bag', help='the damaged rosbag2 folder (MCAP)')
+    parser.add_argument('out', nargs='?', help='bag folder to create (default: BAG-repaired)')
+    return parser
+
+
 def add_play(subparsers: Subparsers) -> argparse.ArgumentParser:
     """Declares ``lumpbeam play BAG``.
 

@@ -48,6 +48,7 @@ COMMANDS = (
     Command('diagnose', arguments.add_diagnose, 'lumpbeam_ros.cli.diagnose:run'),
     Command('compare', arguments.add_compare, 'lumpbeam_ros.cli.compare:run'),
     Command('record', arguments.add_record, 'lumpbeam_ros.cli.record:run'),
+    Command('repair', arguments.add_repair, 'lumpbeam_ros.cli.repair:run'),
     Command('play', arguments.add_play, 'lumpbeam_ros.cli.play:run'),
     Command('bench', arguments.add_bench, 'lumpbeam_ros.cli.bench:run'),
     Command('demo', arguments.add_demo, 'lumpbeam_ros.cli.demo:run'),

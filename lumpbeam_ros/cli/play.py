@@ -56,6 +56,9 @@ def run(args: argparse.Namespace) -> int:
         rclpy.try_shutdown()
         for sig, handler in previous.items():
             signal.signal(sig, handler)
+    from lumpbeam_ros.nodes.counts import write_counts
+
+    write_counts('player', {**stats.published, '/clock': stats.clock_published})
     total = sum(stats.published.values())
     print(
         f'played {args.bag} ({passes} pass{"es" if passes > 1 else ""}): {total} messages in '

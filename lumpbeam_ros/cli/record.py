@@ -50,6 +50,8 @@ def run(args: argparse.Namespace) -> int:
             if deadline is not None and time.monotonic() >= deadline:
                 break
             executor.spin_once(timeout_sec=0.05)
+        if node.error is None and stop['signal'] is not None:
+            _drain(executor, node)
         if node.error is not None:
             raise node.error
     finally:
@@ -66,3 +68,26 @@ def run(args: argparse.Namespace) -> int:
     for topic in node.missing():
         print(f'warning: {topic} never appeared')
     return 0
+
+
+#: After Ctrl-C the recorder keeps taking messages until none came for this long, s ...
+DRAIN_QUIET_S = 0.2
+#: ... but no longer than this, s.
+DRAIN_MAX_S = 2.0
+
+
+def _drain(executor: Any, node: Any) -> None:
+    """Writes the messages already on their way: queued, or sent and not yet delivered.
+
+    Without it the last messages a publisher sent just before the stop would be lost.
+    """
+    deadline = time.monotonic() + DRAIN_MAX_S
+    seen = sum(node.received.values())
+    quiet_since = time.monotonic()
+    while node.error is None and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.02)
+        now_seen = sum(node.received.values())
+        if now_seen != seen:
+            seen, quiet_since = now_seen, time.monotonic()
+        elif time.monotonic() - quiet_since >= DRAIN_QUIET_S:
+            return

@@ -49,13 +49,14 @@ from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import QoSProfile, qos_profile_sensor_data
 from sensor_msgs.msg import CameraInfo as CameraInfoMsg
 from sensor_msgs.msg import Image
 
 from lumpbeam_ros.bagio import BagReader
 from lumpbeam_ros.bagio.convert import NS_PER_S, pitch_to_quaternion
 from lumpbeam_ros.errors import BagError, LumpbeamError
+from lumpbeam_ros.nodes.counts import write_counts
+from lumpbeam_ros.nodes.msgtypes import topic_qos
 from lumpbeam_ros.nodes.parameters import declare_parameters
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
 from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
@@ -73,8 +74,11 @@ from lumpbeam_ros.vision.sources import (
 )
 from lumpbeam_ros.vision.tracker import TrackResult
 
-#: ``/tip_pose`` keeps a few poses for a slow reliable subscriber; a pose is small.
-POSE_QOS = QoSProfile(depth=100)
+#: ``/tip_pose``: reliable, a history of more than a second of poses
+#: (:mod:`lumpbeam_ros.bagio.qos`).
+POSE_QOS = topic_qos('/tip_pose', 'geometry_msgs/msg/PoseStamped')
+#: Images and camera info: the sensor-data profile (best effort, keep last 5).
+IMAGE_QOS = topic_qos('/camera/image_raw', 'sensor_msgs/msg/Image')
 
 # PoseWithCovariance is row-major 6 x 6 over (x, y, z, rot x, rot y, rot z); the tracker
 # measures x, z and the rotation about y (the pitch).
@@ -127,20 +131,24 @@ class CameraNode(Node):
         self.covariance_publisher = self.create_publisher(
             PoseWithCovarianceStamped, '/tip_pose_covariance', POSE_QOS
         )
-        self.diagnostics_publisher = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self.diagnostics_publisher = self.create_publisher(
+            DiagnosticArray,
+            '/diagnostics',
+            topic_qos('/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray'),
+        )
         self.bag_path = str(self._param('bag_path'))
         self.footage_path = str(self._param('footage_path'))
         self.video_device = str(self._param('video_device'))
         if not self.in_process:
             # Raw: the bytes go to the same decoder as a bag's, without rclpy's copy.
             self.create_subscription(
-                Image, '/camera/image_raw', self.on_image, qos_profile_sensor_data, raw=True
+                Image, '/camera/image_raw', self.on_image, IMAGE_QOS, raw=True
             )
             self.create_subscription(
                 CameraInfoMsg,
                 '/camera/camera_info',
                 self.on_camera_info,
-                qos_profile_sensor_data,
+                IMAGE_QOS,
                 raw=True,
             )
         period = float(self._param('diagnostics_period_s'))
@@ -366,6 +374,12 @@ def main(args: Sequence[str] | None = None) -> int:
         pass
     finally:
         if node is not None:
+            stats = node.session.stats
+            write_counts(
+                'camera_node',
+                {'/tip_pose': stats.poses_out, '/tip_pose_covariance': stats.poses_out},
+                {'/camera/image_raw': stats.frames_in},
+            )
             node.destroy_node()
         if rclpy.ok():
             rclpy.shutdown()

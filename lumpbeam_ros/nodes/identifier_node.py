@@ -33,7 +33,6 @@ from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio.convert import pose_values
@@ -44,11 +43,16 @@ from lumpbeam_ros.ident.result import Identification, Status
 from lumpbeam_ros.ident.samples import SampleCounts
 from lumpbeam_ros.ident.window import SlidingWindow
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
+from lumpbeam_ros.nodes.counts import write_counts
+from lumpbeam_ros.nodes.msgtypes import topic_qos
 from lumpbeam_ros.nodes.parameters import declare_parameters
 from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA
 
 STATUS_NAME = 'lumpbeam/identifier'
 BASE_FRAME = 'beam_base'
+_POSE_TYPE = 'geometry_msgs/msg/PoseStamped'
+_LOAD_TYPE = 'std_msgs/msg/Float64'
+_PARAMS_TYPE = 'diagnostic_msgs/msg/DiagnosticArray'
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0
 
@@ -85,14 +89,15 @@ class IdentifierNode(Node):
         self._resets = 0
         self.wrong_frame = 0
         self.updates = 0
-        self._output = self.create_publisher(DiagnosticArray, '/beam_params', 10)
-        self.create_subscription(PoseStamped, '/tip_pose', self._on_pose, 200)
-        latched = QoSProfile(
-            depth=1,
-            reliability=ReliabilityPolicy.RELIABLE,
-            durability=DurabilityPolicy.TRANSIENT_LOCAL,
+        self._output = self.create_publisher(
+            DiagnosticArray, '/beam_params', topic_qos('/beam_params', _PARAMS_TYPE)
         )
-        self.create_subscription(Float64, '/tip_load', self._on_load, latched)
+        self.create_subscription(
+            PoseStamped, '/tip_pose', self._on_pose, topic_qos('/tip_pose', _POSE_TYPE)
+        )
+        self.create_subscription(
+            Float64, '/tip_load', self._on_load, topic_qos('/tip_load', _LOAD_TYPE)
+        )
         self.create_timer(1.0 / self.config.publish_rate_hz, self._on_timer)
 
     def _on_pose(self, msg: PoseStamped) -> None:
@@ -201,6 +206,7 @@ def main(args: list[str] | None = None) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
+        write_counts(IDENTIFIER_SCHEMA.node, {'/beam_params': node.updates})
         node.destroy_node()
         rclpy.try_shutdown()
     return 0

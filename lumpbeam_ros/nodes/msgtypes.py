@@ -26,7 +26,7 @@ from rosbags.interfaces import (
     QosTime,
 )
 
-from lumpbeam_ros.bagio.qos import INFINITE
+from lumpbeam_ros.bagio.qos import INFINITE, SENSOR_DEPTH, STREAM_DEPTH, default_profile
 from lumpbeam_ros.errors import BagError
 
 _MAX_SEC = 2**31 - 1
@@ -75,15 +75,30 @@ def from_bag_qos(qos: Qos) -> QoSProfile:
     subscribers match; the other policies keep rclpy's defaults.
     """
     keep_all = qos.history == QosHistory.KEEP_ALL
+    best_effort = qos.reliability == QosReliability.BEST_EFFORT
     return QoSProfile(
         history=HistoryPolicy.KEEP_ALL if keep_all else HistoryPolicy.KEEP_LAST,
         # Graph discovery reports history UNKNOWN and depth 0 for remote publishers.
-        depth=int(qos.depth) if qos.depth > 0 else 10,
-        reliability=ReliabilityPolicy.BEST_EFFORT
-        if qos.reliability == QosReliability.BEST_EFFORT
-        else ReliabilityPolicy.RELIABLE,
+        depth=int(qos.depth) if qos.depth > 0 else SENSOR_DEPTH if best_effort else STREAM_DEPTH,
+        reliability=ReliabilityPolicy.BEST_EFFORT if best_effort else ReliabilityPolicy.RELIABLE,
         durability=DurabilityPolicy.TRANSIENT_LOCAL
         if qos.durability == QosDurability.TRANSIENT_LOCAL
         else DurabilityPolicy.VOLATILE,
         liveliness=LivelinessPolicy.AUTOMATIC,
     )
+
+
+def topic_qos(topic: str, msgtype: str) -> QoSProfile:
+    """The project's profile of a topic (:func:`~lumpbeam_ros.bagio.qos.default_profile`).
+
+    Every node's publishers and subscriptions take their profile from here, so both ends of
+    a topic always agree.
+
+    Args:
+        topic: Topic name, e.g. ``'/tip_pose'``.
+        msgtype: Its type, e.g. ``'geometry_msgs/msg/PoseStamped'``.
+
+    Returns:
+        The rclpy profile.
+    """
+    return from_bag_qos(default_profile(topic, msgtype))

@@ -1,11 +1,14 @@
 """The player node: a bag back into the live graph, with the original timing and ``/clock``.
 
-Messages are published as their stored CDR bytes (rclpy's ``Publisher.publish(bytes)``
-publishes serialized data), so nothing is deserialized. Message ``i`` is published at wall
-time ``start + (log_time_i - log_time_0) / rate``; ``/clock`` carries the log time before
-each message, so nodes with ``use_sim_time`` follow the bag. Each topic is published with the
-QoS its recorder was offered, or the project's default (:mod:`lumpbeam_ros.bagio.qos`):
-best effort for images, reliable transient-local for ``/tip_load``, reliable otherwise.
+Messages are published in log-time order (the reader merges a file's chunks); a cut file,
+read in file order, can hold one earlier than the last, which is published at once while
+``/clock`` stays monotonic. Messages are published as their stored CDR bytes (rclpy's
+``Publisher.publish(bytes)`` publishes serialized data), so nothing is deserialized.
+Message ``i`` is published at wall time ``start + (log_time_i - log_time_0) / rate``;
+``/clock`` carries the log time before each message, so nodes with ``use_sim_time`` follow
+the bag. Each topic is published with the QoS its recorder was offered, or the project's
+default (:mod:`lumpbeam_ros.bagio.qos`): best effort for images, reliable transient-local
+for ``/tip_load``, reliable otherwise.
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ from rosgraph_msgs.msg import Clock
 from lumpbeam_ros.bagio import BagReader
 from lumpbeam_ros.bagio.qos import default_profile, from_dict
 from lumpbeam_ros.errors import BagError
-from lumpbeam_ros.nodes.msgtypes import from_bag_qos, message_class
+from lumpbeam_ros.nodes.msgtypes import from_bag_qos, message_class, topic_qos
 
 #: Longest wait at the end of playback for reliable subscribers' acknowledgements, s.
 DELIVERY_TIMEOUT_S = 5.0
@@ -38,12 +41,16 @@ class PlayStats:
         published: Messages published per topic.
         lateness_s: Publish time minus scheduled time of every message, s.
         delivered: Whether reliable subscribers acknowledged every message at the end.
+        clock_published: ``/clock`` messages published (one before each message).
+        out_of_order: Messages whose log time was before an earlier one's; they are
+            published at once, and ``/clock`` holds its latest value rather than go back.
     """
 
     published: dict[str, int] = field(default_factory=dict)
     lateness_s: list[float] = field(default_factory=list)
-
     delivered: bool = True
+    clock_published: int = 0
+    out_of_order: int = 0
 
     def lateness_percentile_ms(self, q: float) -> float:
         """Returns a percentile of the lateness, ms (0 when nothing was published)."""
@@ -81,7 +88,9 @@ class Player(Node):
             entry = reader.require(name)
             cls = message_class(entry.msgtype)
             self._outlets[name] = self.create_publisher(cls, name, self._qos(name, entry))
-        self._clock = self.create_publisher(Clock, '/clock', 10)
+        self._clock = self.create_publisher(
+            Clock, '/clock', topic_qos('/clock', 'rosgraph_msgs/msg/Clock')
+        )
 
     def play(self, should_stop: Callable[[], bool] = lambda: False) -> PlayStats:
         """Plays the bag once, sleeping between messages to keep their relative timing.
@@ -95,6 +104,7 @@ class Player(Node):
         stats = PlayStats({name: 0 for name in self._outlets})
         start_wall = None
         first_ns = 0
+        clock_ns = 0
         clock = Clock()
         for raw in self.reader.iter_raw(self._outlets):
             if should_stop():
@@ -105,8 +115,12 @@ class Player(Node):
             delay = due - time.perf_counter()
             if delay > 0.0:
                 time.sleep(delay)
-            clock.clock.sec, clock.clock.nanosec = divmod(raw.log_time_ns, 1_000_000_000)
+            if raw.log_time_ns < clock_ns:
+                stats.out_of_order += 1  # a cut file is read in file order: never turn back
+            clock_ns = max(clock_ns, raw.log_time_ns)
+            clock.clock.sec, clock.clock.nanosec = divmod(clock_ns, 1_000_000_000)
             self._clock.publish(clock)
+            stats.clock_published += 1
             self._outlets[raw.topic].publish(bytes(raw.data))
             stats.lateness_s.append(time.perf_counter() - due)
             stats.published[raw.topic] += 1

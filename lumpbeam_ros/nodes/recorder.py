@@ -6,7 +6,8 @@ deserialized. Each topic's offered QoS (from ``get_publishers_info_by_topic``) g
 bag's metadata; the subscription matches it (best effort if any publisher is, transient local
 only if every publisher is, so a latched ``/tip_load`` is received on joining). The bag is
 flushed at least every ``flush_period_s`` (see :class:`~lumpbeam_ros.bagio.BagWriter`), so a
-killed recorder loses at most that much.
+killed recorder loses at most that much. A message's log time is the time it was received
+(wall clock, kept monotonic), so the bag is in log-time order.
 """
 
 from __future__ import annotations
@@ -19,11 +20,14 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from lumpbeam_ros.bagio import BagWriter
+from lumpbeam_ros.bagio.qos import STREAM_DEPTH
 from lumpbeam_ros.bagio.typestore import is_known
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.nodes.msgtypes import message_class, to_bag_qos
 
-#: Subscription depth: a 180 Hz camera must not overflow it between two executor turns.
+#: Subscription depth of a best-effort topic (images): a 180 fps camera must not overflow it
+#: between two executor turns. Reliable topics take the project's stream depth
+#: (:data:`~lumpbeam_ros.bagio.qos.STREAM_DEPTH`, more than a second of 180 Hz poses).
 DEPTH = 200
 
 
@@ -53,6 +57,7 @@ class Recorder(Node):
         self.error: LumpbeamError | None = None
         self._skipped: set[str] = set()
         self._taps: dict[str, object] = {}
+        self._last_log_ns = 0
         self.create_timer(discovery_period_s, self.discover)
         self.create_timer(flush_period_s, self._flush)
         self.discover()
@@ -95,7 +100,7 @@ class Recorder(Node):
         )
         qos = QoSProfile(
             history=HistoryPolicy.KEEP_LAST,
-            depth=DEPTH,
+            depth=DEPTH if best_effort else STREAM_DEPTH,
             reliability=ReliabilityPolicy.BEST_EFFORT
             if best_effort
             else ReliabilityPolicy.RELIABLE,
@@ -107,8 +112,11 @@ class Recorder(Node):
         def write(data: bytes, topic: str = topic) -> None:
             if self.error is not None:
                 return
+            # Log time is the receive time, never earlier than the previous message's: a
+            # wall clock stepped back (NTP) must not put the bag out of log-time order.
+            self._last_log_ns = max(time.time_ns(), self._last_log_ns)
             try:
-                self.bag.write_raw(topic, time.time_ns(), data)
+                self.bag.write_raw(topic, self._last_log_ns, data)
             except LumpbeamError as exc:
                 self.error = exc  # the caller stops spinning and reports it
                 return

@@ -38,13 +38,14 @@ from std_msgs.msg import Float64
 from visualization_msgs.msg import MarkerArray
 
 from lumpbeam_ros.bagio.convert import NS_PER_S, pitch_to_quaternion, seconds_to_ns
-from lumpbeam_ros.bagio.qos import default_profile
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.adopt import adopt_identified
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
+from lumpbeam_ros.model.statics import static_tip_deflection
 from lumpbeam_ros.model.stream import PredictionStream
 from lumpbeam_ros.model.trajectory import TipTrajectory
-from lumpbeam_ros.nodes.msgtypes import from_bag_qos
+from lumpbeam_ros.nodes.counts import write_counts
+from lumpbeam_ros.nodes.msgtypes import topic_qos
 from lumpbeam_ros.nodes.parameters import declare_parameters
 from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA
 from lumpbeam_ros.vision.config import load_camera_config
@@ -64,8 +65,6 @@ IDENTIFIER_STATUS = 'lumpbeam/identifier'
 OK_LEVEL = 0
 #: A throttled warning repeats at most this often, s.
 WARN_PERIOD_S = 5.0
-#: Publisher depth: a late tick publishes several periods' samples in one burst.
-PREDICTION_DEPTH = 100
 #: /beam_markers shows a measured tip only this close in time to the model's, s.
 MEASURED_MAX_AGE_S = 0.5
 
@@ -123,15 +122,37 @@ class SimulatorNode(Node):
         self._latest: TipTrajectory | None = None  # the last samples published
         self._measured: tuple[float, TipPoint] | None = None  # stamp, tip of /tip_pose
         self._markers_stamp = -math.inf
+        #: Poses published on ``/tip_pose_predicted``, marker arrays on ``/beam_markers``.
+        self.published = 0
+        self.markers_published = 0
 
-        load_qos = from_bag_qos(default_profile('/tip_load', 'std_msgs/msg/Float64'))
+        # A late tick publishes several periods' samples in one burst: the stream profile's
+        # history holds them (lumpbeam_ros.bagio.qos).
         self._pose_out = self.create_publisher(
-            PoseStamped, '/tip_pose_predicted', PREDICTION_DEPTH
+            PoseStamped,
+            '/tip_pose_predicted',
+            topic_qos('/tip_pose_predicted', 'geometry_msgs/msg/PoseStamped'),
         )
-        self.create_subscription(Float64, '/tip_load', self._on_load, load_qos)
-        self.create_subscription(DiagnosticArray, '/beam_params', self._on_beam_params, 10)
-        self._markers_out = self.create_publisher(MarkerArray, MARKERS_TOPIC, 10)
-        self.create_subscription(PoseStamped, '/tip_pose', self._on_measured, PREDICTION_DEPTH)
+        self.create_subscription(
+            Float64, '/tip_load', self._on_load, topic_qos('/tip_load', 'std_msgs/msg/Float64')
+        )
+        self.create_subscription(
+            DiagnosticArray,
+            '/beam_params',
+            self._on_beam_params,
+            topic_qos('/beam_params', 'diagnostic_msgs/msg/DiagnosticArray'),
+        )
+        self._markers_out = self.create_publisher(
+            MarkerArray,
+            MARKERS_TOPIC,
+            topic_qos(MARKERS_TOPIC, 'visualization_msgs/msg/MarkerArray'),
+        )
+        self.create_subscription(
+            PoseStamped,
+            '/tip_pose',
+            self._on_measured,
+            topic_qos('/tip_pose', 'geometry_msgs/msg/PoseStamped'),
+        )
         # A steady timer: under use_sim_time the node must notice a stalled or jumping /clock,
         # which a timer on that clock would not fire to see.
         self._steady = Clock(clock_type=ClockType.STEADY_TIME)
@@ -186,6 +207,13 @@ class SimulatorNode(Node):
                 f'ignoring /tip_load of {kg!r} kg: not a mass', throttle_duration_sec=WARN_PERIOD_S
             )
             return
+        if not _carries(self.beam, kg):
+            self.get_logger().warning(
+                f'ignoring /tip_load of {kg:g} kg: the beam has no static equilibrium under it '
+                f'(cannot carry it); keeping {self._load_kg:g} kg',
+                throttle_duration_sec=WARN_PERIOD_S,
+            )
+            return
         first = not self._load_seen
         self._load_seen = True
         changed = kg != self._load_kg
@@ -227,6 +255,7 @@ class SimulatorNode(Node):
         )
         lifetime = lifetime_for_rate(self._settings['markers_rate_hz'])
         self._markers_out.publish(scene_cdr(scene, seconds_to_ns(stamp), lifetime))
+        self.markers_published += 1
         self._markers_stamp = stamp
 
     def _on_beam_params(self, msg: DiagnosticArray) -> None:
@@ -334,6 +363,16 @@ class SimulatorNode(Node):
             q = msg.pose.orientation
             q.x, q.y, q.z, q.w = pitch_to_quaternion(float(samples.pitch[i]))
             self._pose_out.publish(msg)
+            self.published += 1
+
+
+def _carries(beam: BeamParameters, load_kg: float) -> bool:
+    """Whether the beam has a static equilibrium under ``load_kg`` at its tip."""
+    try:
+        static_tip_deflection(beam, load_kg)
+    except (RuntimeError, ValueError, ArithmeticError):
+        return False
+    return True
 
 
 def _level(status: DiagnosticStatus) -> int:
@@ -362,6 +401,10 @@ def main(args: Sequence[str] | None = None) -> int:
         pass
     finally:
         if node is not None:
+            write_counts(
+                SIMULATOR_SCHEMA.node,
+                {'/tip_pose_predicted': node.published, MARKERS_TOPIC: node.markers_published},
+            )
             node.destroy_node()
         rclpy.try_shutdown()
     return 0

@@ -116,25 +116,36 @@ def normalize_recording(recorded: str | Path, out: str | Path) -> Path:
     clock_log, clock_value = read_clock(recorded)
     loads = read_load_events(recorded)
     load_t = clock_time(loads.t, clock_log, clock_value)
+    # (sim time ns, topic, message), merged into log-time order before writing: each topic
+    # comes in its own order, and a bag's messages are in log-time order.
+    rows: list[tuple[int, str, object]] = []
+    types = {topic: 'geometry_msgs/msg/PoseStamped' for topic in POSE_TOPICS}
+    types['/beam_params'] = 'diagnostic_msgs/msg/DiagnosticArray'
+    for topic, msgtype in types.items():
+        if topic in reader.topics:
+            rows += [
+                (convert.time_ns(msg.header.stamp), topic, msg)
+                for _, msg in reader.messages(topic, msgtype)
+            ]
+    rows += [
+        (convert.seconds_to_ns(float(t)), '/tip_load', convert.float64(float(kg)))
+        for t, kg in zip(load_t, loads.kg, strict=True)
+        if np.isfinite(t)
+    ]
+    if MARKERS_TOPIC in reader.topics:
+        # The simulator node stamps every marker of an array alike.
+        rows += [
+            (convert.time_ns(msg.markers[0].header.stamp), MARKERS_TOPIC, msg)
+            for _, msg in reader.messages(MARKERS_TOPIC, MARKER_ARRAY_TYPE)
+            if msg.markers
+        ]
     with BagWriter(out) as bag:
         for topic in POSE_TOPICS:
             if topic in reader.topics:
-                bag.add_topic(topic, 'geometry_msgs/msg/PoseStamped')
-                for _, msg in reader.messages(topic, 'geometry_msgs/msg/PoseStamped'):
-                    bag.write_message(topic, msg, convert.time_ns(msg.header.stamp))
+                bag.add_topic(topic, types[topic])
         bag.add_topic('/tip_load', 'std_msgs/msg/Float64')
-        for t, kg in zip(load_t, loads.kg, strict=True):
-            if np.isfinite(t):
-                bag.write_float('/tip_load', float(t), float(kg))
-        if '/beam_params' in reader.topics:
-            for _, msg in reader.messages('/beam_params', 'diagnostic_msgs/msg/DiagnosticArray'):
-                bag.write_message('/beam_params', msg, convert.time_ns(msg.header.stamp))
-        if MARKERS_TOPIC in reader.topics:
-            for _, msg in reader.messages(MARKERS_TOPIC, MARKER_ARRAY_TYPE):
-                if msg.markers:  # all stamped alike by the simulator node
-                    bag.write_message(
-                        MARKERS_TOPIC, msg, convert.time_ns(msg.markers[0].header.stamp)
-                    )
+        for ns, topic, msg in sorted(rows, key=lambda row: row[0]):
+            bag.write_message(topic, msg, ns)
     return Path(out)
 
 

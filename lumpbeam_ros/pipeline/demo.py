@@ -6,13 +6,16 @@
    (``lumpbeam play``, with ``/clock``), the simulator node (``use_sim_time``), the identifier
    node and the camera node when they are installed (the camera only for a bag with images;
    it then makes ``/tip_pose`` from the images instead of the player), and the recorder
-   (``lumpbeam record``), stopped with SIGINT once the replay is over.
-3. ``normalize``: the recording with every message logged at its sim time.
-4. ``analyze``: offline identification of the recorded ``/tip_pose`` and ``/tip_load``, and
+   (``lumpbeam record``), stopped with SIGINT once the replay is over and the nodes have
+   worked through their queues.
+3. ``count``: per topic, the messages published (the player's and the nodes' own counters)
+   against those recorded, and the camera frames offered against those tracked.
+4. ``normalize``: the recording with every message logged at its sim time.
+5. ``analyze``: offline identification of the recorded ``/tip_pose`` and ``/tip_load``, and
    the prediction residual.
-5. ``diagnose`` (when ``lumpbeam diagnose`` is installed): the model-discrepancy workflow on
+6. ``diagnose`` (when ``lumpbeam diagnose`` is installed): the model-discrepancy workflow on
    the recording.
-6. ``figures`` and ``summary``: measured against predicted (Figs. B.8-B.10), the table.
+7. ``figures`` and ``summary``: measured against predicted (Figs. B.8-B.10), the table.
 
 Each step is a function of the :class:`DemoRun` it fills in; :func:`default_steps` lists them,
 so a step can be added or swapped without touching the others.
@@ -34,6 +37,7 @@ from lumpbeam_ros.bagio import BagReader, read_tip_poses
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.adopt import first_mode
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, load_beam_config
+from lumpbeam_ros.nodes.counts import COUNTS_DIR_ENV, read_counts
 from lumpbeam_ros.pipeline.analysis import (
     RecordingAnalysis,
     analyze_recording,
@@ -45,6 +49,7 @@ from lumpbeam_ros.pipeline.graph import (
     node_command,
     python_command,
     wait_for_graph,
+    wait_for_quiet,
 )
 from lumpbeam_ros.viz.markers import MARKERS_TOPIC
 
@@ -63,6 +68,21 @@ RECORDED_TOPICS = {
     '/beam_params': 'diagnostic_msgs/msg/DiagnosticArray',
     '/clock': 'rosgraph_msgs/msg/Clock',
     '/beam_markers': 'visualization_msgs/msg/MarkerArray',
+}
+#: Who publishes each recorded topic, by the name of its counts file
+#: (:mod:`lumpbeam_ros.nodes.counts`); ``/tip_pose`` comes from the camera node when it runs.
+PUBLISHERS = {
+    '/tip_pose': 'player',
+    '/tip_load': 'player',
+    '/tip_pose_predicted': 'simulator_node',
+    '/beam_markers': 'simulator_node',
+    '/beam_params': 'identifier_node',
+    '/clock': 'player',
+}
+#: The topics the nodes are still producing when the player is done.
+TRAILING_TOPICS = {
+    '/tip_pose': 'geometry_msgs/msg/PoseStamped',
+    '/tip_pose_predicted': 'geometry_msgs/msg/PoseStamped',
 }
 #: The player waits this long before its first message: its publishers must be discovered
 #: by the recorder's subscriptions first (a new process takes 1-3 s on a busy machine).
@@ -130,6 +150,9 @@ class DemoRun:
         normalized_bag: The recording in sim time.
         with_camera: Whether the camera node made ``/tip_pose`` from images.
         nodes: The node modules that ran in the graph.
+        topic_counts: Per recorded topic: its publisher, messages published and recorded.
+        image_counts: Camera frames offered by the player, received and tracked by the camera
+            node (empty without the camera).
         analysis: The offline analysis.
         diagnosis: ``lumpbeam diagnose``'s JSON result, when it ran.
         figures: Written figures.
@@ -146,6 +169,8 @@ class DemoRun:
     normalized_bag: Path = Path()
     with_camera: bool = False
     nodes: list[str] = field(default_factory=list)
+    topic_counts: dict[str, dict[str, Any]] = field(default_factory=dict)
+    image_counts: dict[str, int | None] = field(default_factory=dict)
     analysis: RecordingAnalysis | None = None
     diagnosis: dict[str, Any] | None = None
     camera_rms_m: float | None = None
@@ -162,6 +187,11 @@ class DemoRun:
     def log_dir(self) -> Path:
         """Where the child processes' logs go."""
         return self.options.out / 'logs'
+
+    @property
+    def counts_dir(self) -> Path:
+        """Where the nodes leave their message counts."""
+        return self.log_dir / 'counts'
 
 
 Step = tuple[str, Callable[[DemoRun], None]]
@@ -216,7 +246,9 @@ def replay(run: DemoRun) -> None:
     readers['/tip_load'] += 1
     readers['/clock'] += 1
     readers['/beam_params'] += 1
+    shutil.rmtree(run.counts_dir, ignore_errors=True)
     with ProcessGraph(run.log_dir, run.options.domain_id) as graph:
+        graph.env[COUNTS_DIR_ENV] = str(run.counts_dir)
         run.echo(f'  ROS_DOMAIN_ID={graph.domain_id}, logs in {run.log_dir}')
         graph.start('simulator', node_command(SIMULATOR_MODULE, *simulator_args))
         run.nodes = [SIMULATOR_MODULE]
@@ -257,8 +289,12 @@ def replay(run: DemoRun) -> None:
         )
         others = [name for name in graph.children if name != 'player']
         graph.wait('player', run.options.duration_s * 2 + 30.0, watch=others)
-        time.sleep(0.5)  # the last messages travel to the recorder before it stops
-        graph.interrupt('recorder')  # must stop cleanly: it closes the bag
+        # The camera node may be a few frames behind: let the nodes finish their queues, then
+        # stop them before the recorder, which takes in what they sent last.
+        trailing = dict(TRAILING_TOPICS)
+        if not run.with_camera:
+            del trailing['/tip_pose']  # the player's, and it is done
+        wait_for_quiet(graph, trailing, timeout_s=run.options.ready_timeout_s)
         for name in others:
             if name != 'recorder':
                 try:
@@ -266,7 +302,57 @@ def replay(run: DemoRun) -> None:
                 except LumpbeamError as exc:
                     # The recording is complete; a node's untidy exit only deserves a note.
                     run.echo(f'  warning: {exc}')
+        graph.interrupt('recorder')  # must stop cleanly: it closes the bag
     run.echo(f'  recorded {run.recorded_bag} with {", ".join(run.nodes)}')
+
+
+def count(run: DemoRun) -> None:
+    """Sets what was published against what was recorded, per topic, and prints it."""
+    counts = read_counts(run.counts_dir)
+    recorded = {name: entry.count for name, entry in BagReader(run.recorded_bag).topics.items()}
+    publishers = dict(PUBLISHERS)
+    if run.with_camera:
+        publishers['/tip_pose'] = 'camera_node'
+    run.topic_counts = {}
+    for topic in RECORDED_TOPICS:
+        publisher = publishers[topic]
+        published = counts.get(publisher, {}).get('published', {}).get(topic)
+        run.topic_counts[topic] = {
+            'publisher': publisher,
+            'published': published,
+            'recorded': recorded.get(topic, 0),
+        }
+    if run.with_camera:
+        camera = counts.get('camera_node', {})
+        run.image_counts = {
+            'offered': counts.get('player', {}).get('published', {}).get(IMAGE_TOPIC),
+            'received': camera.get('received', {}).get(IMAGE_TOPIC),
+            'tracked': camera.get('published', {}).get('/tip_pose'),
+        }
+    for line in count_lines(run.topic_counts, run.image_counts):
+        run.echo(line)
+
+
+def count_lines(
+    topic_counts: Mapping[str, Mapping[str, Any]], image_counts: Mapping[str, int | None]
+) -> list[str]:
+    """The table of :func:`count`: published, recorded and lost per topic."""
+    lines = [f'  {"topic":<22}{"publisher":<16}{"published":>10}{"recorded":>10}{"lost":>6}']
+    for topic, row in topic_counts.items():
+        published = row['published']
+        lost = '-' if published is None else str(published - row['recorded'])
+        shown = '-' if published is None else str(published)
+        lines.append(
+            f'  {topic:<22}{row["publisher"]:<16}{shown:>10}{row["recorded"]:>10}{lost:>6}'
+        )
+    if image_counts:
+        shown = {k: '-' if v is None else str(v) for k, v in image_counts.items()}
+        lines.append(
+            f'  {IMAGE_TOPIC}: {shown["offered"]} frames offered by the player, '
+            f'{shown["received"]} received by the camera node (best effort), '
+            f'{shown["tracked"]} tracked'
+        )
+    return lines
 
 
 def normalize(run: DemoRun) -> None:
@@ -398,6 +484,8 @@ def summarize(run: DemoRun) -> None:
         'measured_samples': int(analysis.measured.t.size),
         'predicted_samples': int(analysis.predicted.t.size),
         'nodes': list(run.nodes),
+        'topic_counts': run.topic_counts,
+        'image_counts': run.image_counts,
         'with_camera': run.with_camera,
         'camera_rms_m': run.camera_rms_m,
         'figures': [str(p) for p in run.figures],
@@ -469,6 +557,7 @@ def default_steps() -> list[Step]:
     steps: list[Step] = [
         ('synthesize', synthesize),
         ('replay', replay),
+        ('count', count),
         ('normalize', normalize),
         ('analyze', analyze),
     ]

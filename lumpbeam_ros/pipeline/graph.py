@@ -29,6 +29,8 @@ from lumpbeam_ros.resources import large_frames_profile
 DOMAIN_IDS = range(1, 102)
 #: How long an interrupted child may take to stop before it is killed, s.
 STOP_GRACE_S = 10.0
+#: Longest a probe waits to discover a publisher before taking it as gone, s.
+DISCOVERY_ALLOWANCE_S = 10.0
 #: Lines of a failed child's log quoted in the error.
 LOG_TAIL_LINES = 5
 
@@ -298,3 +300,72 @@ def wait_for_graph(
         probe.destroy_node()
     finally:
         rclpy.try_shutdown(context=context)
+
+
+def wait_for_quiet(
+    graph: ProcessGraph,
+    topics: Mapping[str, str],
+    quiet_s: float = 1.0,
+    timeout_s: float = 30.0,
+) -> dict[str, int]:
+    """Waits until no message has arrived on any of ``topics`` for ``quiet_s``.
+
+    After the input of a graph has ended, its nodes may still be working through their
+    queues (a camera node a few frames behind on a busy core); stopping the recorder before
+    they are done would cut their last messages off. A probe node subscribes to the topics
+    (with the project's QoS) and listens until they fall silent; the silence is counted from
+    the moment it has discovered a publisher on every topic (or after
+    :data:`DISCOVERY_ALLOWANCE_S`, when one has gone).
+
+    Args:
+        graph: The graph (its domain).
+        topics: Topic names and their types (``'pkg/msg/Name'``), each with a publisher.
+        quiet_s: Silence that counts as done, s.
+        timeout_s: Longest wait, s; the graph is taken as done then too.
+
+    Returns:
+        Messages the probe heard per topic while waiting.
+    """
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+
+    from lumpbeam_ros.nodes.msgtypes import message_class, topic_qos
+
+    heard = dict.fromkeys(topics, 0)
+    last = {'at': time.monotonic()}
+
+    def on_message(_data: bytes, topic: str) -> None:
+        heard[topic] += 1
+        last['at'] = time.monotonic()
+
+    context = Context()
+    rclpy.init(context=context, domain_id=graph.domain_id)
+    try:
+        probe = Node('lumpbeam_demo_quiet_probe', context=context)
+        for topic, msgtype in topics.items():
+            probe.create_subscription(
+                message_class(msgtype),
+                topic,
+                lambda data, topic=topic: on_message(data, topic),
+                topic_qos(topic, msgtype),
+                raw=True,
+            )
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(probe)
+        started = time.monotonic()
+        deadline = started + timeout_s
+        discovered = False
+        while time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+            if not discovered:
+                discovered = all(probe.count_publishers(t) > 0 for t in topics)
+                discovered |= time.monotonic() - started > DISCOVERY_ALLOWANCE_S
+                last['at'] = time.monotonic()
+            elif time.monotonic() - last['at'] >= quiet_s:
+                break
+        probe.destroy_node()
+    finally:
+        rclpy.try_shutdown(context=context)
+    return heard

@@ -106,3 +106,28 @@ def test_reindex_rebuilds_lost_metadata(drop):
     np.testing.assert_array_equal(read_load_events(rebuilt).changes().kg, [4.5, 0.0])
     with pytest.raises(BagError, match='exactly one .mcap'):
         reindex(drop.parent)
+
+
+@pytest.mark.parametrize('fast', [True, False])
+def test_messages_lost_to_damaged_bytes_are_named_with_their_count(drop, caplog, fast):
+    # 4 KB of random bytes in the middle of the data file: the readers skip what those
+    # chunks held; the bag's own counts (metadata.yaml) tell how much that was.
+    data_file = next(drop.glob('*.mcap'))
+    data = bytearray(data_file.read_bytes())
+    middle = len(data) // 2
+    data[middle : middle + 4096] = np.random.default_rng(1).bytes(4096)
+    data_file.write_bytes(bytes(data))
+    listed = BagReader(drop).topics['/tip_pose'].count
+    with caplog.at_level(logging.WARNING):
+        poses = read_tip_poses(drop, fast=fast)
+    lost = listed - len(poses.t)
+    assert 0 < lost < listed
+    assert f'/tip_pose: read {len(poses.t)} of the {listed} messages' in caplog.text
+    assert f'{lost} lost' in caplog.text
+
+
+def test_an_intact_bag_reads_without_a_loss_warning(drop, caplog):
+    with caplog.at_level(logging.WARNING):
+        assert len(read_tip_poses(drop).t) == BagReader(drop).topics['/tip_pose'].count
+        assert len(list(BagReader(drop).iter_raw())) == BagReader(drop).info.message_count
+    assert 'lost' not in caplog.text

@@ -99,3 +99,31 @@ def test_a_full_disk_keeps_what_was_flushed(tmp_path):
     assert reader.truncated and reader.topics['/tip_pose'].count == 20
     # Chunks close every ~1 MiB or flush, so the 20 flushed poses and maybe a few more survive.
     np.testing.assert_array_equal(poses.t[:20], np.arange(20.0))
+
+
+def test_messages_go_to_the_file_in_log_time_order(tmp_path, mcap_doctor):
+    # Written out of order within one flush period: the file holds them sorted, ties in
+    # the order written.
+    with BagWriter(tmp_path / 'b', flush_period_s=60.0) as bag:
+        for t, topic in [(3.0, '/a'), (1.0, '/b'), (2.0, '/a'), (1.0, '/a')]:
+            bag.write_float(topic, t, t)
+    from mcap.reader import make_reader
+
+    with next((tmp_path / 'b').glob('*.mcap')).open('rb') as stream:
+        got = [
+            (m.log_time, c.topic)
+            for _, c, m in make_reader(stream).iter_messages(log_time_order=False)
+        ]
+    assert got == [(1_000_000_000, '/b'), (1_000_000_000, '/a'), (2e9, '/a'), (3e9, '/a')]
+    assert mcap_doctor(tmp_path / 'b') == ''
+
+
+def test_a_message_older_than_what_was_flushed_is_kept_with_a_warning(tmp_path, caplog):
+    with BagWriter(tmp_path / 'b') as bag:
+        bag.write_float('/a', 2.0, 0.0)
+        bag.flush()
+        bag.write_float('/a', 2.0, 1.0)  # the same log time is still in order
+        assert 'out of log-time order' not in caplog.text
+        bag.write_float('/a', 1.0, 0.0)
+    assert 'logged at 1000000000 ns comes after one logged at 2000000000 ns' in caplog.text
+    assert BagReader(tmp_path / 'b').topics['/a'].count == 3

@@ -131,3 +131,39 @@ def test_player_waits_for_subscribers_and_for_delivery(ros_graph, short_bag):
     _, stats = _play(ros_graph, short_bag)
     assert stats.delivered
     assert ros_graph.spin_until(lambda: len(poses) == 60, 5.0)
+
+
+def _out_of_order_bag(path):
+    """A bag whose messages were written out of log-time order (rosbags' writer keeps it)."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    from lumpbeam_ros.bagio import convert
+    from lumpbeam_ros.bagio.typestore import serialize, type_description
+
+    msgdef, rihs01 = type_description('geometry_msgs/msg/PoseStamped')
+    with Writer(path, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        connection = writer.add_connection(
+            '/tip_pose', 'geometry_msgs/msg/PoseStamped', msgdef=msgdef, rihs01=rihs01
+        )
+        for i in [5, 1, 4, 2, 3, 0, 9, 7, 8, 6]:
+            ns = convert.seconds_to_ns(T0 + i / 100)
+            pose = convert.pose_stamped(ns, 2.3, -0.001 * i, 0.0, 'beam_base')
+            writer.write(connection, ns, serialize(pose))
+    return path
+
+
+@pytest.mark.parametrize('cut', [False, True])
+def test_a_bag_out_of_order_plays_every_message_with_a_monotonic_clock(ros_graph, tmp_path, cut):
+    bag = _out_of_order_bag(tmp_path / 'shuffled')
+    if cut:  # without its summary the file is read in the order it was written
+        data_file = next(bag.glob('*.mcap'))
+        data_file.write_bytes(data_file.read_bytes()[:-200])
+    poses = ros_graph.collect('/tip_pose', PoseStamped, 100)
+    clock = ros_graph.collect('/clock', Clock, 100)
+    _, stats = _play(ros_graph, bag)
+    assert ros_graph.spin_until(lambda: len(poses) == 10 and len(clock) == 10, 5.0)
+    ticks = [c.clock.sec * 10**9 + c.clock.nanosec for c in clock]
+    assert np.all(np.diff(ticks) >= 0)
+    z = sorted(round(-p.pose.position.z * 1000) for p in poses)
+    assert z == list(range(10))
+    assert (stats.out_of_order > 0) == cut

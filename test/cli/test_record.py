@@ -7,6 +7,8 @@ import numpy as np
 import pytest
 from geometry_msgs.msg import PoseStamped
 from harness import ros_env
+from mcap.reader import make_reader
+from rosbags.highlevel import AnyReader
 from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio import BagReader, read_load_events, read_tip_poses
@@ -37,7 +39,9 @@ def _publish_poses(ros_graph, n, rate_hz=200.0):
         time.sleep(1.0 / rate_hz)
 
 
-def test_sigkill_keeps_everything_before_the_last_flush(ros_graph, tmp_path):
+def test_sigkill_keeps_everything_before_the_last_flush_and_repair_makes_it_whole(
+    ros_graph, tmp_path, mcap_doctor, capsys
+):
     out = tmp_path / 'killed'
     proc = _start_recorder(ros_graph, out, '/tip_pose', '--flush-period', '0.2')
     try:
@@ -52,10 +56,27 @@ def test_sigkill_keeps_everything_before_the_last_flush(ros_graph, tmp_path):
     stamps = poses.t[poses.t >= 100]
     np.testing.assert_array_equal(stamps, 100.0 + np.arange(200))
     np.testing.assert_allclose(poses.z[poses.t >= 100], -0.001 * np.arange(200))
+    # Other readers need the closing summary the killed writer never wrote.
+    with pytest.raises(Exception, match='magic'):
+        with AnyReader([out]) as bag:
+            list(bag.messages())
+    assert main(['repair', str(out)]) == 0
+    repaired = tmp_path / 'killed-repaired'
+    assert f'into {repaired}: {poses.t.size} messages' in capsys.readouterr().out
+    assert not BagReader(repaired).truncated
+    assert BagReader(repaired).topics['/tip_pose'].count == poses.t.size
+    np.testing.assert_array_equal(read_tip_poses(repaired).t, poses.t)
+    with AnyReader([repaired]) as bag:  # rosbags, an independent reader
+        got = [bag.deserialize(raw, c.msgtype) for c, _, raw in bag.messages()]
+    assert [m.header.stamp.sec for m in got if m.header.stamp.sec >= 100] == list(range(100, 300))
+    with next(repaired.glob('*.mcap')).open('rb') as stream:  # the mcap reader, via its summary
+        summary = make_reader(stream).get_summary()
+    assert summary is not None and summary.statistics.message_count == poses.t.size
+    assert mcap_doctor(repaired) == ''
 
 
 @pytest.mark.parametrize('sig', [signal.SIGINT, signal.SIGTERM])
-def test_a_signal_closes_the_bag_cleanly(ros_graph, tmp_path, sig):
+def test_a_signal_closes_the_bag_cleanly(ros_graph, tmp_path, sig, mcap_doctor):
     out = tmp_path / 'clean'
     proc = _start_recorder(ros_graph, out, '/tip_pose', '/tip_load')
     try:
@@ -72,6 +93,7 @@ def test_a_signal_closes_the_bag_cleanly(ros_graph, tmp_path, sig):
     assert not reader.truncated
     assert reader.topics['/tip_pose'].count == read_tip_poses(reader).t.size >= 50
     assert read_load_events(reader).changes().kg[-1] == 0.0
+    assert mcap_doctor(out) == ''
 
 
 @pytest.mark.parametrize(

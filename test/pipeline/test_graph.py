@@ -13,6 +13,7 @@ from lumpbeam_ros.pipeline.graph import (
     pick_domain_id,
     python_command,
     wait_for_graph,
+    wait_for_quiet,
 )
 
 
@@ -132,8 +133,26 @@ def test_wait_for_graph_sees_a_node_child(tmp_path):
             30.0,
             announce={'/tip_load': 'std_msgs/msg/Float64'},
         )
+        # The node is in the graph before its constructor has finished: a SIGINT now would
+        # stop it before it says it is ready.
+        log = tmp_path / 'simulator.log'
+        deadline = time.monotonic() + 30.0
+        while 'simulator ready' not in log.read_text() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        # It keeps publishing on wall time: never quiet, the wait ends at its timeout.
+        heard = wait_for_quiet(
+            graph, {'/tip_pose_predicted': 'geometry_msgs/msg/PoseStamped'}, 0.5, 5.0
+        )
+        assert heard['/tip_pose_predicted'] > 0
         assert graph.interrupt('simulator') == 0
-    assert 'simulator ready' in (tmp_path / 'simulator.log').read_text()
+    assert 'simulator ready' in log.read_text()
+
+
+def test_wait_for_quiet_returns_on_a_topic_without_publisher(tmp_path, monkeypatch):
+    monkeypatch.setattr(graph_module, 'DISCOVERY_ALLOWANCE_S', 0.2)
+    with ProcessGraph(tmp_path, domain_id=pick_domain_id()) as graph:
+        heard = wait_for_quiet(graph, {'/nobody': 'std_msgs/msg/Float64'}, 0.2, 60.0)
+    assert heard == {'/nobody': 0}
 
 
 def test_commands_and_domain_ids():
