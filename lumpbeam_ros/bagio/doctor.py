@@ -58,9 +58,9 @@ from mcap.records import (
 from mcap.stream_reader import get_chunk_data_stream
 
 from lumpbeam_ros.bagio import metadata
+from lumpbeam_ros.bagio.fastscan import MAGIC
 from lumpbeam_ros.errors import BagError
 
-MAGIC = b'\x89MCAP0\r\n'
 #: Profiles of the MCAP registry; ``''`` is a file without one.
 WELL_KNOWN_PROFILES = ('', 'ros1', 'ros2')
 ROS2_SCHEMA_ENCODINGS = ('ros2msg', 'ros2idl')

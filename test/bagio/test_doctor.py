@@ -127,7 +127,7 @@ def test_product_bags_are_clean(
 @pytest.mark.parametrize('compression', list(CompressionType))
 def test_mcap_package_files_in_order_are_clean(tmp_path: Path, compression) -> None:
     file = tmp_path / 'ok.mcap'
-    write_mcap(file, list(range(1000, 1300, 3)), compression=compression)
+    write_mcap(file, list(range(1000, 1300, 3)), compression=compression, enable_data_crcs=True)
     assert examine_file(file) == []
     with file.open('rb') as stream:
         stats = make_reader(stream).get_summary().statistics
@@ -177,6 +177,19 @@ def corrupted_chunk(compression: CompressionType) -> Callable[[Path], None]:
         path.write_bytes(bytes(data))
 
     return build
+
+
+def wrong_data_crc(path: Path) -> None:
+    write_mcap(
+        path,
+        list(range(0, 2000, 10)),
+        compression=CompressionType.NONE,
+        enable_crcs=False,
+        enable_data_crcs=True,
+    )
+    data = bytearray(path.read_bytes())
+    data[len(data) // 3] ^= 0x01  # inside a message's payload (an uncompressed chunk)
+    path.write_bytes(bytes(data))
 
 
 def wrong_statistics(enable_crcs: bool) -> Callable[[Path], None]:
@@ -250,6 +263,7 @@ BROKEN: dict[str, tuple[Callable[[Path], None], list[str]]] = {
     # A compressed chunk either fails to decompress or decompresses to records of another CRC.
     'corrupted chunk (zstd)': (corrupted_chunk(CompressionType.ZSTD), ['Chunk at offset']),
     'corrupted chunk (lz4)': (corrupted_chunk(CompressionType.LZ4), ['Chunk at offset']),
+    'wrong data section crc': (wrong_data_crc, ['DataEnd.data_section_crc']),
     'wrong statistics': (wrong_statistics(False), ['Statistics.message_count 201 != 200']),
     'wrong statistics, summary crc': (
         wrong_statistics(True),
