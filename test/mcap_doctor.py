@@ -12,6 +12,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+
 from lumpbeam_ros.bagio.doctor import examine_bag
 
 

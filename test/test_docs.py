@@ -221,6 +221,7 @@ def test_every_command_and_option_is_listed():
         )
     for name, parser in parsers.items():
         text = section(f'### lumpbeam {name}')
+        assert text.strip(), f'doc/interfaces.md has no "### lumpbeam {name}" section'
         for action in parser._actions:
             for option in action.option_strings:
                 if option in ('-h', '--help'):
