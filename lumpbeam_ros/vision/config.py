@@ -60,6 +60,7 @@ class TrackerSettings:
     max_saturated_fraction: float = 0.2
     calibration_frames: int = 30
     calibration_min_step_m: float = 0.001
+    tilt_prior_std_rad: float = 2.0e-5
 
 
 @dataclass(frozen=True)
@@ -225,6 +226,9 @@ def camera_config_from_parameters(params: Mapping[str, Any], source: str | Path)
             source,
             t.calibration_min_step_m,
             non_negative=True,
+        ),
+        tilt_prior_std_rad=get_float(
+            params, 'tracker.tilt_prior_std_rad', source, t.tilt_prior_std_rad, **pos
         ),
     )
     if tracker.window_fraction >= 0.5:

@@ -359,7 +359,10 @@ class TipTracker:
         poses = [q for _, q in self._pending]
         self._pending = []
         try:
-            calibration = calibrate_rig(self.config.rig, self.camera_info, pixels, poses)
+            calibration = calibrate_rig(
+                self.config.rig, self.camera_info, pixels, poses,
+                self.settings.tilt_prior_std_rad,
+            )  # fmt: skip
         except LumpbeamError:
             return  # keep the configured rig and try again with the next frames
         self._calibration = calibration
