@@ -95,11 +95,17 @@ def calibrate_rig(
         The calibration.
 
     Raises:
-        LumpbeamError: Fewer than three frames, or the fit fails.
+        LumpbeamError: Too few frames (three without a tilt prior, one with it), or the
+            fit fails.
     """
     n_frames = len(pixels)
-    if n_frames < 3 or len(poses) != n_frames:
-        raise LumpbeamError('calibration: need at least 3 frames, each with a start pose')
+    # With a tilt prior one frame determines the depth (the board's scale); free tilts need
+    # several views.
+    least = 1 if tilt_prior_std_rad is not None else 3
+    if n_frames < least or len(poses) != n_frames:
+        raise LumpbeamError(
+            f'calibration: need at least {least} frames, each with a start pose'
+        )
     measured = np.stack([np.asarray(p, dtype=float) for p in pixels])
     n_points = measured.shape[1]
 

@@ -334,6 +334,8 @@ class TipTracker:
             self._pending.append((ideal, fit.pose))
             if len(self._pending) >= self.settings.calibration_frames:
                 self._calibrate()
+            elif len(self._pending) == 1:
+                fit = self._calibrate_depth(ideal, fit)
         return TrackResult(
             stamp,
             TrackStatus.OK,
@@ -353,6 +355,28 @@ class TipTracker:
 
     def _is_calibrated(self) -> bool:
         return self._calibration is not None or self.settings.calibration_frames == 0
+
+    def _calibrate_depth(self, ideal: np.ndarray, fit: PlaneFit) -> PlaneFit:
+        """Corrects the board's distance from the first frame, before the full calibration.
+
+        The board's known squares fix the distance in a single frame, and a configured
+        distance 5 mm off would otherwise bias the tip by some 300 um (the scale error times
+        the tip's offset from the board's centre) until the full calibration is done.
+        """
+        try:
+            early = calibrate_rig(
+                self.config.rig, self.camera_info, [ideal], [fit.pose],
+                self.settings.tilt_prior_std_rad,
+            )  # fmt: skip
+        except LumpbeamError:
+            return fit
+        self._set_rig(early.rig)
+        refit = self._model.fit(ideal, fit.pose)
+        if not refit.converged:
+            return fit
+        self._history[-1] = (self._history[-1][0], self._history[-1][1], refit.pose)
+        self._pending[-1] = (ideal, refit.pose)
+        return refit
 
     def _calibrate(self) -> None:
         pixels = [p for p, _ in self._pending]
