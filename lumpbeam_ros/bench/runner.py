@@ -8,7 +8,12 @@ from collections.abc import Iterable
 from lumpbeam_ros.bench.result import BenchResult
 
 #: Suite modules under :mod:`lumpbeam_ros.bench`.
-SUITES = ('model', 'tracker', 'ident', 'bagio', 'diagnose')
+SUITES = ('model', 'tracker', 'camera-accuracy', 'ident', 'bagio', 'diagnose')
+
+
+def _module(suite: str) -> str:
+    """The module of a suite (suite names use hyphens, modules underscores)."""
+    return f'lumpbeam_ros.bench.{suite.replace("-", "_")}'
 
 
 def available_suites() -> list[str]:
@@ -16,9 +21,9 @@ def available_suites() -> list[str]:
     names = []
     for name in SUITES:
         try:
-            importlib.import_module(f'lumpbeam_ros.bench.{name}')
+            importlib.import_module(_module(name))
         except ModuleNotFoundError as exc:
-            if exc.name != f'lumpbeam_ros.bench.{name}':
+            if exc.name != _module(name):
                 raise
             continue
         names.append(name)
@@ -37,7 +42,7 @@ def run_suites(names: Iterable[str], quick: bool = False) -> list[BenchResult]:
     """
     results: list[BenchResult] = []
     for name in names:
-        module = importlib.import_module(f'lumpbeam_ros.bench.{name}')
+        module = importlib.import_module(_module(name))
         results.extend(module.run(quick=quick))
     return results
 

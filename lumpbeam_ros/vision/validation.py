@@ -50,6 +50,8 @@ class ValidationCase:
         exposure_s: Exposure, s.
         sub_exposures: Poses integrated over the exposure.
         seed: Noise seed.
+        calibration_frames: Frames of the rig calibration; ``None`` keeps the
+            configuration's (a short test may calibrate on fewer).
     """
 
     size_px: int = 1024
@@ -69,6 +71,7 @@ class ValidationCase:
     exposure_s: float = 0.001
     sub_exposures: int = 4
     seed: int = 1
+    calibration_frames: int | None = None
 
     def label(self) -> str:
         """The conditions, compactly."""
@@ -114,7 +117,10 @@ def case_setup(case: ValidationCase) -> tuple[CameraInfo, CameraConfig, RaycastC
         tip_camera=Transform.from_xyz_rpy(mount_xyz, mount_rpy),
         base_board=Transform.from_xyz_rpy(board_xyz, board_rpy),
     )
-    config = replace(base, camera_info=info, rig=rig)
+    tracker = base.tracker
+    if case.calibration_frames is not None:
+        tracker = replace(tracker, calibration_frames=case.calibration_frames)
+    config = replace(base, camera_info=info, rig=rig, tracker=tracker)
     lens = Lens(
         info.width, info.height, info.k[0, 0], info.k[1, 1], info.k[0, 2], info.k[1, 2],
         case.model, tuple(float(v) for v in info.d),
@@ -148,7 +154,8 @@ def run_case(case: ValidationCase, trajectory: TipTrajectory) -> AccuracyReport:
     )
     inside = (trajectory.t >= case.start_s) & (trajectory.t <= case.end_s)
     times = trajectory.t[inside][:: case.frame_step]
-    offsets = ((np.arange(case.sub_exposures) + 0.5) / case.sub_exposures - 0.5) * case.exposure_s
+    steps = case.sub_exposures
+    offsets = ((np.arange(steps) + 0.5) / steps - 0.5) * case.exposure_s
     tracker = TipTracker(info, config)
     results = []
     for index, stamp in enumerate(times):
