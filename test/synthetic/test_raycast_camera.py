@@ -1,5 +1,6 @@
 """The independent renderer, checked against OpenCV (not against the tracker's own code)."""
 
+import dataclasses
 import subprocess
 import sys
 
@@ -118,9 +119,9 @@ def test_bad_lens_and_board_behind_the_camera():
     with pytest.raises(LumpbeamError, match='equidistant'):
         Lens(64, 64, 50.0, 50.0, 32.0, 32.0, 'equidistant', (0.0,) * 5)
     lens = _lens('plumb_bob', (0.0,) * 5, 128)
-    camera = RaycastCamera(lens, SCENE, Optics())
+    behind = dataclasses.replace(SCENE, board_xyz=(2.3107, -1.0, -0.01))
     with pytest.raises(LumpbeamError, match='behind'):
-        camera.render(np.array([2.3107, -0.01, np.pi]))
+        RaycastCamera(lens, behind, Optics()).render(np.array([2.3107, -0.01, 0.0]))
 
 
 def test_shares_no_code_with_the_tracker():
