@@ -1,6 +1,6 @@
 """A few rows of the validation matrix (the bench's ``camera-accuracy`` runs all of them).
 
-Each is a short drop test filmed by the independent ray caster, every 4th frame, with the
+Each is a short drop test filmed by the independent ray caster, every 6th frame, with the
 rig calibrated on 10 frames so that it completes within the test; every published pose is
 scored, the calibrating ones included, with the bias in the RMS.
 """
@@ -29,16 +29,18 @@ ROWS = matrix_cases()
     ],
 )
 def test_short_rows_meet_the_targets(drop_test, row):
-    case = dataclasses.replace(ROWS[row], frame_step=4, calibration_frames=10)
+    case = dataclasses.replace(ROWS[row], frame_step=6, calibration_frames=10)
     report = run_case(case, drop_test)
     print(format_row(case, report))
-    assert report.frames == 37
+    assert report.frames == 25
     assert report.frames_lost == 0
     assert report.frames_calibrating > 10  # those frames are scored too
     assert report.z_um.rms <= Z_RMS_LIMIT_UM
     assert report.pitch_mrad.rms <= PITCH_RMS_LIMIT_MRAD
-    # The published covariance is about right: a fair share of errors within 1 sigma.
-    assert 0.4 < report.within_1sigma < 0.97
+    # The published covariance is not optimistic (about 68 % within 1 sigma with sensor
+    # noise; on noiseless sharp frames cornerSubPix's pixel-locking error, periodic in the
+    # corners' sub-pixel phases, averages out over the grid better than the residuals say).
+    assert report.within_1sigma > 0.5
 
 
 @pytest.mark.slow
