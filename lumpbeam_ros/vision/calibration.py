@@ -10,8 +10,10 @@ The depth is well determined (the board's known squares give the scale). The til
 a tilt by ``a`` shifts the whole image like a tip translation by ``a`` times the distance,
 and only the faint keystone it adds (about 0.1 px per mrad at the board's edge at 1024 px)
 tells them apart. Over 30 frames with 0.05 px corner noise that leaves some 60 urad of
-uncertainty, 57 um of tip bias at 0.95 m, far more than a tilt measured on the rig. So the
-tilts enter with a Gaussian prior around the configured mount (``tilt_prior_std_rad``): the
+uncertainty, 57 um of tip bias at 0.95 m, and corner biases of a few thousandths of a pixel
+(an illumination gradient across the corner windows) pull it by tens of urad more: the
+validation matrix saw 15 um of z bias from a 20 urad prior at 2048 px. So the tilts enter
+with a tight Gaussian prior around the configured mount (``tilt_prior_std_rad``): the
 images do not pull a well measured mount off by their own noise (and cannot correct a badly
 measured one much either: measure it).
 """

@@ -60,7 +60,7 @@ class TrackerSettings:
     max_saturated_fraction: float = 0.2
     calibration_frames: int = 30
     calibration_min_step_m: float = 0.001
-    tilt_prior_std_rad: float = 2.0e-5
+    tilt_prior_std_rad: float = 5.0e-6
 
 
 @dataclass(frozen=True)
