@@ -42,8 +42,12 @@ def run(quick: bool) -> list[BenchResult]:
         z = report.z_um
         results.append(
             BenchResult(
-                f'camera_accuracy_{case.size_px}_row{i}', z.rms, 'um', 'target 10 um',
-                Z_RMS_LIMIT_UM, Z_RMS_LIMIT_UM / z.rms,
+                f'camera_accuracy_{case.size_px}_row{i}',
+                z.rms,
+                'um',
+                'target 10 um',
+                Z_RMS_LIMIT_UM,
+                Z_RMS_LIMIT_UM / z.rms,
                 {
                     'conditions': case.label(),
                     'frames': report.frames,

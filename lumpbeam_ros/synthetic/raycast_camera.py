@@ -379,7 +379,9 @@ class RaycastCamera:
 
     def _motion_squares(self, maps: list[np.ndarray]) -> float:
         """How far, in squares, any point of the view moves on the board over the exposure."""
-        x, y = (r[:: max(1, r.shape[0] // 8), :: max(1, r.shape[1] // 8)] for r in self._centre_rays)
+        x, y = (
+            r[:: max(1, r.shape[0] // 8), :: max(1, r.shape[1] // 8)] for r in self._centre_rays
+        )
         spots = [np.stack(self._map(g, x, y)) for g in maps]
         return max(float(np.max(np.abs(p - spots[0]))) for p in spots)
 

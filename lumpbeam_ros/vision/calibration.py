@@ -105,9 +105,7 @@ def calibrate_rig(
     # several views.
     least = 1 if tilt_prior_std_rad is not None else 3
     if n_frames < least or len(poses) != n_frames:
-        raise LumpbeamError(
-            f'calibration: need at least {least} frames, each with a start pose'
-        )
+        raise LumpbeamError(f'calibration: need at least {least} frames, each with a start pose')
     measured = np.stack([np.asarray(p, dtype=float) for p in pixels])
     n_points = measured.shape[1]
 

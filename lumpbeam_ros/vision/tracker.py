@@ -188,16 +188,12 @@ class TipTracker:
         if image.dtype != np.uint8:
             return None, f'expected uint8 pixels, got {image.dtype}'
         channels = 1 if encoding == 'mono8' else 3
-        want = (self.camera_info.height, self.camera_info.width)
-        if (
-            image.shape[:2] != want
-            or (image.ndim == 3) != (channels == 3)
-            or (channels == 3 and image.shape[2] != 3)
-        ):
-            return None, (
-                f'{encoding} image of shape {image.shape} does not match the camera '
-                f'({want[1]} x {want[0]})'
-            )
+        if image.ndim != (3 if channels == 3 else 2) or (channels == 3 and image.shape[2] != 3):
+            return None, f'{encoding} image of shape {image.shape} has the wrong channels'
+        try:
+            self.camera_info.check_image_size(image.shape[1], image.shape[0], 'image')
+        except LumpbeamError as exc:
+            return None, str(exc)
         if channels == 3:
             code = cv2.COLOR_BGR2GRAY if encoding == 'bgr8' else cv2.COLOR_RGB2GRAY
             return cv2.cvtColor(image, code), ''

@@ -47,7 +47,9 @@ def test_lens_model_and_its_inverse_match_opencv(model, coefficients):
     pts = np.column_stack([rng.uniform(-0.35, 0.35, (40, 2)), np.ones(40)])
     k, d = _k_d(lens)
     if model == 'equidistant':
-        theirs, _ = cv2.fisheye.projectPoints(pts.reshape(-1, 1, 3), np.zeros(3), np.zeros(3), k, d)
+        theirs, _ = cv2.fisheye.projectPoints(
+            pts.reshape(-1, 1, 3), np.zeros(3), np.zeros(3), k, d
+        )
     else:
         theirs, _ = cv2.projectPoints(pts, np.zeros(3), np.zeros(3), k, d)
     xd, yd = lens_distort(lens, pts[:, 0], pts[:, 1])
@@ -84,7 +86,11 @@ def test_corners_are_where_opencv_projects_them(model, coefficients):
     found, corners = cv2.findChessboardCorners(image, (8, 6))
     assert found
     corners = cv2.cornerSubPix(
-        image, corners, (5, 5), (-1, -1), (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 50, 1e-4)
+        image,
+        corners,
+        (5, 5),
+        (-1, -1),
+        (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 50, 1e-4),
     ).reshape(-1, 2)
     u = (np.arange(8) - 3.5) * 0.06
     v = (np.arange(6) - 2.5) * 0.06

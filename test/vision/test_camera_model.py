@@ -37,7 +37,9 @@ def _opencv_project(info: CameraInfo, points: np.ndarray) -> np.ndarray:
 @pytest.mark.parametrize(('model', 'distortion'), LENSES)
 def test_project_matches_opencv(model, distortion):
     info = CameraInfo.pinhole(2048, 2048, 2400.0, (3.0, -2.0), distortion, model)
-    np.testing.assert_allclose(info.project(_points()), _opencv_project(info, _points()), atol=1e-8)
+    np.testing.assert_allclose(
+        info.project(_points()), _opencv_project(info, _points()), atol=1e-8
+    )
 
 
 @pytest.mark.parametrize(('model', 'distortion'), LENSES)
@@ -48,7 +50,9 @@ def test_undistort_inverts_the_distortion(model, distortion):
 
 
 def test_scaled_keeps_the_view_and_the_lens():
-    info = CameraInfo.pinhole(2048, 2048, 2400.0, distortion=FISHEYE, distortion_model='equidistant')
+    info = CameraInfo.pinhole(
+        2048, 2048, 2400.0, distortion=FISHEYE, distortion_model='equidistant'
+    )
     small = info.scaled(640, 480)
     assert small.k[0, 0] == pytest.approx(750.0)
     assert small.k[0, 2] == pytest.approx(319.5)

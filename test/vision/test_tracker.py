@@ -62,6 +62,12 @@ def test_bad_frame_gives_a_status_and_no_stale_pose(tracker, frames, config, cas
     assert result.status is status
     assert result.pose is None and result.covariance is None
     assert result.reason
+    if case == 'wrong size':
+        assert (
+            result.reason
+            == 'camera info: calibrated for 640 x 480 px but the image is 640 x 478 px'
+        )
+
     # The stream recovers on the next good frame.
     following = tracker.process(frames[4].image, frames[4].stamp)
     assert following.ok
