@@ -27,6 +27,10 @@ EQUIDISTANT = 'equidistant'
 DISTORTION_MODELS = {PLUMB_BOB: 5, RATIONAL_POLYNOMIAL: 8, EQUIDISTANT: 4}
 
 
+#: OpenCV's fixed-point undistortion run to convergence (Newton only polishes what is left).
+_OPENCV_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-15)
+
+
 @dataclass(frozen=True)
 class CameraInfo:
     """The calibration a camera driver publishes, without ROS types.
@@ -203,10 +207,12 @@ class CameraInfo:
         if not self.has_distortion:
             return target.copy()
         pts = np.ascontiguousarray(target).reshape(-1, 1, 2)
+        eye = np.eye(3)
         if self.distortion_model == EQUIDISTANT:
-            xy = cv2.fisheye.undistortPoints(pts, np.eye(3), self.d).reshape(-1, 2)
+            xy = cv2.fisheye.undistortPoints(pts, eye, self.d, criteria=_OPENCV_CRITERIA)
         else:
-            xy = cv2.undistortPoints(pts, np.eye(3), self.d).reshape(-1, 2)
+            xy = cv2.undistortPoints(pts, eye, self.d, None, None, None, _OPENCV_CRITERIA)
+        xy = xy.reshape(-1, 2)
         if not np.all(np.isfinite(xy)):
             xy = target.copy()
         h = 1e-7
