@@ -358,6 +358,13 @@ class TipTracker:
         The board's known squares fix the distance in a single frame, and a configured
         distance 5 mm off would otherwise bias the tip by some 300 um (the scale error times
         the tip's offset from the board's centre) until the full calibration is done.
+
+        Args:
+            ideal: The frame's undistorted corners.
+            fit: Its fit with the configured rig.
+
+        Returns:
+            The frame's fit with the corrected rig (``fit`` when the correction fails).
         """
         try:
             early = calibrate_rig(
