@@ -9,7 +9,22 @@ from collections.abc import Iterable
 from lumpbeam_ros.bench.result import BenchResult
 
 #: Suite modules under :mod:`lumpbeam_ros.bench`.
-SUITES = ('model', 'tracker', 'ident', 'bagio', 'diagnose', 'campaign', 'cli', 'live_graph')
+SUITES = (
+    'model',
+    'tracker',
+    'camera-accuracy',
+    'ident',
+    'bagio',
+    'diagnose',
+    'campaign',
+    'cli',
+    'live_graph',
+)
+
+
+def _module(suite: str) -> str:
+    """The module of a suite (suite names use hyphens, modules underscores)."""
+    return f'lumpbeam_ros.bench.{suite.replace("-", "_")}'
 
 
 def available_suites() -> list[str]:
@@ -18,7 +33,7 @@ def available_suites() -> list[str]:
     None is imported: a suite's dependencies load only when it runs (``--only cli`` needs no
     OpenCV).
     """
-    return [name for name in SUITES if importlib.util.find_spec(f'{__package__}.{name}')]
+    return [name for name in SUITES if importlib.util.find_spec(_module(name))]
 
 
 def run_suites(names: Iterable[str], quick: bool = False) -> list[BenchResult]:
@@ -33,7 +48,7 @@ def run_suites(names: Iterable[str], quick: bool = False) -> list[BenchResult]:
     """
     results: list[BenchResult] = []
     for name in names:
-        module = importlib.import_module(f'lumpbeam_ros.bench.{name}')
+        module = importlib.import_module(_module(name))
         results.extend(module.run(quick=quick))
     return results
 

@@ -181,6 +181,13 @@ _TRACKER = (
         "a partial view's corners spread at least this far (rms) across their weakest direction",
         'squares',
     ),
+    _double(
+        'tracker.tilt_prior_std_rad',
+        5.0e-6,
+        "how well the mount's out-of-plane tilt (camera.mount.rpy_rad) is known: the rig "
+        'calibration fits the tilt with this Gaussian prior',
+        'rad',
+    ),
 )
 
 _NODE = (

@@ -1,4 +1,14 @@
-"""The pinhole camera with plumb_bob distortion, as ``sensor_msgs/CameraInfo`` describes it."""
+"""The calibrated camera as ``sensor_msgs/CameraInfo`` describes it: K and a distortion model.
+
+Every step of the tracker goes through two calls of :class:`CameraInfo`: :meth:`project`
+(camera-frame points to the real, distorted pixels) and :meth:`undistort_pixels` (real pixels
+to where an ideal pinhole camera with the same K sees them). The distortion models are those
+of ROS (``image_geometry``) and OpenCV:
+
+* ``plumb_bob``: ``k1, k2, p1, p2, k3`` (Brown-Conrady, OpenCV's default model);
+* ``rational_polynomial``: ``k1, k2, p1, p2, k3, k4, k5, k6`` (OpenCV's rational model);
+* ``equidistant``: ``k1, k2, k3, k4`` (the fisheye model of ``cv2.fisheye``).
+"""
 
 from __future__ import annotations
 
@@ -9,8 +19,16 @@ import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
 
-#: The only distortion model handled (ROS ``plumb_bob``: k1, k2, p1, p2, k3).
 PLUMB_BOB = 'plumb_bob'
+RATIONAL_POLYNOMIAL = 'rational_polynomial'
+EQUIDISTANT = 'equidistant'
+
+#: Supported distortion models and their number of coefficients.
+DISTORTION_MODELS = {PLUMB_BOB: 5, RATIONAL_POLYNOMIAL: 8, EQUIDISTANT: 4}
+
+
+#: OpenCV's fixed-point undistortion run to convergence (Newton only polishes what is left).
+_OPENCV_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-15)
 
 
 @dataclass(frozen=True)
@@ -20,9 +38,10 @@ class CameraInfo:
     Attributes:
         width: Image width, px.
         height: Image height, px.
-        k: 3x3 intrinsic matrix (fx, fy, cx, cy; pixel centres at integers).
-        d: Distortion coefficients ``k1, k2, p1, p2, k3``.
-        distortion_model: ``'plumb_bob'``.
+        k: 3x3 intrinsic matrix (fx, fy, cx, cy; pixel centres at integers, ROS's and
+            OpenCV's convention).
+        d: Distortion coefficients in the order of ``distortion_model``.
+        distortion_model: A key of :data:`DISTORTION_MODELS`.
     """
 
     width: int
@@ -37,18 +56,23 @@ class CameraInfo:
         if self.width <= 0 or self.height <= 0:
             raise LumpbeamError(f'camera info: bad image size {self.width} x {self.height}')
         if k.shape != (3, 3) or not np.all(np.isfinite(k)) or k[0, 0] <= 0 or k[1, 1] <= 0:
-            raise LumpbeamError('camera info: K must be a finite 3x3 matrix with fx, fy > 0')
-        if (
-            self.distortion_model != PLUMB_BOB
-            or d.size not in (0, 5)
-            or not np.all(np.isfinite(d))
-        ):
             raise LumpbeamError(
-                f'camera info: need plumb_bob with 5 finite coefficients, got '
-                f'{self.distortion_model!r} with {d.size}'
+                'camera info: K must be a finite 3x3 matrix with fx, fy > 0 (an uncalibrated '
+                'camera publishes K = 0)'
+            )
+        size = DISTORTION_MODELS.get(self.distortion_model)
+        if size is None:
+            raise LumpbeamError(
+                f'camera info: distortion model {self.distortion_model!r} is not supported '
+                f'(use one of {", ".join(DISTORTION_MODELS)})'
+            )
+        if d.size not in (0, size) or not np.all(np.isfinite(d)):
+            raise LumpbeamError(
+                f'camera info: {self.distortion_model} needs {size} finite coefficients, '
+                f'got {d.size}'
             )
         object.__setattr__(self, 'k', k)
-        object.__setattr__(self, 'd', np.zeros(5) if d.size == 0 else d)
+        object.__setattr__(self, 'd', np.zeros(size) if d.size == 0 else d)
 
     @staticmethod
     def pinhole(
@@ -57,6 +81,7 @@ class CameraInfo:
         focal_px: float,
         centre_offset_px: tuple[float, float] = (0.0, 0.0),
         distortion: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0, 0.0),
+        distortion_model: str = PLUMB_BOB,
     ) -> CameraInfo:
         """Builds square-pixel intrinsics with the principal point near the image centre.
 
@@ -65,20 +90,44 @@ class CameraInfo:
             height: Image height, px.
             focal_px: fx = fy, px.
             centre_offset_px: Principal point minus the image centre ``((w-1)/2, (h-1)/2)``.
-            distortion: ``k1, k2, p1, p2, k3``.
+            distortion: Coefficients of ``distortion_model``.
+            distortion_model: A key of :data:`DISTORTION_MODELS`.
 
         Returns:
             The camera info.
+
+        Raises:
+            LumpbeamError: A bad size, focal length or distortion.
         """
         cx = (width - 1) / 2.0 + centre_offset_px[0]
         cy = (height - 1) / 2.0 + centre_offset_px[1]
         k = np.array([[focal_px, 0.0, cx], [0.0, focal_px, cy], [0.0, 0.0, 1.0]])
-        return CameraInfo(int(width), int(height), k, np.asarray(distortion, dtype=float))
+        return CameraInfo(
+            int(width), int(height), k, np.asarray(distortion, dtype=float), distortion_model
+        )
 
     @property
     def has_distortion(self) -> bool:
-        """Whether any distortion coefficient is non-zero."""
-        return bool(np.any(self.d != 0.0))
+        """Whether the lens departs from a pinhole (an equidistant lens always does)."""
+        return self.distortion_model == EQUIDISTANT or bool(np.any(self.d != 0.0))
+
+    def check_image_size(self, width: int, height: int, source: str = 'image') -> None:
+        """Checks that images of the given size belong to this calibration.
+
+        Args:
+            width: Image width, px.
+            height: Image height, px.
+            source: What the image is, for the message.
+
+        Raises:
+            LumpbeamError: The sizes differ (the calibration is for another sensor or
+                binning, and would give wrong poses).
+        """
+        if (int(width), int(height)) != (self.width, self.height):
+            raise LumpbeamError(
+                f'camera info: calibrated for {self.width} x {self.height} px but the '
+                f'{source} is {width} x {height} px'
+            )
 
     def scaled(self, width: int, height: int) -> CameraInfo:
         """Returns the same lens on a sensor of another size, focal length scaled with width.
@@ -95,33 +144,119 @@ class CameraInfo:
             self.k[0, 2] - (self.width - 1) / 2.0,
             self.k[1, 2] - (self.height - 1) / 2.0,
         )
-        return replace(
-            CameraInfo.pinhole(width, height, self.k[0, 0] * s, (offset[0] * s, offset[1] * s)),
-            d=self.d.copy(),
+        return CameraInfo.pinhole(
+            width,
+            height,
+            self.k[0, 0] * s,
+            (offset[0] * s, offset[1] * s),
+            tuple(self.d),
+            self.distortion_model,
         )
 
+    def distort_normalized(self, xy: np.ndarray) -> np.ndarray:
+        """Applies the lens distortion to ideal normalized image coordinates.
+
+        Args:
+            xy: N x 2 coordinates ``(X / Z, Y / Z)`` of camera-frame points.
+
+        Returns:
+            N x 2 distorted normalized coordinates (apply K to get pixels).
+        """
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        if not self.has_distortion:
+            return xy
+        x, y = xy[:, 0], xy[:, 1]
+        r2 = x * x + y * y
+        if self.distortion_model == EQUIDISTANT:
+            k1, k2, k3, k4 = self.d
+            r = np.sqrt(r2)
+            theta = np.arctan(r)
+            t2 = theta * theta
+            theta_d = theta * (1.0 + t2 * (k1 + t2 * (k2 + t2 * (k3 + t2 * k4))))
+            # theta_d / r -> 1 on the optical axis.
+            scale = np.divide(theta_d, r, out=np.ones_like(r), where=r > 1e-12)
+            return xy * scale[:, None]
+        k1, k2, p1, p2, k3 = self.d[:5]
+        radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
+        if self.distortion_model == RATIONAL_POLYNOMIAL:
+            k4, k5, k6 = self.d[5:]
+            radial = radial / (1.0 + r2 * (k4 + r2 * (k5 + r2 * k6)))
+        return np.column_stack(
+            [
+                x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
+                y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y,
+            ]
+        )
+
+    def undistort_normalized(self, xy_distorted: np.ndarray, iterations: int = 20) -> np.ndarray:
+        """Inverts :meth:`distort_normalized`: OpenCV's estimate, polished by Newton's method.
+
+        OpenCV's fixed-point iteration is fast but stops short for strong lenses; a Newton
+        step or two on this model's own forward map makes the result exact.
+
+        Args:
+            xy_distorted: N x 2 distorted normalized coordinates.
+            iterations: Newton steps at most (they stop once the model maps every point
+                to within 1e-13 of its target).
+
+        Returns:
+            N x 2 ideal normalized coordinates (exact to round-off within the lens's field
+            of view, where the distortion is one-to-one).
+        """
+        target = np.asarray(xy_distorted, dtype=float).reshape(-1, 2)
+        # OpenCV returns None, not an empty array, for no points (a frame with no corner seen).
+        if not self.has_distortion or target.size == 0:
+            return target.copy()
+        pts = np.ascontiguousarray(target).reshape(-1, 1, 2)
+        eye = np.eye(3)
+        if self.distortion_model == EQUIDISTANT:
+            xy = cv2.fisheye.undistortPoints(pts, eye, self.d, criteria=_OPENCV_CRITERIA)
+        else:
+            xy = cv2.undistortPoints(pts, eye, self.d, None, None, None, _OPENCV_CRITERIA)
+        xy = xy.reshape(-1, 2)
+        if not np.all(np.isfinite(xy)):
+            xy = target.copy()
+        h = 1e-7
+        for _ in range(iterations):
+            f = self.distort_normalized(xy) - target
+            if not np.max(np.abs(f), initial=0.0) > 1e-13:
+                break  # 1e-13 of the focal length: well below a nanopixel
+            # A 2x2 Jacobian per point by forward differences: the models are smooth.
+            jx = (self.distort_normalized(xy + [h, 0.0]) - target - f) / h
+            jy = (self.distort_normalized(xy + [0.0, h]) - target - f) / h
+            det = jx[:, 0] * jy[:, 1] - jy[:, 0] * jx[:, 1]
+            det = np.where(np.abs(det) < 1e-12, 1e-12, det)
+            step = np.column_stack(
+                [
+                    (jy[:, 1] * f[:, 0] - jy[:, 0] * f[:, 1]) / det,
+                    (jx[:, 0] * f[:, 1] - jx[:, 1] * f[:, 0]) / det,
+                ]
+            )
+            xy -= step
+        return xy
+
     def project(self, points: np.ndarray) -> np.ndarray:
-        """Projects camera-frame points (N x 3, z forward) to distorted pixels (N x 2).
+        """Projects camera-frame points (N x 3, z forward) to real (distorted) pixels.
 
         Args:
             points: Points in the camera optical frame, m; z must be positive.
 
         Returns:
-            Pixel coordinates.
+            N x 2 pixel coordinates.
         """
-        xy = points[:, :2] / points[:, 2:3]
-        if self.has_distortion:
-            k1, k2, p1, p2, k3 = self.d
-            x, y = xy[:, 0], xy[:, 1]
-            r2 = x * x + y * y
-            radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
-            xy = np.column_stack(
-                [
-                    x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
-                    y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y,
-                ]
-            )
-        return xy * np.diag(self.k)[:2] + self.k[:2, 2]
+        points = np.asarray(points, dtype=float).reshape(-1, 3)
+        return self.to_pixels(self.distort_normalized(points[:, :2] / points[:, 2:3]))
+
+    def to_pixels(self, xy: np.ndarray) -> np.ndarray:
+        """Applies K to normalized coordinates (N x 2)."""
+        return xy * np.diag(self.k)[:2] + self.k[:2, 2] + np.outer(xy[:, 1], [self.k[0, 1], 0])
+
+    def to_normalized(self, pixels: np.ndarray) -> np.ndarray:
+        """Applies K's inverse to pixels (N x 2)."""
+        pixels = np.asarray(pixels, dtype=float).reshape(-1, 2)
+        y = (pixels[:, 1] - self.k[1, 2]) / self.k[1, 1]
+        x = (pixels[:, 0] - self.k[0, 2] - self.k[0, 1] * y) / self.k[0, 0]
+        return np.column_stack([x, y])
 
     def undistort_pixels(self, pixels: np.ndarray) -> np.ndarray:
         """Maps measured (distorted) pixels to where an ideal pinhole camera sees them.
@@ -130,15 +265,13 @@ class CameraInfo:
             pixels: N x 2 pixel coordinates.
 
         Returns:
-            N x 2 ideal pinhole pixel coordinates (the identity without distortion).
+            N x 2 ideal pinhole pixel coordinates with the same K (the identity without
+            distortion).
         """
         if not self.has_distortion:
-            return np.asarray(pixels, dtype=float)
-        pts = np.ascontiguousarray(pixels, dtype=np.float64).reshape(-1, 1, 2)
-        criteria = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 20, 1e-10)
-        ideal = cv2.undistortPoints(pts, self.k, self.d, None, None, self.k, criteria)
-        return ideal.reshape(-1, 2)
+            return np.asarray(pixels, dtype=float).reshape(-1, 2)
+        return self.to_pixels(self.undistort_normalized(self.to_normalized(pixels)))
 
     def pinhole_only(self) -> CameraInfo:
-        """Returns the same intrinsics without distortion."""
-        return replace(self, d=np.zeros(5))
+        """Returns the same K without distortion (the camera the pose fit works in)."""
+        return replace(self, d=np.zeros(5), distortion_model=PLUMB_BOB)

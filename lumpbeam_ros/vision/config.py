@@ -64,6 +64,7 @@ class TrackerSettings:
     calibration_min_step_m: float = 0.001
     min_corners: int = 12
     min_corner_spread: float = 0.5
+    tilt_prior_std_rad: float = 5.0e-6
 
 
 @dataclass(frozen=True)
@@ -229,6 +230,9 @@ def camera_config_from_parameters(params: Mapping[str, Any], source: str | Path)
             source,
             t.calibration_min_step_m,
             non_negative=True,
+        ),
+        tilt_prior_std_rad=get_float(
+            params, 'tracker.tilt_prior_std_rad', source, t.tilt_prior_std_rad, **pos
         ),
     )
     tracker = replace(

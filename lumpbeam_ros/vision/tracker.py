@@ -233,16 +233,12 @@ class TipTracker:
         if image.dtype != np.uint8:
             return None, f'expected uint8 pixels, got {image.dtype}'
         channels = 1 if encoding == 'mono8' else 3
-        want = (self.camera_info.height, self.camera_info.width)
-        if (
-            image.shape[:2] != want
-            or (image.ndim == 3) != (channels == 3)
-            or (channels == 3 and image.shape[2] != 3)
-        ):
-            return None, (
-                f'{encoding} image of shape {image.shape} does not match the camera '
-                f'({want[1]} x {want[0]})'
-            )
+        if image.ndim != (3 if channels == 3 else 2) or (channels == 3 and image.shape[2] != 3):
+            return None, f'{encoding} image of shape {image.shape} has the wrong channels'
+        try:
+            self.camera_info.check_image_size(image.shape[1], image.shape[0], 'image')
+        except LumpbeamError as exc:
+            return None, str(exc)
         if channels == 3:
             code = cv2.COLOR_BGR2GRAY if encoding == 'bgr8' else cv2.COLOR_RGB2GRAY
             return cv2.cvtColor(image, code), ''
@@ -440,6 +436,8 @@ class TipTracker:
             self._pending.append((ideal, fit.pose))
             if len(self._pending) >= self.settings.calibration_frames:
                 self._calibrate()
+            elif len(self._pending) == 1:
+                fit = self._calibrate_depth(ideal, fit)
         pose, covariance, pose6, covariance6 = fit.pose, fit.covariance, None, None
         if self.pose_model == 'free':
             pose6, covariance6 = fit.pose, fit.covariance
@@ -471,12 +469,44 @@ class TipTracker:
             or self.pose_model == 'free'
         )
 
+    def _calibrate_depth(self, ideal: np.ndarray, fit: PlaneFit) -> PlaneFit:
+        """Corrects the board's distance from the first frame, before the full calibration.
+
+        The board's known squares fix the distance in a single frame, and a configured
+        distance 5 mm off would otherwise bias the tip by some 300 um (the scale error times
+        the tip's offset from the board's centre) until the full calibration is done.
+
+        Args:
+            ideal: The frame's undistorted corners.
+            fit: Its fit with the configured rig.
+
+        Returns:
+            The frame's fit with the corrected rig (``fit`` when the correction fails).
+        """
+        try:
+            early = calibrate_rig(
+                self.config.rig, self.camera_info, [ideal], [fit.pose],
+                self.settings.tilt_prior_std_rad,
+            )  # fmt: skip
+        except LumpbeamError:
+            return fit
+        self._set_rig(early.rig)
+        refit = self._model.fit(ideal, fit.pose)
+        if not refit.converged:
+            return fit
+        self._history[-1] = (self._history[-1][0], self._history[-1][1], refit.pose)
+        self._pending[-1] = (ideal, refit.pose)
+        return refit
+
     def _calibrate(self) -> None:
         pixels = [p for p, _ in self._pending]
         poses = [q for _, q in self._pending]
         self._pending = []
         try:
-            calibration = calibrate_rig(self.config.rig, self.camera_info, pixels, poses)
+            calibration = calibrate_rig(
+                self.config.rig, self.camera_info, pixels, poses,
+                self.settings.tilt_prior_std_rad,
+            )  # fmt: skip
         except LumpbeamError:
             return  # keep the configured rig and try again with the next frames
         self._calibration = calibration

@@ -308,7 +308,7 @@ def test_bad_footage_frames_give_warnings_and_a_diagnostic(
     values = {kv.key: kv.value for kv in status.values}
     assert status.level == DiagnosticStatus.WARN and values['lost_bad_image'] == '2'
     # The last lost frame, 004.png, is the one of another size.
-    assert 'does not match the camera (640 x 480)' in values['last_reason']
+    assert 'calibrated for 640 x 480 px but the image is 320 x 240 px' in values['last_reason']
 
 
 @pytest.mark.parametrize(

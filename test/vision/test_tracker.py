@@ -4,7 +4,7 @@ import cv2
 import numpy as np
 import pytest
 
-from lumpbeam_ros.vision.accuracy import render_frames
+from lumpbeam_ros.vision.accuracy import render_frames, tracker_config
 from lumpbeam_ros.vision.pose import PlaneModel
 from lumpbeam_ros.vision.tracker import TipTracker, TrackStatus
 
@@ -61,6 +61,12 @@ def test_bad_frame_gives_a_status_and_no_stale_pose(tracker, frames, config, cas
     assert result.status is status
     assert result.pose is None and result.covariance is None
     assert result.reason
+    if case == 'wrong size':
+        assert (
+            result.reason
+            == 'camera info: calibrated for 640 x 480 px but the image is 640 x 478 px'
+        )
+
     # The stream recovers on the next good frame.
     following = tracker.process(frames[4].image, frames[4].stamp)
     assert following.ok
@@ -118,3 +124,16 @@ def test_a_beam_at_rest_never_calibrates(config, frames):
     for i in range(8):
         assert tracker.process(frames[0].image, frames[0].stamp + i).ok
     assert tracker.calibration is None
+
+
+def test_a_wrong_board_distance_is_corrected_from_the_first_frame(config, frames):
+    """A board 5 mm off its configured depth is corrected on the first frame.
+
+    Before, every pose until the full calibration was biased by some 100 um (the scale
+    error times the tip's offset from the board's centre).
+    """
+    tracker = TipTracker(config.camera_info, tracker_config(config, (0.0, 0.0, 0.005)))
+    results = [tracker.process(f.image, f.stamp) for f in frames[:5]]
+    assert all(r.ok and not r.calibrated for r in results)
+    errors = np.array([r.pose - f.truth for r, f in zip(results, frames[:5], strict=True)])
+    assert np.max(np.abs(errors[:, :2])) < 20e-6
