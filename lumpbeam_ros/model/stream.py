@@ -134,7 +134,10 @@ class PredictionStream:
                 f'{beam.n_segments}'
             )
         old = self._simulation
-        simulation = BeamSimulation(beam, old.load_kg, t0=old.time, step=self.step)
+        # The sample stamped t shows the beam at t - latency: a new latency moves the
+        # simulation's clock, not the motion, so the next stamps continue it.
+        shift = beam.effects.latency_s - self._beam.effects.latency_s
+        simulation = BeamSimulation(beam, old.load_kg, t0=old.time - shift, step=self.step)
         simulation.state = ChainState(old.state.phi.copy(), old.state.phi_dot.copy())
         self._beam, self._simulation = beam, simulation
 
