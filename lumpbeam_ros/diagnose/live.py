@@ -330,8 +330,9 @@ class LiveBuffer:
         if latest >= release + s.decay_s:
             return release + s.decay_s
         t, z, _ = self.measured.between(latest - AMPLITUDE_SPAN_S, latest)
-        enough = np.count_nonzero(self.measured.between(release, latest)[0])
-        if s.min_amplitude_m > 0.0 and enough > MIN_SAMPLES_AFTER_EVENT and t.size > 2:
+        after = self.measured.between(release, latest)[0] > release
+        enough = np.count_nonzero(after) >= MIN_SAMPLES_AFTER_EVENT  # what a record needs
+        if s.min_amplitude_m > 0.0 and enough and t.size > 2:
             if float(np.ptp(z)) < 2.0 * s.min_amplitude_m:
                 return latest
         return None
