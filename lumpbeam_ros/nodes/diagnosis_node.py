@@ -34,6 +34,7 @@ from typing import Any
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
+from rclpy.clock import Clock, ClockType
 from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
@@ -118,8 +119,11 @@ class DiagnosisNode(Node):
         self.create_subscription(PoseStamped, '/tip_pose_predicted', self._on_predicted, 200)
         load_qos = from_bag_qos(default_profile('/tip_load', 'std_msgs/msg/Float64'))
         self.create_subscription(Float64, '/tip_load', self._on_load, load_qos)
-        self.create_timer(POLL_PERIOD_S, self._poll)
-        self.create_timer(values['status_period_s'], self._publish_status)
+        # Steady timers: under use_sim_time a stopped /clock (a bag that ended) must not
+        # stop the node from collecting a diagnosis and saying so.
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self.create_timer(POLL_PERIOD_S, self._poll, clock=steady)
+        self.create_timer(values['status_period_s'], self._publish_status, clock=steady)
 
     @staticmethod
     def _make_executor(worker: str) -> Executor:
@@ -226,12 +230,18 @@ class DiagnosisNode(Node):
             f'{result.gap_before_rms_m:.3e} m before, {result.gap_after_rms_m:.3e} m after; '
             f'simulator {current:.3e} m ({result.seconds:.1f} s)'
         )
-        self._adopt(result, current)
+        self.offer_adoption(result, current)
         self._publish_status()
 
     # -- adoption -----------------------------------------------------------------------------
 
-    def _adopt(self, result: LiveDiagnosis, current_gap_m: float) -> None:
+    def offer_adoption(self, result: LiveDiagnosis, current_gap_m: float) -> None:
+        """Sets the simulator's effect parameters to a diagnosis's when it fits better.
+
+        Args:
+            result: The diagnosis.
+            current_gap_m: RMS gap of the simulator's prediction over the same stretch, m.
+        """
         if not self.adopt:
             self.adoption = 'off'
             return

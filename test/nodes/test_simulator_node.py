@@ -216,9 +216,7 @@ def test_parameter_file_documents_every_parameter():
     # The effects are the beam file's unless given: the file names them in a comment only.
     effects = [name for name in SIMULATOR_SCHEMA.names if name.startswith('effects.')]
     assert effects and all(f'# {name}' in text for name in effects)
-    assert defaults == {
-        k: v for k, v in SIMULATOR_SCHEMA.defaults().items() if k not in effects
-    }
+    assert defaults == {k: v for k, v in SIMULATOR_SCHEMA.defaults().items() if k not in effects}
     for name in set(SIMULATOR_SCHEMA.names) - set(effects):
         before = text.split(f'\n    {name}:')[0].splitlines()
         assert before[-1].strip().startswith('#'), f'{name} has no comment'
