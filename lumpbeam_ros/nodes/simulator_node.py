@@ -317,7 +317,7 @@ class SimulatorNode(Node):
         """Switches effects on the running beam, keeping its motion; or says why not."""
         if not hasattr(self, '_markers_stamp'):
             return None  # still in __init__: the beam is built with them
-        effects = self._base_beam.effects
+        effects = before = self._base_beam.effects
         for effect, value in values.items():
             effects = effects.with_effect(effect, value)
         self._base_beam = replace(self._base_beam, effects=effects)
@@ -328,8 +328,9 @@ class SimulatorNode(Node):
                 self._stream.set_beam(self.beam)
             except ValueError as exc:
                 return str(exc)
-        shown = ', '.join(f'{k}={v:g}' for k, v in values.items())
-        self.get_logger().info(f'effects set: {shown}')
+        shown = ', '.join(f'{k}={v:g}' for k, v in values.items() if v != before.value(k))
+        if shown:
+            self.get_logger().info(f'effects set: {shown}')
         return None
 
     def _apply(self, changes: Mapping[str, Any], new_beam: BeamParameters | None) -> None:
