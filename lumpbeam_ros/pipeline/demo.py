@@ -46,11 +46,17 @@ from lumpbeam_ros.pipeline.graph import (
     python_command,
     wait_for_graph,
 )
+from lumpbeam_ros.pipeline.live_diagnosis import live_diagnosis, live_diagnosis_lines
 from lumpbeam_ros.viz.markers import MARKERS_TOPIC
 
 SIMULATOR_MODULE = 'lumpbeam_ros.nodes.simulator_node'
 IDENTIFIER_MODULE = 'lumpbeam_ros.nodes.identifier_node'
 CAMERA_MODULE = 'lumpbeam_ros.nodes.camera_node'
+DIAGNOSIS_NODE_MODULE = 'lumpbeam_ros.nodes.diagnosis_node'
+#: The live diagnosis takes the ring-down up to this long after the release: short enough
+#: that the diagnosis (about 1 s of CPU per second of record) and the adoption land inside
+#: the replay, long enough for the workflow (2 s of poses after the release).
+LIVE_DECAY_S = 2.3
 DIAGNOSE_MODULE = 'lumpbeam_ros.cli.diagnose'
 CLI_MODULE = 'lumpbeam_ros.cli.main'
 IMAGE_TOPIC = '/camera/image_raw'
@@ -63,6 +69,7 @@ RECORDED_TOPICS = {
     '/beam_params': 'diagnostic_msgs/msg/DiagnosticArray',
     '/clock': 'rosgraph_msgs/msg/Clock',
     '/beam_markers': 'visualization_msgs/msg/MarkerArray',
+    '/model_discrepancy': 'diagnostic_msgs/msg/DiagnosticArray',
 }
 #: The player waits this long before its first message: its publishers must be discovered
 #: by the recorder's subscriptions first (a new process takes 1-3 s on a busy machine).
@@ -225,6 +232,8 @@ def replay(run: DemoRun) -> None:
             run.nodes.append(IDENTIFIER_MODULE)
             readers['/tip_pose'] += 1
             readers['/tip_load'] += 1
+        if module_available(DIAGNOSIS_NODE_MODULE):
+            _start_diagnosis_node(graph, run, readers)
         if run.with_camera:
             graph.start('camera', node_command(CAMERA_MODULE, *sim_time))
             run.nodes.append(CAMERA_MODULE)
@@ -235,7 +244,8 @@ def replay(run: DemoRun) -> None:
         )
         wait_for_graph(
             graph,
-            ['simulator_node', 'lumpbeam_recorder'],
+            ['simulator_node', 'lumpbeam_recorder']
+            + (['diagnosis_node'] if DIAGNOSIS_NODE_MODULE in run.nodes else []),
             readers,
             run.options.ready_timeout_s,
             announce=RECORDED_TOPICS,
@@ -267,6 +277,18 @@ def replay(run: DemoRun) -> None:
                     # The recording is complete; a node's untidy exit only deserves a note.
                     run.echo(f'  warning: {exc}')
     run.echo(f'  recorded {run.recorded_bag} with {", ".join(run.nodes)}')
+
+
+def _start_diagnosis_node(graph: ProcessGraph, run: DemoRun, readers: dict[str, int]) -> None:
+    """Starts the diagnosis node on the ring-down, adopting into the simulator."""
+    args = ['-p', 'use_sim_time:=true', '-p', 'adopt:=true']
+    args += ['-p', f'ring_down.decay_s:={LIVE_DECAY_S}']
+    if run.options.beam_config is not None:
+        args += ['-p', f'beam_config:={run.options.beam_config}']
+    graph.start('diagnosis', node_command(DIAGNOSIS_NODE_MODULE, *args))
+    run.nodes.append(DIAGNOSIS_NODE_MODULE)
+    for topic in ('/tip_pose', '/tip_load', '/tip_pose_predicted'):
+        readers[topic] += 1
 
 
 def normalize(run: DemoRun) -> None:
@@ -405,6 +427,9 @@ def summarize(run: DemoRun) -> None:
     }
     if run.diagnosis is not None:
         run.summary['diagnosis'] = run.diagnosis
+    live = live_diagnosis(run.recorded_bag, residual, run.drop.release_time_s)
+    if live is not None:
+        run.summary['live_diagnosis'] = live
     for line in summary_lines(run.summary):
         run.echo(line)
     from lumpbeam_ros.cli.output import write_json
@@ -445,6 +470,8 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
         )
     if 'diagnosis' in summary:
         lines += diagnosis_lines(summary['diagnosis'])
+    if 'live_diagnosis' in summary:
+        lines += live_diagnosis_lines(summary['live_diagnosis'])
     return lines
 
 

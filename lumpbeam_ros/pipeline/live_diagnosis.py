@@ -1,0 +1,100 @@
+"""What the diagnosis node did during the demo's replay, read back from the recording.
+
+The node publishes ``/model_discrepancy`` (``lumpbeam/diagnosis``): its verdict on the
+ring-down, and whether the simulator adopted the effects. The recording shows the rest: the
+simulator's live gap (``/tip_pose`` against ``/tip_pose_predicted``) before the adoption and
+after it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from lumpbeam_ros.bagio import BagReader
+from lumpbeam_ros.bagio.series import read_diagnostics
+from lumpbeam_ros.plots.demo import Residual
+
+TOPIC = '/model_discrepancy'
+STATUS_NAME = 'lumpbeam/diagnosis'
+#: The live gap after an adoption starts this long after it: the prediction published in
+#: the tick that applied it still carries the old model.
+SETTLE_S = 0.2
+
+
+def _number(values: dict[str, str], key: str) -> float:
+    try:
+        return float(values[key])
+    except (KeyError, ValueError):
+        return math.nan
+
+
+def live_diagnosis(bag: Any, residual: Residual, release_s: float) -> dict[str, Any] | None:
+    """The node's first diagnosis and adoption, and the live gap before and after it.
+
+    Args:
+        bag: The recording (with ``/model_discrepancy`` as the node published it).
+        residual: Measured against predicted tip z of the recording.
+        release_s: The load change the diagnosis followed, s.
+
+    Returns:
+        ``missing_effect``, ``missing_effects``, ``parameters``, the diagnosis's own
+        ``gap_before_rms_m``/``gap_after_rms_m``, ``adoption`` (what became of it),
+        ``adopted_at_s`` and the live ``prediction_before_rms_m`` (release to adoption) and
+        ``prediction_after_rms_m`` (adoption to the end); ``None`` when the recording holds
+        no diagnosis.
+    """
+    if TOPIC not in BagReader(bag).topics:
+        return None
+    found: dict[str, Any] | None = None
+    for stamp, statuses in read_diagnostics(bag, TOPIC):
+        for status in statuses:
+            values = dict(status.values)
+            if status.name != STATUS_NAME or 'missing_effect' not in values:
+                continue
+            if found is None:
+                names = values.get('missing_effects', '')
+                found = {
+                    'missing_effect': values['missing_effect'],
+                    'missing_effects': [n for n in names.split(',') if n],
+                    'message': status.message,
+                    'level': status.level,
+                    'gap_before_rms_m': _number(values, 'gap_before_rms_m'),
+                    'gap_after_rms_m': _number(values, 'gap_after_rms_m'),
+                    'window_s': [
+                        _number(values, 'window_start_s'),
+                        _number(values, 'window_end_s'),
+                    ],
+                    'adoption': values.get('adoption', ''),
+                    'adopted_at_s': math.nan,
+                }
+            found['adoption'] = values.get('adoption', found['adoption'])
+            if found['adoption'].startswith('adopted') and math.isnan(found['adopted_at_s']):
+                found['adopted_at_s'] = stamp
+    if found is None:
+        return None
+    adopted = found['adopted_at_s']
+    if math.isfinite(adopted):
+        found['prediction_before_rms_m'] = residual.rms(start=release_s, end=adopted)
+        found['prediction_after_rms_m'] = residual.rms(start=adopted + SETTLE_S)
+    return found
+
+
+def live_diagnosis_lines(live: dict[str, Any]) -> list[str]:
+    """The node's diagnosis for the summary: the effect named live, the gaps, the adoption."""
+    start, end = live['window_s']
+    names = ', '.join(live['missing_effects']) or live['missing_effect']
+    lines = [
+        f'live diagnosis (diagnosis_node, ring-down {start:.2f} to {end:.2f} s): {names}'
+        f' - {live["message"]}',
+        f'  its gap: RMS {live["gap_before_rms_m"] * 1e3:.3f} mm with the nominal model, '
+        f'{live["gap_after_rms_m"] * 1e3:.3f} mm with the effect added',
+        f'  adoption: {live["adoption"] or "-"}',
+    ]
+    if 'prediction_after_rms_m' in live:
+        lines.append(
+            f'  simulator live gap: RMS {live["prediction_before_rms_m"] * 1e3:.3f} mm from the '
+            f'release to the adoption at {live["adopted_at_s"]:.2f} s, '
+            f'{live["prediction_after_rms_m"] * 1e3:.3f} mm after it'
+        )
+    return lines
