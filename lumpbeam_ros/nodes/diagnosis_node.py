@@ -26,9 +26,10 @@ from __future__ import annotations
 
 import math
 import multiprocessing
+import signal
 import sys
 from collections.abc import Mapping, Sequence
-from concurrent.futures import Executor, Future, ProcessPoolExecutor, ThreadPoolExecutor
+from multiprocessing.pool import AsyncResult, Pool, ThreadPool
 from typing import Any
 
 import rclpy
@@ -40,6 +41,7 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
+from rclpy.task import Future as RclpyFuture
 from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio.convert import pose_values
@@ -68,8 +70,14 @@ WARN_PERIOD_S = 5.0
 POLL_PERIOD_S = 0.1
 
 
-def _warm_up() -> None:
-    """Imports the workflow in a new worker process before the first diagnosis needs it."""
+def _start_worker() -> None:
+    """Readies a worker process: it ignores Ctrl-C and imports the workflow.
+
+    Ctrl-C is for the node, which then ends the worker; the import is done now rather than
+    when the first diagnosis waits for it.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    import lumpbeam_ros.diagnose.workflow  # noqa: F401
 
 
 class DiagnosisNode(Node):
@@ -110,8 +118,8 @@ class DiagnosisNode(Node):
         self.last: LiveDiagnosis | None = None
         self.adoption = 'not asked'  # what became of the last adoption, for the status
         self._problem: str | None = None  # why the last stretch was not diagnosed
-        self._running: tuple[Stretch, float, Future[LiveDiagnosis]] | None = None
-        self._executor = self._make_executor(values['worker'])
+        self._running: tuple[Stretch, float, AsyncResult[LiveDiagnosis]] | None = None
+        self._pool = self._make_pool(values['worker'])
         self._parameters = AsyncParameterClient(self, values['simulator_node'])
 
         self._output = self.create_publisher(DiagnosticArray, TOPIC, 10)
@@ -126,15 +134,11 @@ class DiagnosisNode(Node):
         self.create_timer(values['status_period_s'], self._publish_status, clock=steady)
 
     @staticmethod
-    def _make_executor(worker: str) -> Executor:
+    def _make_pool(worker: str) -> Pool:
         if worker == 'thread':
-            return ThreadPoolExecutor(max_workers=1, thread_name_prefix='diagnosis')
+            return ThreadPool(1)
         # spawn: a forked copy of a process running DDS threads is not safe.
-        executor = ProcessPoolExecutor(
-            max_workers=1, mp_context=multiprocessing.get_context('spawn')
-        )
-        executor.submit(_warm_up)
-        return executor
+        return multiprocessing.get_context('spawn').Pool(1, initializer=_start_worker)
 
     # -- callbacks ----------------------------------------------------------------------------
 
@@ -201,7 +205,7 @@ class DiagnosisNode(Node):
             self._publish_status()
             return
         current = self.buffer.prediction_gap(stretch.start_s, stretch.end_s)
-        future = self._executor.submit(diagnose_live, record, self.beam, stretch)
+        future = self._pool.apply_async(diagnose_live, (record, self.beam, stretch))
         self._running = (stretch, current, future)
         self.get_logger().info(
             f'diagnosing {stretch.start_s:.3f} to {stretch.end_s:.3f} s ({len(record)} poses)'
@@ -210,11 +214,11 @@ class DiagnosisNode(Node):
     def _collect(self) -> None:
         assert self._running is not None
         stretch, current, future = self._running
-        if not future.done():
+        if not future.ready():
             return
         self._running = None
         try:
-            result = future.result()
+            result = future.get()
         except Exception as exc:  # noqa: BLE001 - a worker's failure must not stop the node
             self._problem = (
                 f'diagnosis of {stretch.start_s:.3f} to {stretch.end_s:.3f} s failed: {exc}'
@@ -269,7 +273,7 @@ class DiagnosisNode(Node):
         self.adoption = 'asked'
         future.add_done_callback(lambda f: self._adopted(f, values))
 
-    def _adopted(self, future: Future[Any], values: Mapping[str, float]) -> None:
+    def _adopted(self, future: RclpyFuture, values: Mapping[str, float]) -> None:
         node = self._parameters.remote_node_name
         try:
             results = future.result().results
@@ -335,7 +339,7 @@ class DiagnosisNode(Node):
 
     def destroy_node(self) -> None:
         """Stops the worker (a running diagnosis is abandoned), then the node."""
-        self._executor.shutdown(wait=False, cancel_futures=True)
+        self._pool.terminate()
         super().destroy_node()
 
 
