@@ -95,10 +95,15 @@ def read_clock(bag: str | Path) -> tuple[np.ndarray, np.ndarray]:
     return log_s, value_s
 
 
+#: Status topics a normalized recording keeps, each message at its header stamp.
+DIAGNOSTIC_TOPICS = ('/beam_params', '/model_discrepancy')
+
+
 def normalize_recording(recorded: str | Path, out: str | Path) -> Path:
     """Copies a recording with every message logged at its sim time.
 
-    Poses, ``/beam_params`` and ``/beam_markers`` are logged at their header stamps;
+    Poses, ``/beam_params``, ``/model_discrepancy`` and ``/beam_markers`` are logged at their
+    header stamps;
     ``/tip_load`` readings at the ``/clock`` shown when they were recorded (readings before
     the first ``/clock`` are dropped: they have no sim time).
 
@@ -126,9 +131,10 @@ def normalize_recording(recorded: str | Path, out: str | Path) -> Path:
         for t, kg in zip(load_t, loads.kg, strict=True):
             if np.isfinite(t):
                 bag.write_float('/tip_load', float(t), float(kg))
-        if '/beam_params' in reader.topics:
-            for _, msg in reader.messages('/beam_params', 'diagnostic_msgs/msg/DiagnosticArray'):
-                bag.write_message('/beam_params', msg, convert.time_ns(msg.header.stamp))
+        for topic in DIAGNOSTIC_TOPICS:
+            if topic in reader.topics:
+                for _, msg in reader.messages(topic, 'diagnostic_msgs/msg/DiagnosticArray'):
+                    bag.write_message(topic, msg, convert.time_ns(msg.header.stamp))
         if MARKERS_TOPIC in reader.topics:
             for _, msg in reader.messages(MARKERS_TOPIC, MARKER_ARRAY_TYPE):
                 if msg.markers:  # all stamped alike by the simulator node
