@@ -155,10 +155,11 @@ class DiagnosisNode(Node):
             stamp_ns, _, z, pitch, _ = pose_values(msg)
         except LumpbeamError:
             stamp_ns, z, pitch = 0, math.nan, math.nan
-        if not all(math.isfinite(v) for v in (z, pitch)) or stamp_ns <= 0:
+        if not all(math.isfinite(v) for v in (z, pitch)):
             self.non_finite += 1
             self.get_logger().warning(
-                f'{topic} with a non-finite value or no stamp: dropped ({self.non_finite} so far)',
+                f'{topic} with a non-finite position or orientation: dropped '
+                f'({self.non_finite} so far)',
                 throttle_duration_sec=WARN_PERIOD_S,
             )
             return None

@@ -46,7 +46,11 @@ from lumpbeam_ros.pipeline.graph import (
     python_command,
     wait_for_graph,
 )
-from lumpbeam_ros.pipeline.live_diagnosis import live_diagnosis, live_diagnosis_lines
+from lumpbeam_ros.pipeline.live_diagnosis import (
+    live_diagnosis,
+    live_diagnosis_lines,
+    wait_for_verdict,
+)
 from lumpbeam_ros.viz.markers import MARKERS_TOPIC
 
 SIMULATOR_MODULE = 'lumpbeam_ros.nodes.simulator_node'
@@ -57,6 +61,8 @@ DIAGNOSIS_NODE_MODULE = 'lumpbeam_ros.nodes.diagnosis_node'
 #: that the diagnosis (about 1 s of CPU per second of record) and the adoption land inside
 #: the replay, long enough for the workflow (2 s of poses after the release).
 LIVE_DECAY_S = 2.3
+#: Longest wait after the replay for the live diagnosis (tens of seconds on a busy machine).
+VERDICT_WAIT_S = 120.0
 DIAGNOSE_MODULE = 'lumpbeam_ros.cli.diagnose'
 CLI_MODULE = 'lumpbeam_ros.cli.main'
 IMAGE_TOPIC = '/camera/image_raw'
@@ -267,6 +273,8 @@ def replay(run: DemoRun) -> None:
         )
         others = [name for name in graph.children if name != 'player']
         graph.wait('player', run.options.duration_s * 2 + 30.0, watch=others)
+        if DIAGNOSIS_NODE_MODULE in run.nodes and not wait_for_verdict(graph, VERDICT_WAIT_S):
+            run.echo(f'  warning: no live diagnosis within {VERDICT_WAIT_S:g} s of the replay')
         time.sleep(0.5)  # the last messages travel to the recorder before it stops
         graph.interrupt('recorder')  # must stop cleanly: it closes the bag
         for name in others:

@@ -9,10 +9,12 @@ after it.
 from __future__ import annotations
 
 import math
+import time
 from typing import Any
 
 from lumpbeam_ros.bagio import BagReader
 from lumpbeam_ros.bagio.series import read_diagnostics
+from lumpbeam_ros.pipeline.graph import ProcessGraph
 from lumpbeam_ros.plots.demo import Residual
 
 TOPIC = '/model_discrepancy'
@@ -20,6 +22,57 @@ STATUS_NAME = 'lumpbeam/diagnosis'
 #: The live gap after an adoption starts this long after it: the prediction published in
 #: the tick that applied it still carries the old model.
 SETTLE_S = 0.2
+
+
+def _settled(values: dict[str, str], message: str) -> bool:
+    """Whether a status is a final word: a diagnosis whose adoption is decided, or a refusal."""
+    if 'missing_effect' in values:
+        return values.get('adoption', '') != 'asked'
+    return message.startswith(('not diagnosed', 'diagnosis of'))
+
+
+def wait_for_verdict(graph: ProcessGraph, timeout_s: float) -> bool:
+    """Waits until the diagnosis node has said its first verdict (and adopted or not).
+
+    A diagnosis takes seconds of CPU; on a busy machine it may end after the replay, and the
+    nodes must still be running for its adoption to reach the simulator and the recorder.
+
+    Args:
+        graph: The running graph (its domain).
+        timeout_s: Longest wait, s.
+
+    Returns:
+        Whether the verdict came in time.
+
+    Raises:
+        LumpbeamError: A child of the graph exited meanwhile.
+    """
+    import rclpy
+    from diagnostic_msgs.msg import DiagnosticArray
+    from rclpy.context import Context
+    from rclpy.node import Node
+
+    context = Context()
+    rclpy.init(context=context, domain_id=graph.domain_id)
+    settled: list[bool] = []
+
+    def on_status(msg: DiagnosticArray) -> None:
+        for status in msg.status:
+            values = {kv.key: kv.value for kv in status.values}
+            if status.name == STATUS_NAME and _settled(values, status.message):
+                settled.append(True)
+
+    try:
+        probe = Node('lumpbeam_demo_verdict', context=context)
+        probe.create_subscription(DiagnosticArray, TOPIC, on_status, 10)
+        deadline = time.monotonic() + timeout_s
+        while not settled and time.monotonic() < deadline:
+            graph.check_running()
+            rclpy.spin_once(probe, timeout_sec=0.1)
+        probe.destroy_node()
+    finally:
+        rclpy.try_shutdown(context=context)
+    return bool(settled)
 
 
 def _number(values: dict[str, str], key: str) -> float:
