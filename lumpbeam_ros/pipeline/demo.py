@@ -273,7 +273,8 @@ def replay(run: DemoRun) -> None:
         )
         others = [name for name in graph.children if name != 'player']
         graph.wait('player', run.options.duration_s * 2 + 30.0, watch=others)
-        if DIAGNOSIS_NODE_MODULE in run.nodes and not wait_for_verdict(graph, VERDICT_WAIT_S):
+        live = DIAGNOSIS_NODE_MODULE in run.nodes
+        if live and not wait_for_verdict(graph, VERDICT_WAIT_S, others):
             run.echo(f'  warning: no live diagnosis within {VERDICT_WAIT_S:g} s of the replay')
         time.sleep(0.5)  # the last messages travel to the recorder before it stops
         graph.interrupt('recorder')  # must stop cleanly: it closes the bag

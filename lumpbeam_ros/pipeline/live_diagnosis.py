@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from typing import Any
 
 from lumpbeam_ros.bagio import BagReader
@@ -31,7 +32,7 @@ def _settled(values: dict[str, str], message: str) -> bool:
     return message.startswith(('not diagnosed', 'diagnosis of'))
 
 
-def wait_for_verdict(graph: ProcessGraph, timeout_s: float) -> bool:
+def wait_for_verdict(graph: ProcessGraph, timeout_s: float, watch: Sequence[str]) -> bool:
     """Waits until the diagnosis node has said its first verdict (and adopted or not).
 
     A diagnosis takes seconds of CPU; on a busy machine it may end after the replay, and the
@@ -40,6 +41,7 @@ def wait_for_verdict(graph: ProcessGraph, timeout_s: float) -> bool:
     Args:
         graph: The running graph (its domain).
         timeout_s: Longest wait, s.
+        watch: Children that must keep running meanwhile.
 
     Returns:
         Whether the verdict came in time.
@@ -67,7 +69,7 @@ def wait_for_verdict(graph: ProcessGraph, timeout_s: float) -> bool:
         probe.create_subscription(DiagnosticArray, TOPIC, on_status, 10)
         deadline = time.monotonic() + timeout_s
         while not settled and time.monotonic() < deadline:
-            graph.check_running()
+            graph.check_running(watch)
             rclpy.spin_once(probe, timeout_sec=0.1)
         probe.destroy_node()
     finally:
