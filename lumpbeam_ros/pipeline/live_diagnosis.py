@@ -52,6 +52,7 @@ def wait_for_verdict(graph: ProcessGraph, timeout_s: float, watch: Sequence[str]
     import rclpy
     from diagnostic_msgs.msg import DiagnosticArray
     from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
     from rclpy.node import Node
 
     context = Context()
@@ -67,10 +68,13 @@ def wait_for_verdict(graph: ProcessGraph, timeout_s: float, watch: Sequence[str]
     try:
         probe = Node('lumpbeam_demo_verdict', context=context)
         probe.create_subscription(DiagnosticArray, TOPIC, on_status, 10)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(probe)
         deadline = time.monotonic() + timeout_s
         while not settled and time.monotonic() < deadline:
             graph.check_running(watch)
-            rclpy.spin_once(probe, timeout_sec=0.1)
+            executor.spin_once(timeout_sec=0.1)
+        executor.shutdown()
         probe.destroy_node()
     finally:
         rclpy.try_shutdown(context=context)
