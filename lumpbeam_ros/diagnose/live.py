@@ -340,6 +340,11 @@ class LiveBuffer:
     def record(self, stretch: Stretch) -> Record:
         """The measured poses of a stretch as a diagnosis record.
 
+        A load change is dated when its ``/tip_load`` reading arrived (``Float64`` has no
+        stamp), not from the poses: a release timed from the measured onset would absorb a
+        ``sensor_latency``, the very delay the diagnosis looks for. A reading delivered late
+        therefore shortens the latency found by as much.
+
         Args:
             stretch: A stretch of :meth:`next_stretch`.
 
