@@ -150,7 +150,14 @@ def live_diagnosis_lines(live: dict[str, Any]) -> list[str]:
         f'{live["gap_after_rms_m"] * 1e3:.3f} mm with the effect added',
         f'  adoption: {live["adoption"] or "-"}',
     ]
-    if 'prediction_after_rms_m' in live:
+    after = live.get('prediction_after_rms_m', math.nan)
+    if 'prediction_after_rms_m' in live and not math.isfinite(after):
+        lines.append(
+            f'  simulator live gap: RMS {live["prediction_before_rms_m"] * 1e3:.3f} mm from the '
+            f'release on; the adoption at {live["adopted_at_s"]:.2f} s came after the replay '
+            '(a longer --duration shows the gap after it)'
+        )
+    elif 'prediction_after_rms_m' in live:
         lines.append(
             f'  simulator live gap: RMS {live["prediction_before_rms_m"] * 1e3:.3f} mm from the '
             f'release to the adoption at {live["adopted_at_s"]:.2f} s, '
