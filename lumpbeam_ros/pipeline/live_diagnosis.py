@@ -13,6 +13,8 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
+import numpy as np
+
 from lumpbeam_ros.bagio import BagReader
 from lumpbeam_ros.bagio.series import read_diagnostics
 from lumpbeam_ros.pipeline.graph import ProcessGraph
@@ -134,9 +136,23 @@ def live_diagnosis(bag: Any, residual: Residual, release_s: float) -> dict[str, 
         return None
     adopted = found['adopted_at_s']
     if math.isfinite(adopted):
-        found['prediction_before_rms_m'] = residual.rms(start=release_s, end=adopted)
-        found['prediction_after_rms_m'] = residual.rms(start=adopted + SETTLE_S)
+        spans = {'before': (release_s, adopted), 'after': (adopted + SETTLE_S, math.inf)}
+        for name, (start, end) in spans.items():
+            found[f'prediction_{name}_rms_m'] = residual.rms(start=start, end=end)
+            found[f'prediction_{name}_relative'] = _relative(residual, start, end)
     return found
+
+
+def _relative(residual: Residual, start: float, end: float) -> float:
+    """The RMS gap over a span as a fraction of the measured swing's RMS (its std) there.
+
+    The swing decays while the gaps are compared, and a timing or latency error grows with
+    the swing: the fraction compares spans of different amplitude fairly.
+    """
+    keep = (residual.t >= start) & (residual.t < end)
+    if np.count_nonzero(keep) < 2:
+        return math.nan
+    return residual.rms(start=start, end=end) / float(np.std(residual.measured[keep]))
 
 
 def live_diagnosis_lines(live: dict[str, Any]) -> list[str]:
@@ -159,8 +175,9 @@ def live_diagnosis_lines(live: dict[str, Any]) -> list[str]:
         )
     elif 'prediction_after_rms_m' in live:
         lines.append(
-            f'  simulator live gap: RMS {live["prediction_before_rms_m"] * 1e3:.3f} mm from the '
-            f'release to the adoption at {live["adopted_at_s"]:.2f} s, '
-            f'{live["prediction_after_rms_m"] * 1e3:.3f} mm after it'
+            f'  simulator live gap: RMS {live["prediction_before_rms_m"] * 1e3:.3f} mm '
+            f'({live["prediction_before_relative"]:.1%} of the swing) from the release to the '
+            f'adoption at {live["adopted_at_s"]:.2f} s, {after * 1e3:.3f} mm '
+            f'({live["prediction_after_relative"]:.1%} of the swing) after it'
         )
     return lines
