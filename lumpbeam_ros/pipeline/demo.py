@@ -273,7 +273,9 @@ def replay(run: DemoRun) -> None:
         )
         others = [name for name in graph.children if name != 'player']
         graph.wait('player', run.options.duration_s * 2 + 30.0, watch=others)
-        live = DIAGNOSIS_NODE_MODULE in run.nodes
+        # Only a record that holds the whole ring-down gets a verdict to wait for.
+        ends = run.drop.release_time_s + LIVE_DECAY_S < run.options.duration_s
+        live = DIAGNOSIS_NODE_MODULE in run.nodes and ends
         if live and not wait_for_verdict(graph, VERDICT_WAIT_S, others):
             run.echo(f'  warning: no live diagnosis within {VERDICT_WAIT_S:g} s of the replay')
         time.sleep(0.5)  # the last messages travel to the recorder before it stops
