@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 import multiprocessing
+import os
 import signal
 import sys
 from collections.abc import Mapping, Sequence
@@ -66,17 +67,22 @@ TOPIC = '/model_discrepancy'
 BASE_FRAME = 'beam_base'
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0
+#: How much lower than the node's the worker process's scheduling priority is.
+WORKER_NICENESS = 10
 #: How often the node looks for a complete stretch and a finished diagnosis, s.
 POLL_PERIOD_S = 0.1
 
 
 def _start_worker() -> None:
-    """Readies a worker process: it ignores Ctrl-C and imports the workflow.
+    """Readies a worker process: it ignores Ctrl-C, yields the CPU, imports the workflow.
 
-    Ctrl-C is for the node, which then ends the worker; the import is done now rather than
+    Ctrl-C is for the node, which then ends the worker. A diagnosis is background work: at a
+    lower priority it does not starve the nodes that must keep up with the stream (a camera
+    node tracking frames) on a machine with few cores. The import is done now rather than
     when the first diagnosis waits for it.
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    os.nice(WORKER_NICENESS)
     import lumpbeam_ros.diagnose.workflow  # noqa: F401
 
 
