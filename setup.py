@@ -48,6 +48,7 @@ setup(
             'identifier_node = lumpbeam_ros.nodes.identifier_node:main',
             'simulator_node = lumpbeam_ros.nodes.simulator_node:main',
             'camera_node = lumpbeam_ros.nodes.camera_node:main',
+            'diagnosis_node = lumpbeam_ros.nodes.diagnosis_node:main',
         ],
     },
 )

@@ -122,6 +122,9 @@ class PredictionStream:
     def set_beam(self, beam: BeamParameters) -> None:
         """Swaps the beam's parameters, keeping the motion (angles, rates, load, time).
 
+        A longer ``sensor_latency`` holds the pose for the difference (the samples then
+        show the motion that much later, as a later camera would); a shorter one skips it.
+
         Args:
             beam: The new beam, with the same number of segments.
 
@@ -180,11 +183,12 @@ class PredictionStream:
             return _empty()
         stamps = np.arange(self._next_index, last_index + 1) / self._rate_hz
         self._next_index = last_index + 1
-        physical = stamps - self._beam.effects.latency_s
+        simulation = self._simulation
+        # Not before the simulation's present: a latency made longer holds the pose.
+        physical = np.maximum(stamps - self._beam.effects.latency_s, simulation.time)
         n = self._beam.n_segments
         phi = np.empty((stamps.size, n))
         loads = np.empty(stamps.size)
-        simulation = self._simulation
         lo = 0
         while self._events and self._events[0][0] <= physical[-1]:
             when, load = self._events.pop(0)

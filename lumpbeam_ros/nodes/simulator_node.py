@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -40,14 +41,14 @@ from visualization_msgs.msg import MarkerArray
 from lumpbeam_ros.bagio.convert import NS_PER_S, pitch_to_quaternion, seconds_to_ns
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.adopt import adopt_identified
-from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
+from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters, load_beam_config
 from lumpbeam_ros.model.statics import static_tip_deflection
 from lumpbeam_ros.model.stream import PredictionStream
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.nodes.counts import write_counts
 from lumpbeam_ros.nodes.msgtypes import topic_qos
 from lumpbeam_ros.nodes.parameters import declare_parameters
-from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA
+from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA, effect_parameter_name
 from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.viz.markers import (
     MARKERS_TOPIC,
@@ -125,6 +126,8 @@ class SimulatorNode(Node):
         #: Poses published on ``/tip_pose_predicted``, marker arrays on ``/beam_markers``.
         self.published = 0
         self.markers_published = 0
+        # Parameters from --params-file, -p and the overrides.
+        self._with_effect_parameters(self._base_beam, set(self._parameter_overrides))
 
         # A late tick publishes several periods' samples in one burst: the stream profile's
         # history holds them (lumpbeam_ros.bagio.qos).
@@ -290,12 +293,46 @@ class SimulatorNode(Node):
                 f'adopted k_tE={k_total:.1f} N m/rad, zeta={zeta:.5f} (c_tE={beam.c_total:.4f})'
             )
 
+    def _with_effect_parameters(self, beam: BeamParameters, given: set[str]) -> BeamParameters:
+        """The beam with the effect parameters given at start; the others take its values.
+
+        Args:
+            beam: The beam file's beam.
+            given: Parameter names set by ``--params-file``, ``-p`` or the overrides.
+
+        Returns:
+            The beam the node runs with.
+        """
+        effects = beam.effects
+        from_file = []
+        for effect in EFFECT_PARAMETERS:
+            name = effect_parameter_name(effect)
+            if name in given:
+                effects = effects.with_effect(effect, self._settings[name])
+            else:
+                from_file.append(Parameter(name, value=float(effects.value(effect))))
+        beam = replace(beam, effects=effects)
+        self._base_beam = beam
+        # So that `ros2 param get` shows the effect the beam runs with.
+        self.set_parameters(from_file)
+        return beam
+
     def _on_change(self, changes: Mapping[str, Any]) -> str | None:
         """Applies parameter changes the schema accepted; refuses a beam file that fails."""
         new_beam = None
+        effects = {
+            effect: float(changes[effect_parameter_name(effect)])
+            for effect in EFFECT_PARAMETERS
+            if effect_parameter_name(effect) in changes
+        }
+        if effects:
+            problem = self._apply_effects(effects)
+            if problem is not None:
+                return problem
         try:
             if 'beam_config' in changes:
                 new_beam = load_beam(changes['beam_config'])
+                new_beam = replace(new_beam, effects=self._base_beam.effects)
             if 'camera_config' in changes:
                 self._board = load_board(changes['camera_config'])
         except LumpbeamError as exc:
@@ -304,6 +341,26 @@ class SimulatorNode(Node):
         return None
 
     # -- helpers ------------------------------------------------------------------------------
+
+    def _apply_effects(self, values: Mapping[str, float]) -> str | None:
+        """Switches effects on the running beam, keeping its motion; or says why not."""
+        if not hasattr(self, '_markers_stamp'):
+            return None  # still in __init__: the beam is built with them
+        effects = before = self._base_beam.effects
+        for effect, value in values.items():
+            effects = effects.with_effect(effect, value)
+        self._base_beam = replace(self._base_beam, effects=effects)
+        if self._adopted_beam is not None:
+            self._adopted_beam = replace(self._adopted_beam, effects=effects)
+        if self._stream is not None:
+            try:
+                self._stream.set_beam(self.beam)
+            except ValueError as exc:
+                return str(exc)
+        shown = ', '.join(f'{k}={v:g}' for k, v in values.items() if v != before.value(k))
+        if shown:
+            self.get_logger().info(f'effects set: {shown}')
+        return None
 
     def _apply(self, changes: Mapping[str, Any], new_beam: BeamParameters | None) -> None:
         self._settings.update(changes)

@@ -9,12 +9,18 @@ from __future__ import annotations
 import sys
 
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA
+from lumpbeam_ros.params.diagnosis_params import DIAGNOSIS_SCHEMA
 from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA
 from lumpbeam_ros.params.schema import ParameterSchema, ParameterSpec, ParameterValue
 from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA
 
 #: Every node's schema, in the order the reference lists them.
-SCHEMAS: tuple[ParameterSchema, ...] = (CAMERA_SCHEMA, IDENTIFIER_SCHEMA, SIMULATOR_SCHEMA)
+SCHEMAS: tuple[ParameterSchema, ...] = (
+    CAMERA_SCHEMA,
+    DIAGNOSIS_SCHEMA,
+    IDENTIFIER_SCHEMA,
+    SIMULATOR_SCHEMA,
+)
 
 _HEADER = """\
 # Node parameters

@@ -2,7 +2,38 @@
 
 from __future__ import annotations
 
+from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, Effects
 from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec
+
+#: Physical bounds and unit of each effect's parameter; an effect missing here is only
+#: checked to be finite.
+EFFECT_BOUNDS: dict[str, tuple[Bounds, str]] = {
+    'k_base_nm_per_rad': (Bounds(0.0), 'N m/rad'),  # 0: a rigid mount
+    'torque_nm': (Bounds(0.0, 1000.0), 'N m'),
+    'c_q': (Bounds(0.0, 1000.0), 'N s^2/m^2'),
+    'mass_kg': (Bounds(0.0, 1000.0), 'kg'),
+    'latency_s': (Bounds(0.0, 1.0), 's'),
+}
+
+
+def effect_parameter_name(effect: str) -> str:
+    """The simulator's parameter of an effect: ``effects.<effect>.<contract parameter>``."""
+    return f'effects.{effect}.{EFFECT_PARAMETERS[effect]}'
+
+
+def _effect_spec(effect: str, parameter: str) -> ParameterSpec:
+    bounds, unit = EFFECT_BOUNDS.get(parameter, (None, ''))
+    return ParameterSpec(
+        effect_parameter_name(effect),
+        'double',
+        Effects().value(effect),
+        f'the {effect} effect the beam runs with (as in the beam file, whose value it takes '
+        'at start unless given); set at run time, the beam keeps its motion',
+        unit,
+        bounds,
+        read_only=False,
+    )
+
 
 SIMULATOR_SCHEMA = ParameterSchema(
     node='simulator_node',
@@ -90,5 +121,6 @@ SIMULATOR_SCHEMA = ParameterSchema(
             "package's camera.yaml",
             read_only=False,
         ),
+        *(_effect_spec(effect, parameter) for effect, parameter in EFFECT_PARAMETERS.items()),
     ),
 )

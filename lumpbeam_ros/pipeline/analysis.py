@@ -95,10 +95,15 @@ def read_clock(bag: str | Path) -> tuple[np.ndarray, np.ndarray]:
     return log_s, value_s
 
 
+#: Status topics a normalized recording keeps, each message at its header stamp.
+DIAGNOSTIC_TOPICS = ('/beam_params', '/model_discrepancy')
+
+
 def normalize_recording(recorded: str | Path, out: str | Path) -> Path:
     """Copies a recording with every message logged at its sim time.
 
-    Poses, ``/beam_params`` and ``/beam_markers`` are logged at their header stamps;
+    Poses, ``/beam_params``, ``/model_discrepancy`` and ``/beam_markers`` are logged at their
+    header stamps;
     ``/tip_load`` readings at the ``/clock`` shown when they were recorded (readings before
     the first ``/clock`` are dropped: they have no sim time).
 
@@ -120,7 +125,7 @@ def normalize_recording(recorded: str | Path, out: str | Path) -> Path:
     # comes in its own order, and a bag's messages are in log-time order.
     rows: list[tuple[int, str, object]] = []
     types = {topic: 'geometry_msgs/msg/PoseStamped' for topic in POSE_TOPICS}
-    types['/beam_params'] = 'diagnostic_msgs/msg/DiagnosticArray'
+    types.update({topic: 'diagnostic_msgs/msg/DiagnosticArray' for topic in DIAGNOSTIC_TOPICS})
     for topic, msgtype in types.items():
         if topic in reader.topics:
             rows += [

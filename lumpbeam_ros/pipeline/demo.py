@@ -51,11 +51,23 @@ from lumpbeam_ros.pipeline.graph import (
     wait_for_graph,
     wait_for_quiet,
 )
+from lumpbeam_ros.pipeline.live_diagnosis import (
+    live_diagnosis,
+    live_diagnosis_lines,
+    wait_for_verdict,
+)
 from lumpbeam_ros.viz.markers import MARKERS_TOPIC
 
 SIMULATOR_MODULE = 'lumpbeam_ros.nodes.simulator_node'
 IDENTIFIER_MODULE = 'lumpbeam_ros.nodes.identifier_node'
 CAMERA_MODULE = 'lumpbeam_ros.nodes.camera_node'
+DIAGNOSIS_NODE_MODULE = 'lumpbeam_ros.nodes.diagnosis_node'
+#: The live diagnosis takes the ring-down up to this long after the release: short enough
+#: that the diagnosis (about 1 s of CPU per second of record) and the adoption land inside
+#: the replay, long enough for the workflow (2 s of poses after the release).
+LIVE_DECAY_S = 2.3
+#: Longest wait after the replay for the live diagnosis (tens of seconds on a busy machine).
+VERDICT_WAIT_S = 120.0
 DIAGNOSE_MODULE = 'lumpbeam_ros.cli.diagnose'
 CLI_MODULE = 'lumpbeam_ros.cli.main'
 IMAGE_TOPIC = '/camera/image_raw'
@@ -68,6 +80,7 @@ RECORDED_TOPICS = {
     '/beam_params': 'diagnostic_msgs/msg/DiagnosticArray',
     '/clock': 'rosgraph_msgs/msg/Clock',
     '/beam_markers': 'visualization_msgs/msg/MarkerArray',
+    '/model_discrepancy': 'diagnostic_msgs/msg/DiagnosticArray',
 }
 #: Who publishes each recorded topic, by the name of its counts file
 #: (:mod:`lumpbeam_ros.nodes.counts`); ``/tip_pose`` comes from the camera node when it runs.
@@ -77,6 +90,7 @@ PUBLISHERS = {
     '/tip_pose_predicted': 'simulator_node',
     '/beam_markers': 'simulator_node',
     '/beam_params': 'identifier_node',
+    '/model_discrepancy': 'diagnosis_node',
     '/clock': 'player',
 }
 #: The topics the nodes are still producing when the player is done.
@@ -257,6 +271,8 @@ def replay(run: DemoRun) -> None:
             run.nodes.append(IDENTIFIER_MODULE)
             readers['/tip_pose'] += 1
             readers['/tip_load'] += 1
+        if module_available(DIAGNOSIS_NODE_MODULE):
+            _start_diagnosis_node(graph, run, readers)
         if run.with_camera:
             graph.start('camera', node_command(CAMERA_MODULE, *sim_time))
             run.nodes.append(CAMERA_MODULE)
@@ -267,7 +283,8 @@ def replay(run: DemoRun) -> None:
         )
         wait_for_graph(
             graph,
-            ['simulator_node', 'lumpbeam_recorder'],
+            ['simulator_node', 'lumpbeam_recorder']
+            + (['diagnosis_node'] if DIAGNOSIS_NODE_MODULE in run.nodes else []),
             readers,
             run.options.ready_timeout_s,
             announce=RECORDED_TOPICS,
@@ -289,6 +306,11 @@ def replay(run: DemoRun) -> None:
         )
         others = [name for name in graph.children if name != 'player']
         graph.wait('player', run.options.duration_s * 2 + 30.0, watch=others)
+        # Only a record that holds the whole ring-down gets a verdict to wait for.
+        ends = run.drop.release_time_s + LIVE_DECAY_S < run.options.duration_s
+        live = DIAGNOSIS_NODE_MODULE in run.nodes and ends
+        if live and not wait_for_verdict(graph, VERDICT_WAIT_S, others):
+            run.echo(f'  warning: no live diagnosis within {VERDICT_WAIT_S:g} s of the replay')
         # The camera node may be a few frames behind: let the nodes finish their queues, then
         # stop them before the recorder, which takes in what they sent last.
         trailing = dict(TRAILING_TOPICS)
@@ -353,6 +375,18 @@ def count_lines(
             f'{shown["tracked"]} tracked'
         )
     return lines
+
+
+def _start_diagnosis_node(graph: ProcessGraph, run: DemoRun, readers: dict[str, int]) -> None:
+    """Starts the diagnosis node on the ring-down, adopting into the simulator."""
+    args = ['-p', 'use_sim_time:=true', '-p', 'adopt:=true']
+    args += ['-p', f'ring_down.decay_s:={LIVE_DECAY_S}']
+    if run.options.beam_config is not None:
+        args += ['-p', f'beam_config:={run.options.beam_config}']
+    graph.start('diagnosis', node_command(DIAGNOSIS_NODE_MODULE, *args))
+    run.nodes.append(DIAGNOSIS_NODE_MODULE)
+    for topic in ('/tip_pose', '/tip_load', '/tip_pose_predicted'):
+        readers[topic] += 1
 
 
 def normalize(run: DemoRun) -> None:
@@ -493,6 +527,9 @@ def summarize(run: DemoRun) -> None:
     }
     if run.diagnosis is not None:
         run.summary['diagnosis'] = run.diagnosis
+    live = live_diagnosis(run.recorded_bag, residual, run.drop.release_time_s)
+    if live is not None:
+        run.summary['live_diagnosis'] = live
     for line in summary_lines(run.summary):
         run.echo(line)
     from lumpbeam_ros.cli.output import write_json
@@ -533,6 +570,8 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
         )
     if 'diagnosis' in summary:
         lines += diagnosis_lines(summary['diagnosis'])
+    if 'live_diagnosis' in summary:
+        lines += live_diagnosis_lines(summary['live_diagnosis'])
     return lines
 
 

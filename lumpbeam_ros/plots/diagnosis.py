@@ -1,4 +1,8 @@
-"""Figures of a diagnosis: the fits, the residuals before and after, the candidates' scores."""
+"""Figures of a diagnosis: fits, residuals before and after, signatures, candidates' scores.
+
+The signatures are what singled out each effect: the time shift at the load event, the
+frequency against the amplitude, the envelope law of the peaks.
+"""
 
 from __future__ import annotations
 
@@ -10,12 +14,29 @@ matplotlib.use('Agg')  # files only: no display on a robot or a CI runner
 
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
 
+from lumpbeam_ros.diagnose.gap import SETTLE_S  # noqa: E402
+from lumpbeam_ros.diagnose.live import named_effects  # noqa: E402
+from lumpbeam_ros.diagnose.signatures import decay_peaks  # noqa: E402
 from lumpbeam_ros.diagnose.workflow import Diagnosis  # noqa: E402
 from lumpbeam_ros.errors import LumpbeamError  # noqa: E402
+from lumpbeam_ros.model.trajectory import TipTrajectory  # noqa: E402
 
 #: The files :func:`plot_diagnosis` writes.
-FIGURES = ('diagnosis_fit.png', 'diagnosis_residuals.png', 'diagnosis_candidates.png')
+FIGURES = (
+    'diagnosis_fit.png',
+    'diagnosis_residuals.png',
+    'diagnosis_signatures.png',
+    'diagnosis_candidates.png',
+)
+
+#: Which effects each signature panel speaks for.
+SIGNATURE_EFFECTS = {
+    'time_shift': ('sensor_latency',),
+    'frequency': ('cubic_stiffness', 'added_mass', 'base_compliance'),
+    'envelope': ('coulomb_friction', 'quadratic_drag'),
+}
 
 
 def _fit_figure(d: Diagnosis, path: Path) -> None:
@@ -51,6 +72,107 @@ def _residual_figure(d: Diagnosis, path: Path) -> None:
     ax.set_title(f'Residuals before and after: missing effect = {d.missing_effect}')
     ax.legend(loc='upper right', fontsize=8)
     fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def _refined(t: np.ndarray, z: np.ndarray, peak_t: np.ndarray) -> np.ndarray:
+    """Peak times between samples: the vertex of the parabola through each peak's samples."""
+    i = np.clip(np.searchsorted(t, peak_t), 1, t.size - 2)
+    left, mid, right = z[i - 1], z[i], z[i + 1]
+    curvature = left - 2.0 * mid + right
+    step = np.where(curvature != 0.0, 0.5 * (left - right) / np.where(curvature, curvature, 1), 0)
+    return t[i] + np.clip(step, -1.0, 1.0) * (t[i + 1] - t[i - 1]) / 2.0
+
+
+def _swing(
+    t: np.ndarray, z: np.ndarray, event: float, level: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mid-times, amplitudes and frequencies of a decay, one per full period.
+
+    Each period runs over three successive peaks (both signs): its frequency is the inverse
+    of the time between the first and the third, its amplitude the mean of the three
+    weighted 1:2:1, which cancels an error in ``level``.
+    """
+    peak_t, peak_a = decay_peaks(t, z, event, level)
+    if peak_t.size < 3:
+        return np.empty(0), np.empty(0), np.empty(0)
+    peak_t = _refined(t, z, peak_t)
+    period = peak_t[2:] - peak_t[:-2]
+    amplitude = 0.25 * (peak_a[:-2] + 2.0 * peak_a[1:-1] + peak_a[2:])
+    ok = (period > 0.5 * np.median(period)) & (period < 2.0 * np.median(period))
+    return peak_t[1:-1][ok], amplitude[ok], 1.0 / period[ok]
+
+
+def signature_figure(d: Diagnosis) -> Figure:
+    """The signatures that single out the effects, measured against the nominal model.
+
+    Three panels: the time shift at the load event (``sensor_latency``), the frequency
+    against the amplitude of the swing (``cubic_stiffness`` drifts with amplitude;
+    ``added_mass`` and ``base_compliance`` move it as a whole), and the envelope law of the
+    peaks (exponential: viscous only; linear: ``coulomb_friction``; faster at large
+    amplitude: ``quadratic_drag``). A panel's title is green when it speaks for an effect
+    the diagnosis named.
+
+    Args:
+        d: The diagnosis.
+
+    Returns:
+        The figure (the caller saves and closes it).
+    """
+    r, sig = d.record, d.signatures
+    event = r.event_time_s
+    level = float(np.mean(r.z[r.t >= event + SETTLE_S]))
+    named = {name for name, _ in named_effects(d)}
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+
+    ax = axes[0]
+    near = (r.t >= event - 0.05) & (r.t <= event + 0.5)
+    ax.plot(r.t[near], r.z[near] * 1e3, '.', ms=2, color='0.4', label='measured')
+    ax.plot(d.before.t[near], d.before.z[near] * 1e3, lw=1.0, label='nominal')
+    shifted = np.interp(r.t[near] - sig.time_shift_s, d.before.t, d.before.z)
+    ax.plot(r.t[near], shifted * 1e3, lw=1.0, ls='--', label='nominal, shifted')
+    ax.set_title(f'time shift at the load event: {sig.time_shift_s * 1e3:+.1f} ms')
+    ax.set_xlabel('time, s')
+    ax.set_ylabel('tip z, mm')
+
+    models: tuple[tuple[str, TipTrajectory, str], ...] = (
+        ('nominal', d.before, '-'),
+        (f'augmented ({d.missing_effect})', d.after, '--'),
+    )
+    mid_t, amplitude, frequency = _swing(r.t, r.z, event, level)
+    axes[1].plot(amplitude * 1e3, frequency, '.', color='0.4', label='measured')
+    axes[2].semilogy(mid_t, amplitude * 1e3, '.', color='0.4', label='measured')
+    for label, model, style in models:
+        m_t, m_amp, m_f = _swing(model.t, model.z, event, level)
+        axes[1].plot(m_amp * 1e3, m_f, style, lw=1.0, label=label)
+        axes[2].semilogy(m_t, m_amp * 1e3, style, lw=1.0, label=label)
+    axes[1].set_title(f'frequency against amplitude (drift {sig.frequency_drift:+.2e})')
+    axes[1].set_xlabel('swing amplitude, mm')
+    axes[1].set_ylabel('frequency (peak to peak), Hz')
+    terms = sig.envelope_terms
+    axes[2].set_title(
+        f'envelope law: {sig.envelope} (F dry {terms["dry_f"]:.3g}, '
+        f'quadratic {terms["quadratic_f"]:.3g})'
+    )
+    axes[2].set_xlabel('time, s')
+    axes[2].set_ylabel('swing amplitude, mm')
+    for ax, effects in zip(axes, SIGNATURE_EFFECTS.values(), strict=True):
+        speaks = [e for e in effects if e in named]
+        ax.set_title(
+            f'{", ".join(effects)}\n{ax.get_title()}',
+            fontsize=9,
+            color='C2' if speaks else 'k',
+            fontweight='bold' if speaks else 'normal',
+        )
+        ax.legend(fontsize=7)
+    fig.suptitle(f'Signatures of the residual: missing effect = {d.missing_effect}', fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def _signature_figure(d: Diagnosis, path: Path) -> None:
+    fig = signature_figure(d)
     fig.savefig(path, dpi=120)
     plt.close(fig)
 
@@ -101,7 +223,9 @@ def plot_diagnosis(d: Diagnosis, folder: str | Path) -> list[Path]:
         folder.mkdir(parents=True, exist_ok=True)
         paths = [folder / name for name in FIGURES]
         for draw, path in zip(
-            (_fit_figure, _residual_figure, _candidate_figure), paths, strict=True
+            (_fit_figure, _residual_figure, _signature_figure, _candidate_figure),
+            paths,
+            strict=True,
         ):
             draw(d, path)
     except OSError as exc:

@@ -145,3 +145,24 @@ def test_start_a_hair_after_a_stamp_includes_it(t0):
     samples = stream.advance_to(t0 + 0.1)
     assert samples.t[0] == pytest.approx(t0, abs=1e-9)
     assert np.ptp(samples.z) < 1e-12
+
+
+@pytest.mark.parametrize('frames', [4, -4])
+def test_a_new_latency_shows_the_motion_that_much_later(frames):
+    # Four frames at 180 Hz: the changed stream's samples are the reference's, shifted.
+    beam = BeamParameters()
+    before = replace(beam, effects=beam.effects.with_effect('sensor_latency', 8 / 180))
+    after = replace(beam, effects=beam.effects.with_effect('sensor_latency', (8 + frames) / 180))
+    changed = PredictionStream(before, 4.5, 0.0, 180.0)
+    reference = PredictionStream(after, 4.5, 0.0, 180.0)
+    for stream in (changed, reference):
+        stream.set_load(0.5, 0.0)
+    changed.advance_to(1.0)
+    reference.advance_to(1.0)
+    changed.set_beam(after)
+    shown = changed.advance_to(2.0)
+    expected = reference.advance_to(2.0)
+    # After the hold (longer latency) or the skip (shorter), the two show the same motion.
+    settled = shown.t >= 1.0 + 2 * abs(frames) / 180
+    np.testing.assert_allclose(shown.z[settled], expected.z[settled], atol=2e-6)
+    assert np.all(np.diff(shown.t) > 0)

@@ -228,8 +228,11 @@ def test_adopts_identified_parameters_when_asked(ros_graph, adopt):
 def test_parameter_file_documents_every_parameter():
     text = config_path('simulator.yaml').read_text()
     defaults = read_parameter_file(config_path('simulator.yaml'))
-    assert defaults == SIMULATOR_SCHEMA.defaults()
-    for name in SIMULATOR_SCHEMA.names:
+    # The effects are the beam file's unless given: the file names them in a comment only.
+    effects = [name for name in SIMULATOR_SCHEMA.names if name.startswith('effects.')]
+    assert effects and all(f'# {name}' in text for name in effects)
+    assert defaults == {k: v for k, v in SIMULATOR_SCHEMA.defaults().items() if k not in effects}
+    for name in set(SIMULATOR_SCHEMA.names) - set(effects):
         before = text.split(f'\n    {name}:')[0].splitlines()
         assert before[-1].strip().startswith('#'), f'{name} has no comment'
 
@@ -239,3 +242,31 @@ def test_main_exits_2_on_a_bad_parameter(monkeypatch, capsys):
     code = simulator_node.main(['simulator_node', '--ros-args', '-p', 'rate_hz:=-1.0'])
     assert code == 2
     assert 'rate_hz' in capsys.readouterr().err
+
+
+def test_effect_parameters_start_from_the_beam_file_and_switch_the_running_beam(
+    ros_graph, tmp_path
+):
+    from dataclasses import replace
+
+    from lumpbeam_ros.model.parameters import load_beam_config, write_beam_config
+
+    beam, drop = load_beam_config()
+    path = tmp_path / 'late.yaml'
+    write_beam_config(path, replace(beam, effects=beam.effects.with_effect('added_mass', 0.2)))
+    latency, mass = 'effects.sensor_latency.latency_s', 'effects.added_mass.mass_kg'
+    got = ros_graph.collect('/tip_pose_predicted', PoseStamped, 500)
+    node = _start(ros_graph, beam_config=str(path), initial_load_kg=4.5, **{latency: 0.01})
+    assert node.get_parameter(mass).value == 0.2  # from the file
+    assert node.get_parameter(latency).value == 0.01  # given
+    assert node.beam.effects.added_mass_kg == 0.2 and node.beam.effects.latency_s == 0.01
+    assert ros_graph.spin_until(lambda: len(got) >= 5, 10.0)
+    assert node.set_parameters([Parameter(latency, value=0.02)])[0].successful
+    assert node.stream.beam.effects.latency_s == 0.02
+    refused = node.set_parameters([Parameter(latency, value=2.0)])[0]
+    assert not refused.successful and 'out of range' in refused.reason
+    assert node.stream.beam.effects.latency_s == 0.02
+    count = len(got)
+    assert ros_graph.spin_until(lambda: len(got) > count + 5, 10.0)  # still predicting
+    t, _, _ = _columns(got)
+    assert np.all(np.diff(t) > 0)  # no stamp twice across the change

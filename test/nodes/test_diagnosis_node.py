@@ -1,0 +1,228 @@
+"""The diagnosis node on a private graph: bad input, a live ring-down, adoption."""
+
+import math
+
+import pytest
+from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import PoseStamped
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock
+from std_msgs.msg import Float64
+
+from lumpbeam_ros.bagio.convert import pitch_to_quaternion
+from lumpbeam_ros.diagnose.live import LiveDiagnosis, Stretch
+from lumpbeam_ros.model.parameters import load_beam_config
+from lumpbeam_ros.nodes.diagnosis_node import STATUS_NAME, TOPIC, DiagnosisNode
+from lumpbeam_ros.nodes.simulator_node import SimulatorNode
+from lumpbeam_ros.synthetic.drop_test import SynthOptions, simulate_experiment
+
+LATCHED = QoSProfile(
+    depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+)
+LATENCY = 'effects.sensor_latency.latency_s'
+#: Generous: a diagnosis takes seconds, tens of them on a loaded machine.
+DIAGNOSIS_TIMEOUT_S = 300.0
+
+
+def _pose(t, z, pitch, frame='beam_base'):
+    msg = PoseStamped()
+    msg.header.frame_id = frame
+    msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(round(t * 1e9), 1_000_000_000)
+    msg.pose.position.z = z
+    q = msg.pose.orientation
+    q.x, q.y, q.z, q.w = pitch_to_quaternion(pitch)
+    return msg
+
+
+def _start(ros_graph, **overrides):
+    node = DiagnosisNode(
+        context=ros_graph.context,
+        parameter_overrides={'worker': 'thread', 'status_period_s': 0.1, **overrides},
+    )
+    ros_graph.add_node(node)
+    return node
+
+
+def _statuses(messages):
+    return [s for m in messages for s in m.status if s.name == STATUS_NAME]
+
+
+def _values(status):
+    return {kv.key: kv.value for kv in status.values}
+
+
+def test_predicted_poses_without_measured_ones_say_what_is_missing(ros_graph):
+    got = ros_graph.collect(TOPIC, DiagnosticArray)
+    node = _start(ros_graph)
+    for i in range(20):
+        ros_graph.publish('/tip_pose_predicted', _pose(10.0 + i / 180, -0.07, 0.04))
+        ros_graph.spin_for(0.01)
+
+    def said():
+        return any(
+            _values(s).get('missing_input') == '/tip_pose'
+            and 'only /tip_pose_predicted' in s.message
+            for s in _statuses(got)
+        )
+
+    assert ros_graph.spin_until(said, 30.0)
+    assert node.buffer.predicted_count > 0 and node.diagnoses == 0
+    assert _statuses(got)[-1].level == bytes([3])  # STALE: nothing diagnosed
+
+
+def test_nan_and_wrong_frame_poses_are_dropped_and_counted(ros_graph):
+    got = ros_graph.collect(TOPIC, DiagnosticArray)
+    node = _start(ros_graph)
+    ros_graph.publish('/tip_pose', _pose(1.0, -0.07, 0.04))
+    ros_graph.wait_for_subscribers('/tip_pose')
+    for msg in (
+        _pose(1.0, -0.07, 0.04),
+        _pose(1.1, math.nan, 0.04),
+        _pose(1.2, -0.07, 0.04, frame='camera'),
+        _pose(1.3, -0.07, 0.04),
+    ):
+        ros_graph.publish('/tip_pose', msg)
+    assert ros_graph.spin_until(lambda: node.non_finite == 1 and node.wrong_frame == 1, 30.0)
+    assert ros_graph.spin_until(lambda: node.buffer.measured_count >= 2, 30.0)
+    assert list(node.buffer.measured.t)[-1] == pytest.approx(1.3)
+    assert all(math.isfinite(z) for z in node.buffer.measured.z)
+    assert ros_graph.spin_until(
+        lambda: any(_values(s).get('samples_wrong_frame') == '1' for s in _statuses(got)), 30.0
+    )
+
+
+def _feed(ros_graph, nodes, t, z, pitch, loads, offset, chunk=18):
+    """Plays poses in clock order: /clock, then the poses and load changes up to it."""
+    pending = list(loads)
+    diag = nodes[0]
+    for start in range(0, t.size, chunk):
+        end = min(start + chunk, t.size)
+        clock_s = offset + t[end - 1]
+        while pending and offset + pending[0][0] <= clock_s:
+            when, kg = pending.pop(0)
+            _set_clock(ros_graph, nodes, offset + when)
+            ros_graph.publish('/tip_load', Float64(data=kg), LATCHED)
+            assert ros_graph.spin_until(
+                lambda kg=kg: bool(diag.buffer.loads) and diag.buffer.loads[-1][1] == kg, 30.0
+            )
+        _set_clock(ros_graph, nodes, clock_s)
+        for i in range(start, end):
+            ros_graph.publish('/tip_pose', _pose(offset + t[i], z[i], pitch[i]), 200)
+        assert ros_graph.spin_until(lambda end=end: diag.buffer.measured_count >= end - 1, 30.0)
+
+
+def _set_clock(ros_graph, nodes, seconds):
+    msg = Clock()
+    msg.clock.sec, msg.clock.nanosec = divmod(round(seconds * 1e9), 1_000_000_000)
+    ros_graph.publish('/clock', msg)
+    target = round(seconds * 1e9)
+    assert ros_graph.spin_until(
+        lambda: all(n.get_clock().now().nanoseconds == target for n in nodes), 30.0
+    )
+
+
+def test_a_live_ring_down_names_the_hidden_latency_and_the_simulator_adopts_it(ros_graph):
+    beam, drop = load_beam_config()
+    measured, _ = simulate_experiment(
+        beam, drop, SynthOptions(duration_s=4.5, effects={'sensor_latency': 0.015})
+    )
+    got = ros_graph.collect(TOPIC, DiagnosticArray)
+    simulator = SimulatorNode(
+        context=ros_graph.context,
+        parameter_overrides=[Parameter('use_sim_time', value=True)],
+    )
+    ros_graph.add_node(simulator)
+    node = _start(
+        ros_graph,
+        use_sim_time=True,
+        adopt=True,
+        worker='process',
+        **{'ring_down.decay_s': 2.3},
+    )
+    ros_graph.publish('/tip_pose', _pose(1.0, -0.07, 0.04), 200)
+    ros_graph.publish('/tip_load', Float64(data=drop.load_kg), LATCHED)
+    ros_graph.wait_for_subscribers('/tip_pose')
+    ros_graph.wait_for_subscribers('/tip_load', 2)
+    _feed(
+        ros_graph,
+        [node, simulator],
+        measured.t[1:],
+        measured.z[1:],
+        measured.pitch[1:],
+        [(0.0, drop.load_kg), (drop.release_time_s, 0.0)],
+        offset=100.0,
+    )
+    assert ros_graph.spin_until(lambda: node.last is not None, DIAGNOSIS_TIMEOUT_S), node.status()
+    assert node.last.missing_effect == 'sensor_latency'
+    assert node.last.effect_parameters['latency_s'] == pytest.approx(0.015, rel=0.1)
+    assert ros_graph.spin_until(lambda: node.adoption.startswith('adopted'), 60.0), node.adoption
+    adopted = simulator.get_parameter(LATENCY).value
+    assert adopted == node.last.effect_parameters['latency_s']
+    assert simulator.beam.effects.latency_s == adopted
+    warned = [s for s in _statuses(got) if s.level == bytes([1])]
+    assert warned and _values(warned[-1])['missing_effects'] == 'sensor_latency'
+    assert float(_values(warned[-1])['gap_after_rms_m']) < float(
+        _values(warned[-1])['gap_before_rms_m']
+    )
+
+
+def _found(after_m):
+    return LiveDiagnosis(
+        'sensor_latency',
+        (('sensor_latency', {'latency_s': 0.015}),),
+        3e-3,
+        after_m,
+        'test',
+        Stretch(1.0, 4.3, 2.0),
+    )
+
+
+def test_a_simulator_that_refuses_the_parameters_is_one_message_and_no_adoption(ros_graph):
+    # A simulator whose latency is fixed at start: its parameter service refuses a change.
+    fixed = Node('simulator_node', context=ros_graph.context)
+    fixed.declare_parameter(LATENCY, 0.0, ParameterDescriptor(read_only=True))
+    ros_graph.add_node(fixed)
+    node = _start(ros_graph, adopt=True)
+    assert ros_graph.spin_until(node._parameters.services_are_ready, 30.0)
+    node.offer_adoption(_found(2e-5), 3e-3)
+    assert ros_graph.spin_until(lambda: 'refused' in node.adoption, 30.0), node.adoption
+    assert node.adoption.startswith(f'simulator_node refused the adoption: {LATENCY}')
+    assert fixed.get_parameter(LATENCY).value == 0.0
+
+
+def test_a_model_that_fits_worse_than_the_running_one_is_not_adopted(ros_graph):
+    simulator = SimulatorNode(context=ros_graph.context)
+    ros_graph.add_node(simulator)
+    node = _start(ros_graph, adopt=True)
+    assert ros_graph.spin_until(node._parameters.services_are_ready, 30.0)
+    node.offer_adoption(_found(4e-3), 3e-3)
+    assert node.adoption.startswith('not adopted: the augmented model')
+    node.offer_adoption(_found(2e-5), math.nan)  # no prediction to compare with
+    assert node.adoption.startswith('not adopted: no simulator prediction')
+    ros_graph.spin_for(0.5)
+    assert simulator.get_parameter(LATENCY).value == 0.0
+    node.offer_adoption(_found(2e-5), 3e-3)
+    assert ros_graph.spin_until(lambda: node.adoption.startswith('adopted'), 30.0)
+    assert simulator.beam.effects.latency_s == 0.015
+
+
+def test_a_window_without_a_release_is_reported_not_diagnosed(ros_graph):
+    got = ros_graph.collect(TOPIC, DiagnosticArray)
+    node = _start(ros_graph, trigger='window', window_s=2.0)
+    ros_graph.publish('/tip_load', Float64(data=4.5), LATCHED)
+    ros_graph.publish('/tip_pose', _pose(1.0, -0.07, 0.04), 200)
+    ros_graph.wait_for_subscribers('/tip_pose')
+    assert ros_graph.spin_until(lambda: len(node.buffer.loads) == 1, 30.0)
+    for i in range(181, 181 + 3 * 180):
+        ros_graph.publish('/tip_pose', _pose(i / 180, -0.07, 0.04), 200)
+        if i % 50 == 0:
+            ros_graph.spin_for(0.02)
+
+    def said():
+        return any('no load change between' in s.message for s in _statuses(got))
+
+    assert ros_graph.spin_until(said, 30.0)
+    assert node.diagnoses == 0
