@@ -139,6 +139,7 @@ class DiagnosisNode(Node):
         )
         #: Statuses published on ``/model_discrepancy``.
         self.published = 0
+        self._heard = False  # any input yet
         # Steady timers: under use_sim_time a stopped /clock (a bag that ended) must not
         # stop the node from collecting a diagnosis and saying so.
         steady = Clock(clock_type=ClockType.STEADY_TIME)
@@ -178,16 +179,19 @@ class DiagnosisNode(Node):
         return stamp_ns * 1e-9, z, pitch
 
     def _on_pose(self, msg: PoseStamped) -> None:
+        self._heard = True
         pose = self._pose(msg, '/tip_pose')
         if pose is not None:
             self.buffer.push_measured(*pose)
 
     def _on_predicted(self, msg: PoseStamped) -> None:
+        self._heard = True
         pose = self._pose(msg, '/tip_pose_predicted')
         if pose is not None:
             self.buffer.push_predicted(*pose)
 
     def _on_load(self, msg: Float64) -> None:
+        self._heard = True
         kg = float(msg.data)
         if not math.isfinite(kg) or kg < 0.0:
             self.get_logger().warning(
@@ -346,6 +350,10 @@ class DiagnosisNode(Node):
         )
 
     def _publish_status(self) -> None:
+        if not self._heard:
+            # Statuses start with the first input: before it, no subscriber may have found
+            # this node yet, and a graph's count of what was sent would not add up.
+            return
         msg = DiagnosticArray(status=[self.status()])
         msg.header.stamp = self.get_clock().now().to_msg()
         self._output.publish(msg)

@@ -234,3 +234,51 @@ def live_value(analysis: RecordingAnalysis, key: str) -> float:
         return float(analysis.live[key])
     except (KeyError, ValueError):
         return math.nan
+
+
+def prediction_lag(
+    measured: PoseSeries, predicted: PoseSeries, start_s: float, max_lag_s: float = 0.2
+) -> tuple[float, float]:
+    """How late the prediction runs behind the measurement, and the gap once shifted by it.
+
+    In a live graph the simulator applies a ``/tip_load`` change when the message arrives
+    (``std_msgs/Float64`` carries no stamp), so its whole ring-down is shifted by the
+    message's delivery delay; this separates that timing error from the error in shape.
+
+    Args:
+        measured: ``/tip_pose``.
+        predicted: ``/tip_pose_predicted``.
+        start_s: Compare from this time on (the release), s.
+        max_lag_s: The largest lag searched either way, s.
+
+    Returns:
+        The lag (positive: the prediction is late), s, and the RMS of measured minus the
+        prediction shifted back by it over the stretch, m (NaN, NaN when they do not overlap
+        there).
+    """
+    keep = measured.t >= start_s
+    t, z = measured.t[keep], measured.z[keep]
+
+    def rms(lag: float) -> float:
+        inside = (t + lag >= predicted.t[0]) & (t + lag <= predicted.t[-1])
+        if inside.sum() < 10:
+            return math.inf
+        shifted = np.interp(t[inside] + lag, predicted.t, predicted.z)
+        return float(np.sqrt(np.mean((z[inside] - shifted) ** 2)))
+
+    if t.size < 10 or predicted.t.size < 10:
+        return math.nan, math.nan
+    step = float(np.median(np.diff(predicted.t)))
+    lags = np.arange(-max_lag_s, max_lag_s + step / 2, step / 4)
+    costs = np.array([rms(float(lag)) for lag in lags])
+    best = int(np.argmin(costs))
+    if not math.isfinite(costs[best]):
+        return math.nan, math.nan
+    if 0 < best < lags.size - 1:
+        # A parabola through the best grid point and its neighbours.
+        a, b, c = costs[best - 1 : best + 2]
+        denominator = a - 2 * b + c
+        offset = 0.5 * (a - c) / denominator if denominator > 0 else 0.0
+        lag = float(lags[best] + offset * (lags[1] - lags[0]))
+        return lag, rms(lag)
+    return float(lags[best]), float(costs[best])

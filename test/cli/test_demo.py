@@ -27,8 +27,11 @@ def test_demo_runs_the_graph_end_to_end(tmp_path, capsys, mcap_doctor):
     assert rows['damping_ratio']['identified'] == pytest.approx(0.00237, rel=0.25)
     assert rows['stiffness_total_nm_per_rad']['identified'] == pytest.approx(3899.1, rel=0.02)
     assert rows['stiffness_total_nm_per_rad']['paper'] == 3899.1
-    # The simulator predicted what the camera would see: the residual is the 20 um noise.
-    assert summary['prediction_rms_m'] < 40e-6
+    # The simulator predicted what the camera would see: once its ring-down is shifted by the
+    # /tip_load delivery delay (a Float64 has no stamp; a loaded machine delivers it late),
+    # the residual is the 20 um noise.
+    assert abs(summary['prediction_lag_s']) < 0.1
+    assert summary['prediction_rms_aligned_m'] < 40e-6
     assert summary['measured_samples'] == 5 * 180 + 1  # nothing lost by the recorder
     assert summary['predicted_samples'] > 4 * 180
     for name in ('tip_measured_vs_predicted.png', 'tip_release_zoom.png'):
@@ -98,6 +101,9 @@ def test_summary_table_reads_back_from_json():
     assert 'RMS 0.020 mm' in lines[4] and lines[-1] == 'diagnosis: missing effect none'
 
 
+# Best-effort camera frames: how many a machine tracks depends on its load (the bench measures
+# it); the suite on a quiet machine (make test-slow, in CI) runs the whole camera path.
+@pytest.mark.slow
 def test_demo_tracks_images_and_names_the_hidden_latency(tmp_path, capsys):
     # The default demo: camera frames through the camera node, and a 15 ms camera latency
     # hidden in the data for the diagnosis step.
