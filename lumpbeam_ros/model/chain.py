@@ -5,13 +5,16 @@ segment angles ``phi`` of B.17. With ``phi_i`` the pitch of segment ``i`` (posit
 points downward, SPEC section 2) and every mass a point on some segment at a lever ``l_i^p``
 from joint ``i``, B.16 collapses to
 
-    M(phi) phi'' + S(phi) phi'^2 + K phi + C phi' = g G cos(phi) + Q_e(phi, phi'),
+    M(phi) phi'' + S(phi) phi'^2 + K phi + C phi' = g G cos(phi + tilt) + Q_e(phi, phi'),
     M_ij = A_ij cos(phi_i - phi_j) + I_i delta_ij,   S_ij = A_ij sin(phi_i - phi_j),
     A_ij = sum_p m_p l_i^p l_j^p,                     G_i = sum_p m_p l_i^p,
 
 where ``K = D^T diag(k) D`` and ``C = D^T diag(c) D`` act on the joint angles ``D phi``
 (joint 1 against the wall, the others between neighbours: B.10, B.11) and ``Q_e`` holds the
-effects of SPEC section 6 that are forces (friction, drag).
+effects of doc/interfaces.md ("Missing effects") that are forces: dry friction, drag and the
+cubic term ``-k3 phi_1^3`` of joint 1's spring. ``tilt`` is the clamp's pitch below level
+(``mount_tilt``): the segments' angles stay relative to the clamp (``beam_base``), gravity
+acts at ``phi + tilt``.
 """
 
 from __future__ import annotations
@@ -48,6 +51,8 @@ class LumpedChain:
         gravity: g, m/s^2.
         coulomb_torque: Dry friction torque at joint 1, N m.
         drag_c_q: Quadratic drag on the tip, N s^2/m^2.
+        cubic_stiffness: k3 of joint 1's spring, torque ``k phi_1 + k3 phi_1^3``, N m/rad^3.
+        tilt: The clamp's pitch below level, rad.
     """
 
     segment_length: float
@@ -59,6 +64,8 @@ class LumpedChain:
     gravity: float
     coulomb_torque: float = 0.0
     drag_c_q: float = 0.0
+    cubic_stiffness: float = 0.0
+    tilt: float = 0.0
 
     @classmethod
     def from_beam(cls, beam: BeamParameters, load_kg: float = 0.0) -> LumpedChain:
@@ -100,6 +107,8 @@ class LumpedChain:
             gravity=beam.gravity_mps2,
             coulomb_torque=beam.effects.coulomb_torque_nm,
             drag_c_q=beam.effects.drag_c_q,
+            cubic_stiffness=beam.effects.k3_nm_per_rad3,
+            tilt=beam.effects.tilt_rad,
         )
 
     @property
@@ -116,6 +125,18 @@ class LumpedChain:
     def gravity_moment(self) -> np.ndarray:
         """G_i = sum_p m_p l_i^p: first moment of the masses beyond each joint."""
         return self.masses @ self.levers
+
+    def gravity_forces(self, phi: np.ndarray) -> np.ndarray:
+        """``g G cos(phi + tilt)``: the generalized forces of gravity, any batch shape."""
+        return self.gravity * self.gravity_moment * np.cos(phi + self.tilt)
+
+    def gravity_stiffness(self, phi: np.ndarray) -> np.ndarray:
+        """``g G sin(phi + tilt)``: minus the derivative of :meth:`gravity_forces`."""
+        return self.gravity * self.gravity_moment * np.sin(phi + self.tilt)
+
+    def cubic_tangent(self, phi: np.ndarray) -> float:
+        """``3 k3 phi_1^2``: the cubic term's contribution to joint 1's tangent stiffness."""
+        return 3.0 * self.cubic_stiffness * float(phi[0]) ** 2
 
     @property
     def stiffness_matrix(self) -> np.ndarray:
@@ -163,7 +184,7 @@ class LumpedChain:
     def effect_forces(
         self, phi: np.ndarray, phi_dot: np.ndarray, friction: bool = True
     ) -> np.ndarray:
-        """Generalized forces of dry friction at joint 1 and quadratic tip drag.
+        """Generalized forces of dry friction and the cubic spring at joint 1, and tip drag.
 
         Args:
             phi: Angles, shape (..., n).
@@ -175,6 +196,8 @@ class LumpedChain:
             Q_e, same shape.
         """
         q = np.zeros(np.broadcast_shapes(phi.shape, phi_dot.shape))
+        if self.cubic_stiffness != 0.0:
+            q[..., 0] -= self.cubic_stiffness * phi[..., 0] ** 3
         if friction and self.coulomb_torque > 0.0:
             # Joint 1's angle is phi_1 itself (it turns against the wall).
             q[..., 0] -= self.coulomb_torque * np.tanh(phi_dot[..., 0] / FRICTION_SMOOTHING_RAD_S)
@@ -191,7 +214,7 @@ class LumpedChain:
     ) -> np.ndarray:
         """Right-hand side of B.16 for a batch: every force but the inertial ``M phi''``.
 
-        ``-S(phi) phi'^2 + g G cos(phi) - K phi - C phi' + Q_e``, evaluated with the
+        ``-S(phi) phi'^2 + g G cos(phi + tilt) - K phi - C phi' + Q_e``, evaluated with the
         ``cos(a - b) = cos a cos b + sin a sin b`` split so that a batch costs two matrix
         products rather than a batch of n x n matrices.
 
@@ -209,7 +232,7 @@ class LumpedChain:
         coriolis = s * ((c * w2) @ a) - c * ((s * w2) @ a)
         return (
             -coriolis
-            + self.gravity * self.gravity_moment * c
+            + self.gravity_forces(phi)
             - phi @ self.stiffness_matrix
             - phi_dot @ self.damping_matrix
             + self.effect_forces(phi, phi_dot, friction)
@@ -229,5 +252,6 @@ class LumpedChain:
         """Kinetic plus potential (springs and gravity) energy, J, for a batch."""
         kinetic = 0.5 * (phi_dot * self.inertial_forces(phi, phi_dot)).sum(axis=-1)
         spring = 0.5 * (phi * (phi @ self.stiffness_matrix)).sum(axis=-1)
-        heights = -self.gravity * (self.gravity_moment * np.sin(phi)).sum(axis=-1)
+        spring = spring + 0.25 * self.cubic_stiffness * phi[..., 0] ** 4
+        heights = -self.gravity * (self.gravity_moment * np.sin(phi + self.tilt)).sum(axis=-1)
         return kinetic + spring + heights

@@ -18,7 +18,8 @@ class LinearModel:
         phi_eq: The equilibrium angles.
         mass: M0 = M(phi_eq).
         damping: C.
-        stiffness: K_eff = K + diag(g G sin(phi_eq)) (springs plus the gravity stiffness).
+        stiffness: K_eff = K + diag(g G sin(phi_eq + tilt)) (springs plus the gravity
+            stiffness), plus the cubic spring's tangent ``3 k3 phi_1^2`` at joint 1.
     """
 
     phi_eq: np.ndarray
@@ -33,12 +34,13 @@ class LinearModel:
         """Linearises a chain about ``phi_eq`` (default: its static equilibrium)."""
         if phi_eq is None:
             phi_eq = static_equilibrium(chain)
-        gravity_stiffness = chain.gravity * chain.gravity_moment * np.sin(phi_eq)
+        stiffness = chain.stiffness_matrix + np.diag(chain.gravity_stiffness(phi_eq))
+        stiffness[0, 0] += chain.cubic_tangent(phi_eq)
         return cls(
             phi_eq=phi_eq,
             mass=chain.mass_matrix(phi_eq),
             damping=chain.damping_matrix,
-            stiffness=chain.stiffness_matrix + np.diag(gravity_stiffness),
+            stiffness=stiffness,
         )
 
     def state_matrix(self) -> np.ndarray:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -10,6 +11,7 @@ from typing import Any, Literal
 import numpy as np
 import yaml
 
+from lumpbeam_ros.errors import ConfigError
 from lumpbeam_ros.model import rules
 from lumpbeam_ros.paramfile import (
     check_known_keys,
@@ -30,12 +32,58 @@ EFFECT_PARAMETERS: dict[str, str] = {
     'quadratic_drag': 'c_q',
     'added_mass': 'mass_kg',
     'sensor_latency': 'latency_s',
+    'cubic_stiffness': 'k3_nm_per_rad3',
+    'sensor_scale': 'scale',
+    'mount_tilt': 'tilt_rad',
 }
+
+#: Each effect's parameter when the effect is off (0 for all but ``sensor_scale``: 1).
+EFFECT_OFF: dict[str, float] = {name: 0.0 for name in EFFECT_PARAMETERS} | {'sensor_scale': 1.0}
+
+#: Physical limits of each effect's parameter: ``(low, high, low_included)``; the high end is
+#: excluded. A negative stiffness, mass, friction, drag or delay, a scale that is not
+#: positive, or a clamp tilted to the vertical or beyond describe no real rig.
+EFFECT_LIMITS: dict[str, tuple[float, float, bool]] = {
+    'base_compliance': (0.0, math.inf, True),
+    'coulomb_friction': (0.0, math.inf, True),
+    'quadratic_drag': (0.0, math.inf, True),
+    'added_mass': (0.0, math.inf, True),
+    'sensor_latency': (0.0, math.inf, True),
+    'cubic_stiffness': (-math.inf, math.inf, False),
+    'sensor_scale': (0.0, math.inf, False),
+    'mount_tilt': (-0.5 * math.pi, 0.5 * math.pi, False),
+}
+
+
+def effect_value_problem(name: str, value: float) -> str | None:
+    """Why a value is outside an effect's physical limits (:data:`EFFECT_LIMITS`).
+
+    Args:
+        name: An effect name of :data:`EFFECT_PARAMETERS`.
+        value: Its parameter, SI.
+
+    Returns:
+        ``None`` when the value is physical, else what is wrong, e.g. ``'must be positive'``.
+    """
+    low, high, low_included = EFFECT_LIMITS[name]
+    inside = math.isfinite(value) and (value >= low if low_included else value > low)
+    if inside and value < high:
+        return None
+    if low == 0.0 and high == math.inf:
+        wanted = 'zero or positive' if low_included else 'positive'
+    elif math.isinf(low) and math.isinf(high):
+        wanted = 'finite'
+    else:
+        wanted = f'in ({low:.6g}, {high:.6g})'
+    return f'must be {wanted}, got {value!r}'
 
 
 @dataclass(frozen=True)
 class Effects:
-    """Physical effects beyond the paper's model (SPEC section 6); zero switches one off.
+    """Physical effects beyond the paper's model (doc/interfaces.md, "Missing effects").
+
+    Every field is 0 when its effect is off; ``sensor_scale`` is therefore stored as its
+    excess over 1 (:meth:`value` and :meth:`with_effect` speak the parameter itself).
 
     Attributes:
         k_base_nm_per_rad: Wall-mount rotational spring in series with joint 1 (0: rigid).
@@ -43,6 +91,11 @@ class Effects:
         drag_c_q: Quadratic aerodynamic drag on the tip, N s^2/m^2.
         added_mass_kg: Unmodelled point mass at the tip.
         latency_s: Constant delay of the measurement stamps.
+        k3_nm_per_rad3: Cubic term of joint 1's spring, torque ``k theta + k3 theta^3``
+            (hardening > 0, softening < 0), N m/rad^3.
+        scale_excess: ``scale - 1``: the measured tip displacement from rest is ``scale``
+            times the true one (a camera with a wrong depth).
+        tilt_rad: The clamp's pitch below level: gravity loads the beam at this angle.
     """
 
     k_base_nm_per_rad: float = 0.0
@@ -50,6 +103,9 @@ class Effects:
     drag_c_q: float = 0.0
     added_mass_kg: float = 0.0
     latency_s: float = 0.0
+    k3_nm_per_rad3: float = 0.0
+    scale_excess: float = 0.0
+    tilt_rad: float = 0.0
 
     _FIELDS = {
         'base_compliance': 'k_base_nm_per_rad',
@@ -57,23 +113,39 @@ class Effects:
         'quadratic_drag': 'drag_c_q',
         'added_mass': 'added_mass_kg',
         'sensor_latency': 'latency_s',
+        'cubic_stiffness': 'k3_nm_per_rad3',
+        'sensor_scale': 'scale_excess',
+        'mount_tilt': 'tilt_rad',
     }
 
     def with_effect(self, name: str, value: float) -> Effects:
-        """Returns a copy with one effect (by its SPEC name) set to ``value``.
+        """Returns a copy with one effect (by its name) set to ``value`` (its SI parameter).
 
         Raises:
-            KeyError: ``name`` is not an effect of SPEC section 6.
+            KeyError: ``name`` is not an effect of :data:`EFFECT_PARAMETERS`.
         """
-        return replace(self, **{self._FIELDS[name]: float(value)})
+        return replace(self, **{self._FIELDS[name]: float(value) - EFFECT_OFF[name]})
 
     def value(self, name: str) -> float:
-        """Returns the parameter of one effect, by its SPEC name."""
-        return float(getattr(self, self._FIELDS[name]))
+        """Returns the parameter of one effect (SI), by its name."""
+        return float(getattr(self, self._FIELDS[name])) + EFFECT_OFF[name]
 
     def active(self) -> dict[str, float]:
-        """Returns the effects that are switched on, by SPEC name."""
-        return {name: self.value(name) for name in self._FIELDS if self.value(name) != 0.0}
+        """Returns the effects that are switched on, by name."""
+        return {
+            name: self.value(name)
+            for name, attr in self._FIELDS.items()
+            if float(getattr(self, attr)) != 0.0
+        }
+
+    @property
+    def scale(self) -> float:
+        """The ``sensor_scale`` parameter (1: a true sensor)."""
+        return 1.0 + self.scale_excess
+
+    def physical(self) -> Effects:
+        """The effects on the beam itself: the sensor's (latency, scale) switched off."""
+        return replace(self, latency_s=0.0, scale_excess=0.0)
 
 
 @dataclass(frozen=True)
@@ -204,14 +276,14 @@ def beam_from_parameters(params: Mapping[str, Any], source: str | Path) -> BeamP
     d = BeamParameters()
     pos = {'positive': True}
     nonneg = {'non_negative': True}
-    effects = Effects(
-        **{
-            Effects._FIELDS[name]: get_float(
-                params, f'effects.{name}.{param}', source, 0.0, **nonneg
-            )
-            for name, param in EFFECT_PARAMETERS.items()
-        }
-    )
+    effects = Effects()
+    for name, param in EFFECT_PARAMETERS.items():
+        key = f'effects.{name}.{param}'
+        value = get_float(params, key, source, EFFECT_OFF[name])
+        problem = effect_value_problem(name, value)
+        if problem is not None:
+            raise ConfigError(source, key, problem)
+        effects = effects.with_effect(name, value)
     return BeamParameters(
         length_m=get_float(params, 'beam.length_m', source, d.length_m, **pos),
         bending_stiffness_nm2=get_float(

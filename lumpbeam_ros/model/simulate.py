@@ -17,6 +17,7 @@ from scipy.interpolate import CubicHermiteSpline
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.integrate import ChainState, ModalSolver, solve_reference
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
+from lumpbeam_ros.model.sensor import scaled_position
 from lumpbeam_ros.model.statics import static_equilibrium
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
@@ -120,8 +121,10 @@ def simulate_loads(
 ) -> TipTrajectory:
     """Simulates the tip under a schedule of load changes, starting at rest.
 
-    The ``sensor_latency`` effect of ``beam`` is applied to the result: the sample stamped
-    ``t`` shows the beam at ``t - latency`` (before the start, at rest).
+    The sensor effects of ``beam`` are applied to the result: with ``sensor_latency`` the
+    sample stamped ``t`` shows the beam at ``t - latency`` (before the start, at rest), with
+    ``sensor_scale`` the position's displacement from rest is scaled
+    (:func:`~lumpbeam_ros.model.sensor.scaled_position`).
 
     Args:
         beam: The beam.
@@ -159,6 +162,7 @@ def simulate_loads(
         if lo >= t.size:
             break
     x, z, pitch = simulation.chain.tip_pose(phi)
+    x, z = scaled_position(beam, x, z)
     return TipTrajectory(t=t, x=x, z=z, pitch=pitch, load_kg=loads, q=phi)
 
 

@@ -9,7 +9,7 @@ from lumpbeam_ros.model.parameters import BeamParameters
 
 
 def static_equilibrium(chain: LumpedChain, tol: float = 1e-13, max_iter: int = 50) -> np.ndarray:
-    """Solves ``K phi = g G cos(phi)`` (B.16 at rest) by Newton's method.
+    """Solves ``K phi + k3 phi_1^3 e_1 = g G cos(phi + tilt)`` (B.16 at rest) by Newton.
 
     The beam's deflections are small against its stiffness, so Newton from the straight
     beam converges in a few steps; large rotations converge too, only slower.
@@ -26,11 +26,13 @@ def static_equilibrium(chain: LumpedChain, tol: float = 1e-13, max_iter: int = 5
         RuntimeError: No convergence (the beam is too soft to carry its load).
     """
     k = chain.stiffness_matrix
-    gg = chain.gravity * chain.gravity_moment
+    k3 = chain.cubic_stiffness
     phi = np.zeros(chain.n)
     for _ in range(max_iter):
-        residual = k @ phi - gg * np.cos(phi)
-        jacobian = k + np.diag(gg * np.sin(phi))
+        residual = k @ phi - chain.gravity_forces(phi)
+        residual[0] += k3 * phi[0] ** 3
+        jacobian = k + np.diag(chain.gravity_stiffness(phi))
+        jacobian[0, 0] += chain.cubic_tangent(phi)
         step = np.linalg.solve(jacobian, residual)
         phi -= step
         if np.max(np.abs(step)) < tol:

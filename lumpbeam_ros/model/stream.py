@@ -7,10 +7,10 @@ prediction shares its stamps with a 180 Hz camera that started on a whole second
 sample is computed at its own stamp, however late the call comes.
 
 Load changes are queued with their time and applied when the simulation reaches it, so a
-change that arrives between two ticks still takes effect at its own instant. The
-``sensor_latency`` effect (SPEC section 6) is applied as in
-:func:`~lumpbeam_ros.model.simulate.simulate_loads`: the sample stamped ``t`` shows the beam at
-``t - latency``, which is what a late camera would report.
+change that arrives between two ticks still takes effect at its own instant. The sensor
+effects are applied as in :func:`~lumpbeam_ros.model.simulate.simulate_loads`: the sample
+stamped ``t`` shows the beam at ``t - latency``, which is what a late camera would report, and
+its position's displacement from rest is ``sensor_scale`` times the true one.
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ import numpy as np
 
 from lumpbeam_ros.model.integrate import ChainState
 from lumpbeam_ros.model.parameters import BeamParameters
+from lumpbeam_ros.model.sensor import scaled_position
 from lumpbeam_ros.model.simulate import DEFAULT_STEP_S, BeamSimulation
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
@@ -163,6 +164,7 @@ class PredictionStream:
         """The tip pose ``(x, z, pitch)`` at rest under a load (default: the current one)."""
         simulation = BeamSimulation(self._beam, self.load_kg if load_kg is None else load_kg)
         x, z, pitch = simulation.chain.tip_pose(simulation.state.phi[None, :])
+        x, z = scaled_position(self._beam, x, z)
         return float(x[0]), float(z[0]), float(pitch[0])
 
     def advance_to(self, now: float) -> TipTrajectory:
@@ -203,6 +205,7 @@ class PredictionStream:
         phi[lo:], _ = simulation.advance(physical[lo:])
         loads[lo:] = simulation.load_kg
         x, z, pitch = simulation.chain.tip_pose(phi)
+        x, z = scaled_position(self._beam, x, z)
         return TipTrajectory(t=stamps, x=x, z=z, pitch=pitch, load_kg=loads, q=phi)
 
 

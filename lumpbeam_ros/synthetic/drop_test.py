@@ -18,7 +18,12 @@ import numpy as np
 
 from lumpbeam_ros.bagio import BagWriter
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters, DropTestConfig
+from lumpbeam_ros.model.parameters import (
+    EFFECT_PARAMETERS,
+    BeamParameters,
+    DropTestConfig,
+    effect_value_problem,
+)
 from lumpbeam_ros.model.simulate import drop_test_events, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.synthetic.tracker import TrackerOptions, simulate_tracker, write_tracker_points
@@ -74,7 +79,8 @@ def parse_effect(text: str) -> tuple[str, float]:
         The effect's SPEC name and its parameter.
 
     Raises:
-        LumpbeamError: Not ``NAME=VALUE``, an unknown name, or a negative or non-finite value.
+        LumpbeamError: Not ``NAME=VALUE``, an unknown name, or a value outside the effect's
+            physical limits (:data:`~lumpbeam_ros.model.parameters.EFFECT_LIMITS`).
     """
     name, sep, value_text = text.partition('=')
     name = name.strip()
@@ -89,8 +95,9 @@ def parse_effect(text: str) -> tuple[str, float]:
         value = float(value_text)
     except ValueError:
         raise LumpbeamError(f'--effect {text!r}: {value_text!r} is not a number') from None
-    if not math.isfinite(value) or value < 0.0:
-        raise LumpbeamError(f'--effect {text!r}: the value must be zero or positive')
+    problem = effect_value_problem(name, value)
+    if problem is not None:
+        raise LumpbeamError(f'--effect {text!r}: {EFFECT_PARAMETERS[name]} {problem}')
     return name, value
 
 
@@ -113,18 +120,18 @@ def simulate_experiment(
         options: Duration, rate and hidden effects.
 
     Returns:
-        ``(measured, truth)``: the measurement without noise (every effect, latency
-        included) and the true pose at the same stamps (no latency).
+        ``(measured, truth)``: the measurement without noise (every effect, the sensor's
+        latency and scale included) and the true pose at the same stamps (without them).
     """
     hidden = with_effects(beam, options.effects)
     count = int(math.floor(options.duration_s * options.rate_hz + 1e-9)) + 1
     t = np.arange(count) / options.rate_hz
     events = drop_test_events(drop)
     measured = simulate_loads(hidden, t, events, drop.load_kg)
-    if hidden.effects.latency_s == 0.0:
+    true_sensor = replace(hidden, effects=hidden.effects.physical())
+    if true_sensor == hidden:
         return measured, measured
-    on_time = replace(hidden, effects=hidden.effects.with_effect('sensor_latency', 0.0))
-    return measured, simulate_loads(on_time, t, events, drop.load_kg)
+    return measured, simulate_loads(true_sensor, t, events, drop.load_kg)
 
 
 def load_messages(drop: DropTestConfig, duration_s: float) -> list[tuple[float, float]]:

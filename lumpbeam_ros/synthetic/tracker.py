@@ -95,8 +95,8 @@ def simulate_tracker(
     """Simulates the tracker over a drop test.
 
     Args:
-        beam: The beam as it really is (hidden effects included; a ``sensor_latency`` is the
-            camera's, so it is removed here).
+        beam: The beam as it really is (hidden effects included; ``sensor_latency`` and
+            ``sensor_scale`` are the camera's, so they are removed here).
         drop: The load and its release time.
         duration_s: Length of the record in true time, s.
         options: The tracker.
@@ -104,7 +104,7 @@ def simulate_tracker(
     Returns:
         The samples from true time 0 (or from the first with a non-negative stamp).
     """
-    physical = replace(beam, effects=beam.effects.with_effect('sensor_latency', 0.0))
+    physical = replace(beam, effects=beam.effects.physical())
     count = int(math.floor(duration_s * options.rate_hz + 1e-9)) + 1
     t = np.arange(count) / options.rate_hz
     t = t[t + options.clock_offset_s >= 0.0]  # ROS time has no negative stamps

@@ -2,6 +2,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from scipy.integrate import quad
 
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.integrate import ChainState, ModalSolver, solve_reference
@@ -43,6 +44,10 @@ def test_energy_decays_with_damping():
         (Effects(k_base_nm_per_rad=2e4, added_mass_kg=0.3), 1e-7),
         # Radau needs the friction sign smoothed; the modal solver steps it exactly.
         (Effects(coulomb_torque_nm=1.0), 1e-4),
+        (Effects(k3_nm_per_rad3=1e8), 1e-6),
+        (Effects(k3_nm_per_rad3=-5e7), 1e-6),
+        (Effects(tilt_rad=0.2), 1e-7),
+        (Effects(k3_nm_per_rad3=1e8, coulomb_torque_nm=1.0), 1e-4),
     ],
 )
 def test_modal_solver_matches_radau(effects, tolerance_m):
@@ -65,3 +70,52 @@ def test_large_rotation_falls_back_or_converges():
     if solution is not None:
         assert np.max(np.abs(solution.phi - reference.phi)) < 1e-5
     assert np.max(np.abs(reference.phi)) > 0.3
+
+
+def _duffing_period(omega0: float, epsilon: float, amplitude: float) -> float:
+    """Exact period of ``x'' + omega0^2 x + epsilon x^3 = 0`` released at rest from ``A``.
+
+    ``T = 4 int_0^A dx / sqrt(2 (V(A) - V(x)))`` with ``x = A sin(u)`` removing the
+    endpoint singularity; numerical quadrature, independent of the chain and its solver.
+    """
+
+    def integrand(u: float) -> float:
+        x = amplitude * np.sin(u)
+        drop = omega0**2 * (amplitude**2 - x**2) / 2 + epsilon * (amplitude**4 - x**4) / 4
+        return amplitude * np.cos(u) / np.sqrt(2.0 * drop)
+
+    return 4.0 * quad(integrand, 0.0, np.pi / 2, epsabs=1e-14, epsrel=1e-12)[0]
+
+
+@pytest.mark.parametrize('k3', [4e4, -3e4])
+def test_cubic_stiffness_shifts_the_frequency_as_duffing_predicts(k3):
+    # One rigid segment without gravity or damping: J theta'' + k theta + k3 theta^3 = 0,
+    # the undamped Duffing oscillator. Its period at 0.1 rad, hardening (shorter) or
+    # softening (longer), against the exact quadrature; harmonic balance, omega^2 =
+    # omega0^2 + 3 k3 A^2 / (4 J), agrees to first order in k3.
+    beam = BeamParameters(
+        n_segments=1, gravity_mps2=0.0, beta_identified=0.0, tip_mass_kg=2.5, mass_kg=1.9
+    )
+    beam = replace(beam, effects=Effects(k3_nm_per_rad3=k3))
+    chain = LumpedChain.from_beam(beam)
+    inertia = float(chain.mass_matrix(np.zeros(1))[0, 0])
+    k = float(chain.stiffness[0])
+    amplitude = 0.1
+    start = ChainState(np.array([amplitude]), np.zeros(1))
+    with np.errstate(all='ignore'):  # a diverging relaxation is detected and returns None
+        solution = ModalSolver(chain).solve(start, 4.0, 1e-3)
+    if solution is None:  # too nonlinear for the waveform relaxation: the simulator's fallback
+        grid = np.linspace(0.0, 4.0, 4001)
+        solution = solve_reference(chain, start, grid, rtol=1e-11, atol=1e-13)
+    theta = solution.phi[:, 0]
+    # Downward zero crossings, linearly interpolated: the period between the first and last.
+    down = np.flatnonzero((theta[:-1] > 0) & (theta[1:] <= 0))
+    crossings = solution.t[down] + theta[down] / (theta[down] - theta[down + 1]) * 1e-3
+    period = (crossings[-1] - crossings[0]) / (crossings.size - 1)
+    omega0 = np.sqrt(k / inertia)
+    exact = _duffing_period(omega0, k3 / inertia, amplitude)
+    linear = 2 * np.pi / omega0
+    balance = 2 * np.pi / np.sqrt(omega0**2 + 0.75 * k3 / inertia * amplitude**2)
+    assert abs(exact / linear - 1.0) > 0.01  # the shift is large enough to test
+    assert period == pytest.approx(exact, rel=2e-5)
+    assert abs(period / balance - 1.0) < 0.1 * abs(exact / linear - 1.0)

@@ -38,7 +38,9 @@ def test_partial_file_takes_defaults(tmp_path):
 
 def test_roundtrip(tmp_path):
     beam = BeamParameters(n_segments=7, tip_placement='segment_com')
-    beam = replace(beam, effects=beam.effects.with_effect('added_mass', 0.3))
+    effects = beam.effects.with_effect('added_mass', 0.3).with_effect('sensor_scale', 1.04)
+    effects = effects.with_effect('cubic_stiffness', -2e7).with_effect('mount_tilt', -0.03)
+    beam = replace(beam, effects=effects)
     path = tmp_path / 'out.yaml'
     write_beam_config(path, beam, DropTestConfig(load_kg=3.0), header='written by a test')
     assert load_beam_config(path) == (beam, DropTestConfig(load_kg=3.0))
@@ -58,6 +60,21 @@ def test_roundtrip(tmp_path):
         ('beam:\n      lenght_m: 2.0', 'beam.lenght_m', 'unknown key'),
         ('tip:\n      placement: middle', 'tip.placement', 'must be one of'),
         ('tip:\n      mass_kg: -2.5', 'tip.mass_kg', 'must not be negative'),
+        (
+            'effects:\n      sensor_scale:\n        scale: 0.0',
+            'effects.sensor_scale.scale',
+            'must be positive',
+        ),
+        (
+            'effects:\n      mount_tilt:\n        tilt_rad: -2.0',
+            'effects.mount_tilt.tilt_rad',
+            'must be in (-1.5708, 1.5708)',
+        ),
+        (
+            'effects:\n      added_mass:\n        mass_kg: -0.1',
+            'effects.added_mass.mass_kg',
+            'must be zero or positive',
+        ),
     ],
 )
 def test_bad_values_name_file_and_key(tmp_path, body, key, problem):

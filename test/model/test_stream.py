@@ -25,10 +25,19 @@ def _run(stream, until, seed=0, start=None):
     return t, z, pitch
 
 
-@pytest.mark.parametrize('latency', [0.0, 0.013])
+@pytest.mark.parametrize(
+    'effects',
+    [
+        {},
+        {'sensor_latency': 0.013},
+        {'sensor_scale': 1.05, 'mount_tilt': 0.1, 'cubic_stiffness': 5e7},
+    ],
+)
 @pytest.mark.parametrize('t0', [0.0, 1_700_000_000.25])
-def test_matches_the_batch_simulation_on_the_same_stamps(latency, t0):
-    beam = replace(BEAM, effects=BEAM.effects.with_effect('sensor_latency', latency))
+def test_matches_the_batch_simulation_on_the_same_stamps(effects, t0):
+    beam = replace(BEAM, effects=BEAM.effects)
+    for name, value in effects.items():
+        beam = replace(beam, effects=beam.effects.with_effect(name, value))
     stream = PredictionStream(beam, 4.5, t0, rate_hz=180.0)
     stream.set_load(t0 + 1.0, 0.0)
     stream.set_load(t0 + 2.5, 1.0)

@@ -10,6 +10,7 @@ from lumpbeam_ros.synthetic.drop_test import (
     SynthOptions,
     parse_effect,
     simulate_experiment,
+    with_effects,
     write_drop_test_bag,
 )
 
@@ -47,6 +48,10 @@ def test_latency_is_hidden_from_the_truth():
         ('added_mass=heavy', 'not a number'),
         ('added_mass=-0.3', 'zero or positive'),
         ('added_mass=nan', 'zero or positive'),
+        ('sensor_scale=0', 'scale must be positive'),
+        ('sensor_scale=-1.1', 'scale must be positive'),
+        ('mount_tilt=1.6', 'tilt_rad must be in .-1.5708, 1.5708.'),
+        ('cubic_stiffness=inf', 'k3_nm_per_rad3 must be finite'),
     ],
 )
 def test_bad_effects(text, message):
@@ -56,6 +61,17 @@ def test_bad_effects(text, message):
 
 def test_good_effect():
     assert parse_effect('base_compliance=2e4') == ('base_compliance', 2e4)
+    assert parse_effect('cubic_stiffness=-3e7') == ('cubic_stiffness', -3e7)
+    assert parse_effect('mount_tilt=-0.05') == ('mount_tilt', -0.05)
+
+
+def test_the_sensor_s_scale_is_hidden_from_the_truth():
+    options = SynthOptions(duration_s=3.0, effects={'sensor_scale': 1.05, 'mount_tilt': 0.1})
+    measured, truth = simulate_experiment(BeamParameters(), DropTestConfig(), options)
+    tilted = with_effects(BeamParameters(), {'mount_tilt': 0.1})
+    assert np.max(np.abs(truth.z - simulate_loads(tilted, truth.t, [(2.0, 0.0)], 4.5).z)) < 1e-12
+    assert np.max(np.abs(measured.z - truth.z)) > 1e-3
+    np.testing.assert_array_equal(measured.pitch, truth.pitch)
 
 
 @pytest.mark.parametrize(
