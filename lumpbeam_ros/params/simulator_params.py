@@ -13,6 +13,9 @@ EFFECT_BOUNDS: dict[str, tuple[Bounds, str]] = {
     'c_q': (Bounds(0.0, 1000.0), 'N s^2/m^2'),
     'mass_kg': (Bounds(0.0, 1000.0), 'kg'),
     'latency_s': (Bounds(0.0, 1.0), 's'),
+    'k3_nm_per_rad3': (Bounds(-1e12, 1e12), 'N m/rad^3'),  # hardening > 0, softening < 0
+    'scale': (Bounds(0.0, 10.0, low_open=True), ''),  # 1: a camera that measures true
+    'tilt_rad': (Bounds(-1.5, 1.5), 'rad'),
 }
 
 

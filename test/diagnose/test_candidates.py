@@ -4,7 +4,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from lumpbeam_ros.diagnose.candidates import effect_candidates, nominal_candidate
+from lumpbeam_ros.diagnose.candidates import SEARCHED_EFFECTS, effect_candidates, nominal_candidate
 from lumpbeam_ros.diagnose.workflow import nominal_form
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters
 
@@ -24,7 +24,8 @@ def _x(candidate, value, k_factor=1.0, beta_factor=1.0):
 
 def test_one_candidate_per_spec_effect_and_the_nominal_model_at_strength_zero():
     candidates = effect_candidates(BEAM)
-    assert [c.name for c in candidates] == list(EFFECT_PARAMETERS)
+    assert [c.name for c in candidates] == list(SEARCHED_EFFECTS)
+    assert set(SEARCHED_EFFECTS) <= set(EFFECT_PARAMETERS)
     assert all(c.parameter == EFFECT_PARAMETERS[c.name] for c in candidates)
     for c in candidates:
         lo, hi = c.bounds()
