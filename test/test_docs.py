@@ -20,7 +20,7 @@ import pytest
 
 from lumpbeam_ros.bench.result import BenchResult
 from lumpbeam_ros.campaign.task import ID_COLUMNS
-from lumpbeam_ros.cli.analyze import SPEC_KEYS
+from lumpbeam_ros.cli.analyze import CONTRACT_KEYS
 from lumpbeam_ros.cli.main import COMMANDS, build_parser
 from lumpbeam_ros.diagnose.gap import Gap
 from lumpbeam_ros.diagnose.signatures import Signatures
@@ -133,8 +133,8 @@ def json_keys() -> dict[str, set[str]]:
         | field_names(Comparison)
         | dict_keys('model/reproduce.py', 'paper_frequencies')
         | dict_keys('model/reproduce.py', 'static_test'),
-        'analyze': set(SPEC_KEYS)
-        | {f'{key}_std' for key in SPEC_KEYS}
+        'analyze': set(CONTRACT_KEYS)
+        | {f'{key}_std' for key in CONTRACT_KEYS}
         | {'release_time_s', 'static_deflection_m'}
         | identification,
         '/beam_params': (identification - {'status', 'message'})

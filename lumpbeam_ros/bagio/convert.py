@@ -1,6 +1,6 @@
 """Conversions between ROS messages (rosbags classes) and numbers / numpy arrays.
 
-Conventions (SPEC section 2): poses are in frame ``beam_base`` (x toward the tip, z up);
+Conventions (doc/interfaces.md): poses are in frame ``beam_base`` (x toward the tip, z up);
 the tip's pitch is its rotation about +y, positive when the tip bends down, so a pitch
 ``theta`` is the quaternion ``(w, x, y, z) = (cos theta/2, 0, sin theta/2, 0)``. Header stamps
 are the time the measurement describes. Times are integer nanoseconds in messages and float
@@ -344,7 +344,7 @@ class Status:
         name: E.g. ``'lumpbeam/identifier'``.
         level: 0 OK, 1 WARN, 2 ERROR, 3 STALE.
         message: Human-readable summary.
-        values: Key-value pairs (values as strings; SPEC 3 uses ``repr`` of floats).
+        values: Key-value pairs (values as strings; doc/interfaces.md uses ``repr`` of floats).
         hardware_id: Optional hardware identifier.
     """
 

@@ -1,6 +1,6 @@
 """Whole topics as numpy arrays: what the offline commands (analyze, diagnose) read.
 
-Times are header stamps (measurement time, SPEC section 2) in float seconds, sorted; a topic
+Times are header stamps (measurement time, doc/interfaces.md) in float seconds, sorted; a topic
 without a header (``std_msgs/Float64``) uses the log time, which equals the stamp in
 synthetic bags and is the receive time in recorded ones.
 """

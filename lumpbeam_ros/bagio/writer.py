@@ -19,7 +19,7 @@ adds what a recorder needs on top of it:
   so a writer whose sources are out of order merges them first.
 
 Messages' log time is the recording time; for synthetic bags it equals the header stamp
-(SPEC section 2: stamps are measurement time).
+(doc/interfaces.md, 'Frames, units and time': stamps are measurement time).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The result record of one benchmark (SPEC section 5, ``bench`` JSON keys)."""
+"""The result record of one benchmark (doc/interfaces.md, 'Command line', ``bench`` JSON keys)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""``lumpbeam analyze BAG``: identification of a recorded drop test (SPEC section 5)."""
+"""``lumpbeam analyze BAG``: identification of a recorded drop test (doc/interfaces.md)."""
 
 from __future__ import annotations
 
@@ -10,15 +10,15 @@ from lumpbeam_ros.cli.output import write_json
 from lumpbeam_ros.ident.config import load_identifier_config
 from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.pipeline.bag_analysis import (
+    CONTRACT_KEYS,
     POSE_TOPIC,
-    SPEC_KEYS,
     analyze_bag,
     read_window,
     result_json,
 )
 from lumpbeam_ros.progress import Progress
 
-__all__ = ['SPEC_KEYS', 'Progress', 'read_window', 'result_json', 'run']
+__all__ = ['CONTRACT_KEYS', 'Progress', 'read_window', 'result_json', 'run']
 
 
 def run(args: argparse.Namespace) -> int:

@@ -1,4 +1,4 @@
-"""``lumpbeam compare BAG``: camera poses against a reference sensor (SPEC section 5)."""
+"""``lumpbeam compare BAG``: camera poses against a reference sensor (doc/interfaces.md)."""
 
 from __future__ import annotations
 

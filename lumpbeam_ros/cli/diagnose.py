@@ -1,4 +1,4 @@
-"""``lumpbeam diagnose BAG``: the model-discrepancy workflow of SPEC section 6."""
+"""``lumpbeam diagnose BAG``: the model-discrepancy workflow of doc/interfaces.md."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""``lumpbeam record OUT [TOPIC...] [--all]``: record live topics into a bag (SPEC 5)."""
+"""``lumpbeam record OUT [TOPIC...] [--all]``: record live topics into a bag."""
 
 from __future__ import annotations
 

@@ -31,7 +31,7 @@ def _format(rows: list[Comparison]) -> str:
 
 
 def result_json(result: Reproduction, rows: list[Comparison]) -> dict:
-    """The JSON of SPEC section 5, plus the comparison with the paper."""
+    """The JSON of doc/interfaces.md, 'Command line', plus the comparison with the paper."""
     return {
         'table_b1': [asdict(r) for r in result.table_b1],
         'table_b2': [asdict(r) for r in result.table_b2],

@@ -1,4 +1,4 @@
-"""``lumpbeam synth OUT``: a synthetic drop-test bag (SPEC section 5)."""
+"""``lumpbeam synth OUT``: a synthetic drop-test bag (doc/interfaces.md, 'Command line')."""
 
 from __future__ import annotations
 

@@ -7,7 +7,7 @@ offset ``tau`` (``tracker_stamp = camera_stamp + tau``). Two blocks of residuals
   transformed reference read at ``t_i + tau``. These fix the offset, the translation and the
   rotation about the axes the tip's large vertical motion spans.
 * plane: the transformed ``y`` of every reference sample, which is zero because the tip moves
-  in the ``x``-``z`` plane (SPEC section 2). The rotation about the vertical is seen only
+  in the ``x``-``z`` plane (doc/interfaces.md). The rotation about the vertical is seen only
   through the tip's small bow along the beam, so every reference sample counts here, not
   just the ones at camera stamps.
 

@@ -1,7 +1,7 @@
 """The two position streams a comparison takes, and gap-aware interpolation of the reference.
 
 A :class:`Track` is one sensor's point positions over its own clock: the camera's tip
-positions in ``beam_base`` (``y = 0``: the motion is planar, SPEC section 2) or the tracker's
+positions in ``beam_base`` (``y = 0``: the motion is planar, doc/interfaces.md) or the tracker's
 retroreflector positions in the tracker's frame. :class:`GapInterpolator` reads the fast
 reference stream at arbitrary times and says where it cannot: outside its span and inside
 dropouts, where a straight line between the samples around the gap would be a guess.

@@ -1,7 +1,7 @@
-"""Model-discrepancy diagnosis (SPEC section 6): residual signatures, candidate effects, scores.
+"""Model-discrepancy diagnosis (doc/interfaces.md): residual signatures, candidate effects, scores.
 
 Where a simulation and a measurement disagree, which physics is missing? The nominal beam and
-the nominal beam plus each effect of SPEC section 6 are fitted to a drop-test record (tip z
+the nominal beam plus each effect of doc/interfaces.md are fitted to a drop-test record (tip z
 and pitch under the ``/tip_load`` events) by least squares on the modal simulator, scored by
 an information criterion and on a held-out part of the record, and the winner is named only
 when the data insist on it; otherwise the answer is ``none`` or ``unexplained``.

@@ -1,4 +1,4 @@
-"""The models a diagnosis compares: the nominal beam and one candidate per SPEC section 6 effect.
+"""The models a diagnosis compares: the nominal beam and one candidate per missing effect.
 
 Every model refits the two nominal parameters that the data identify and that trade off with
 the effects: ``k_total_nm_per_rad`` (k_tE, B.12: the static drop and the frequency) and
@@ -6,7 +6,7 @@ the effects: ``k_total_nm_per_rad`` (k_tE, B.12: the static drop and the frequen
 (positive by construction, order one whatever the unit).
 
 A candidate adds one *strength*: a quantity that is zero when the effect is off and grows
-with it, fitted linearly in units of ``scale``. For four effects it is the SPEC parameter
+with it, fitted linearly in units of ``scale``. For four effects it is the contract parameter
 itself; for ``base_compliance`` it is the mount's compliance relative to the clamp joint,
 ``k_clamp / k_base`` (a rigid mount is 0, where ``k_base`` would be infinite). So the nominal
 model is the candidate at strength 0, a bound that the least squares reaches in a step or
@@ -38,13 +38,13 @@ class Candidate:
     """One model: the nominal beam, or the nominal beam plus one effect.
 
     Attributes:
-        name: ``'nominal'`` or an effect name of SPEC section 6.
-        parameter: The effect's SPEC parameter name (``None`` for the nominal model).
+        name: ``'nominal'`` or an effect name of doc/interfaces.md, 'Missing effects'.
+        parameter: The effect's contract parameter name (``None`` for the nominal model).
         scale: Unit of the fitted strength (``x[2] = strength / scale``).
         search_max: Largest strength searched.
         plausible_max: Largest strength a real setup can have.
         start: Strength a fit starts from: small, but felt by the data.
-        reciprocal: The SPEC parameter is ``reference / strength`` (a compliance fitted
+        reciprocal: The contract parameter is ``reference / strength`` (a compliance fitted
             for a stiffness), else the strength itself.
         reference: See ``reciprocal``.
     """
@@ -87,7 +87,7 @@ class Candidate:
         return np.r_[nominal_x[:2], (self.start if strength is None else strength) / self.scale]
 
     def value(self, x: np.ndarray) -> float:
-        """The effect's SPEC parameter (SI) at ``x``; NaN for the nominal model.
+        """The effect's contract parameter (SI) at ``x``; NaN for the nominal model.
 
         A reciprocal parameter at strength 0 is infinite (a rigid mount).
         """

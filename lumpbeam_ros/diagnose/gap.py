@@ -19,7 +19,7 @@ SETTLE_S = 0.3
 
 @dataclass(frozen=True)
 class Gap:
-    """How far a model is from the measurement (SPEC section 5, ``gap_before``/``gap_after``).
+    """How far a model is from the measurement (doc/interfaces.md, ``gap_before``/``gap_after``).
 
     Attributes:
         rms_m: RMS of the tip-z residual over the record, m.

@@ -29,7 +29,7 @@ MIN_TRACKED_SAMPLES = 20
 
 @dataclass(frozen=True)
 class Record:
-    """Tip poses in ``beam_base`` and the ``/tip_load`` schedule (SPEC sections 2, 3).
+    """Tip poses in ``beam_base`` and the ``/tip_load`` schedule (doc/interfaces.md).
 
     Attributes:
         t: Pose stamps, s, increasing.

@@ -1,4 +1,4 @@
-"""The discrepancy workflow of SPEC section 6: measure the gap, name the missing effect, close it.
+"""The discrepancy workflow: measure the gap, name the missing effect, close it.
 
 1. Measurement error of z and pitch from the data (:mod:`~lumpbeam_ros.diagnose.noise`):
    the larger of the white noise and what a free-form fit of the free decay leaves, so a
@@ -56,10 +56,10 @@ DEFAULT_C_TOTAL = 0.08
 
 @dataclass(frozen=True)
 class Diagnosis:
-    """What ``lumpbeam diagnose`` reports (SPEC section 5, ``diagnose`` keys).
+    """What ``lumpbeam diagnose`` reports (doc/interfaces.md, 'Command line', ``diagnose`` keys).
 
     Attributes:
-        missing_effect: An effect name of SPEC section 6, ``'none'`` or ``'unexplained'``.
+        missing_effect: An effect name of doc/interfaces.md, ``'none'`` or ``'unexplained'``.
         effect_parameters: The named effect's parameter (empty otherwise).
         gap_before: The nominal model (k_tE, beta refit) against the record.
         gap_after: The augmented model against the record (the nominal one when nothing
@@ -100,7 +100,7 @@ class Diagnosis:
     simulations: int
 
     def as_dict(self) -> dict[str, Any]:
-        """The JSON form: the SPEC keys, then ``details`` for humans and plots."""
+        """The JSON form: the contract keys, then ``details`` for humans and plots."""
         return {
             'missing_effect': self.missing_effect,
             'effect_parameters': dict(self.effect_parameters),

@@ -1,4 +1,4 @@
-"""The identification result: SPEC section 3 (``/beam_params``) and section 5 (``analyze``)."""
+"""The identification result: doc/interfaces.md (``/beam_params``) and section 5 (``analyze``)."""
 
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ class Status(IntEnum):
 class Identification:
     """Frequency, damping and stiffness identified from one window, each with its std.
 
-    Keys follow SPEC sections 3 and 5; a ``<key>_std`` field is the standard deviation of
+    Keys follow doc/interfaces.md; a ``<key>_std`` field is the standard deviation of
     ``<key>``. NaN marks a figure the window does not determine (e.g. no stiffness without a
     release in it). Paper equation numbers: B.12 (stiffness), B.20 and B.21 (decrement and
     damping ratio), B.22 (total damping).
@@ -142,7 +142,7 @@ class Identification:
         return out
 
     def key_values(self) -> list[tuple[str, str]]:
-        """The ``/beam_params`` KeyValue pairs: floats as Python ``repr`` (SPEC section 3).
+        """The ``/beam_params`` KeyValue pairs: floats as Python ``repr`` (doc/interfaces.md).
 
         ``status`` and ``message`` are left out: they are the DiagnosticStatus's own level
         and message. Strings (``method``, ``release_source``) are given as they are.

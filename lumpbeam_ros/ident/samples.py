@@ -1,7 +1,7 @@
 """Tip-pose samples as the estimators take them, and their validation.
 
 A :class:`PoseWindow` is what the identifier analyses: stamps, vertical tip position and tip
-pitch (SPEC section 2), plus the ``/tip_load`` readings that fall in or just before it.
+pitch (doc/interfaces.md), plus the ``/tip_load`` readings that fall in or just before it.
 :func:`clean_window` turns raw samples (a bag, a live buffer) into strictly increasing, finite
 arrays and counts what it dropped, so a bad sample never becomes an exception in a live node.
 """

@@ -2,7 +2,7 @@
 
 The equations of motion are the paper's Newton-Euler form (B.14-B.18) written in the absolute
 segment angles ``phi`` of B.17. With ``phi_i`` the pitch of segment ``i`` (positive when it
-points downward, SPEC section 2) and every mass a point on some segment at a lever ``l_i^p``
+points downward, doc/interfaces.md) and every mass a point on some segment at a lever ``l_i^p``
 from joint ``i``, B.16 collapses to
 
     M(phi) phi'' + S(phi) phi'^2 + K phi + C phi' = g G cos(phi + tilt) + Q_e(phi, phi'),

@@ -25,7 +25,7 @@ from lumpbeam_ros.resources import config_path
 StiffnessSource = Literal['analytic', 'identified']
 TipPlacement = Literal['free_end', 'segment_com']
 
-#: SPEC section 6: each effect's name and its single parameter.
+#: doc/interfaces.md, 'Missing effects': each effect's name and its single parameter.
 EFFECT_PARAMETERS: dict[str, str] = {
     'base_compliance': 'k_base_nm_per_rad',
     'coulomb_friction': 'torque_nm',
@@ -150,7 +150,7 @@ class Effects:
 
 @dataclass(frozen=True)
 class BeamParameters:
-    """The lumped beam of SPEC section 1.
+    """The lumped beam of doc/interfaces.md, 'Beam model'.
 
     Attributes:
         length_m: L.
@@ -259,7 +259,7 @@ _KEYS = frozenset(
 def beam_from_parameters(params: Mapping[str, Any], source: str | Path) -> BeamParameters:
     """Builds and validates beam parameters from flat (dotted) ROS parameters.
 
-    Missing keys take the defaults of SPEC section 1.
+    Missing keys take the defaults of doc/interfaces.md, 'Beam model'.
 
     Args:
         params: Flat parameters, e.g. from :func:`~lumpbeam_ros.paramfile.read_parameter_file`.
@@ -315,7 +315,7 @@ def beam_from_parameters(params: Mapping[str, Any], source: str | Path) -> BeamP
 
 
 def drop_test_from_parameters(params: Mapping[str, Any], source: str | Path) -> DropTestConfig:
-    """Builds the drop-test scenario from flat parameters (defaults of SPEC section 5)."""
+    """Builds the drop-test scenario from flat parameters (defaults of doc/interfaces.md)."""
     d = DropTestConfig()
     return DropTestConfig(
         load_kg=get_float(params, 'drop_test.load_kg', source, d.load_kg, non_negative=True),

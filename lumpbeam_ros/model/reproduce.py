@@ -1,6 +1,6 @@
 """The paper's numbers recomputed with this model: Tables B.1 and B.2, frequencies, statics.
 
-The bookkeeping follows SPEC section 1: table rows carry the load at the free end of the last
+The bookkeeping follows doc/interfaces.md: table rows carry the load at the free end of the last
 segment (the ``n_s = 1`` row at that segment's centre), and the paper's frequencies lump the
 tip masses into the last segment's centre of mass ("added to m_ns").
 """
@@ -116,7 +116,7 @@ def static_test(beam: BeamParameters) -> dict[str, float]:
 
 @dataclass(frozen=True)
 class Reproduction:
-    """This model's values for everything the paper reports (SPEC section 5 keys)."""
+    """This model's values for everything the paper reports (doc/interfaces.md keys)."""
 
     table_b1: list[TableRow]
     table_b2: list[TableRow]
@@ -129,7 +129,7 @@ def reproduce(beam: BeamParameters | None = None) -> Reproduction:
     """Recomputes the paper's tables, frequencies and static deflections.
 
     Args:
-        beam: The beam (default: SPEC section 1, n_s = 10).
+        beam: The beam (default: doc/interfaces.md, 'Beam model', n_s = 10).
 
     Returns:
         The values, with the frequencies also for tip masses at the free end.

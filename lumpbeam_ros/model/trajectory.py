@@ -9,7 +9,7 @@ import numpy as np
 
 @dataclass(frozen=True)
 class TipTrajectory:
-    """Tip pose samples in frame ``beam_base`` (SPEC section 2).
+    """Tip pose samples in frame ``beam_base`` (doc/interfaces.md, 'Frames, units and time').
 
     Attributes:
         t: Sample times, s, increasing.

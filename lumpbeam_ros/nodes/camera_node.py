@@ -1,4 +1,4 @@
-"""The camera node: camera frames in, the tip pose out (SPEC section 3).
+"""The camera node: camera frames in, the tip pose out (doc/interfaces.md, 'Topics').
 
 Subscribes to ``/camera/image_raw`` and ``/camera/camera_info`` (sensor-data QoS: best
 effort, a late frame is worth less than the next) and publishes, stamped with each image's

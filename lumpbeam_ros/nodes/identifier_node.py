@@ -5,7 +5,7 @@ reliable and transient local as :mod:`lumpbeam_ros.bagio.qos` gives it), keeps t
 ``window.length_s`` of poses in a :class:`~lumpbeam_ros.ident.window.SlidingWindow`, and on
 a timer at ``publish_rate_hz`` identifies the window
 (:func:`~lumpbeam_ros.ident.identify.identify_from`, warm-started from the last update) and
-publishes one DiagnosticStatus ``lumpbeam/identifier`` (SPEC section 3).
+publishes one DiagnosticStatus ``lumpbeam/identifier`` (doc/interfaces.md, 'Topics').
 
 Parameters: :data:`~lumpbeam_ros.params.identifier_params.IDENTIFIER_SCHEMA`
 (``doc/parameters.md``). Run it with the package's settings, on sim time when a bag is
@@ -149,7 +149,7 @@ class IdentifierNode(Node):
         self._output.publish(self.diagnostics(result))
 
     def diagnostics(self, result: Identification) -> DiagnosticArray:
-        """The ``/beam_params`` message of one identification (SPEC section 3).
+        """The ``/beam_params`` message of one identification (doc/interfaces.md, 'Topics').
 
         Args:
             result: The identification.

@@ -27,7 +27,7 @@ LOAD_TOPIC = '/tip_load'
 BASE_FRAME = 'beam_base'
 
 #: The keys scripts rely on (doc/interfaces.md, "lumpbeam analyze"), each also with ``_std``.
-SPEC_KEYS = (
+CONTRACT_KEYS = (
     'natural_frequency_hz',
     'damped_frequency_hz',
     'damping_ratio',
@@ -90,8 +90,8 @@ def read_window(bag: str | Path, show_progress: bool = True) -> PoseWindow:
 def result_json(result: Identification) -> dict[str, Any]:
     """The JSON of ``lumpbeam analyze``: the keys scripts rely on first, then every other."""
     data = result.as_dict()
-    head = {key: data[key] for key in SPEC_KEYS}
-    head.update({f'{key}_std': data[f'{key}_std'] for key in SPEC_KEYS})
+    head = {key: data[key] for key in CONTRACT_KEYS}
+    head.update({f'{key}_std': data[f'{key}_std'] for key in CONTRACT_KEYS})
     head['release_time_s'] = data['release_time_s']
     head['static_deflection_m'] = data['static_deflection_m']
     return {**head, **{k: v for k, v in data.items() if k not in head}}

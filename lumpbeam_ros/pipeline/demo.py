@@ -136,7 +136,7 @@ class DemoOptions:
         ready_timeout_s: Longest wait for the nodes to join the graph, s.
         image_size: Width and height of the synthetic camera's frames; ``None`` plays the
             bag's ``/tip_pose`` instead of running the camera node.
-        effects: Effects of SPEC section 6 hidden in the synthetic data, for the diagnosis
+        effects: Effects of doc/interfaces.md hidden in the synthetic data, for the diagnosis
             step to find (default: the camera's stamps 15 ms late).
     """
 

@@ -12,7 +12,7 @@ matplotlib.use('Agg')  # files only: no display
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from lumpbeam_ros.pipeline.bag_analysis import SPEC_KEYS, BagAnalysis, result_json  # noqa: E402
+from lumpbeam_ros.pipeline.bag_analysis import CONTRACT_KEYS, BagAnalysis, result_json  # noqa: E402
 from lumpbeam_ros.plots.analysis import write_analysis_plots  # noqa: E402
 from lumpbeam_ros.report.html import HtmlReport, as_cell, estimate_rows, figure_png  # noqa: E402
 
@@ -95,7 +95,7 @@ def add_analysis(page: HtmlReport, analysis: BagAnalysis) -> None:
         f'status {data["status"]}' + (f' ({data["message"]})' if data['message'] else '')
     )
     page.heading('Estimates (1 sigma)')
-    page.table(['estimate', 'value', 'std'], estimate_rows(data, SPEC_KEYS + CROSS_CHECKS))
+    page.table(['estimate', 'value', 'std'], estimate_rows(data, CONTRACT_KEYS + CROSS_CHECKS))
     page.heading('The fit')
     page.table(['figure', 'value'], [[key, as_cell(data.get(key))] for key in FIT_FACTS])
     png = fit_residual_figure(analysis)

@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from lumpbeam_ros.compare.comparison import Comparison  # noqa: E402
-from lumpbeam_ros.pipeline.bag_analysis import SPEC_KEYS  # noqa: E402
+from lumpbeam_ros.pipeline.bag_analysis import CONTRACT_KEYS  # noqa: E402
 from lumpbeam_ros.plots.comparison import plot_comparison  # noqa: E402
 from lumpbeam_ros.report.html import HtmlReport, as_cell, figure_png  # noqa: E402
 
@@ -93,7 +93,7 @@ def write_comparison_report(comparison: Comparison, bag: str | Path, path: str |
                     for k in (key, f'{key}_std')
                 ),
             ]
-            for key in SPEC_KEYS
+            for key in CONTRACT_KEYS
         ],
     )
     with tempfile.TemporaryDirectory(prefix='lumpbeam-report-') as tmp:

@@ -1,4 +1,4 @@
-"""The synthetic drop-test bag of ``lumpbeam synth`` (SPEC section 5).
+"""The synthetic drop-test bag of ``lumpbeam synth`` (doc/interfaces.md, 'Command line').
 
 The model is simulated under the drop-test load schedule and written as a rosbag2 MCAP bag:
 ``/tip_pose`` (the measurement: with pose noise and any hidden effects), ``/tip_pose_truth``
@@ -43,7 +43,7 @@ if TYPE_CHECKING:
 #: Pitch noise per metre of position noise: the camera sees the board about 1 m away.
 PITCH_NOISE_PER_M = 1.0
 
-#: How often ``/tip_load`` repeats its value (SPEC section 3: at least 1 Hz).
+#: How often ``/tip_load`` repeats its value (doc/interfaces.md, 'Topics': at least 1 Hz).
 LOAD_REPEAT_S = 1.0
 
 
@@ -57,7 +57,7 @@ class SynthOptions:
         noise_m: Standard deviation of the position noise on ``/tip_pose``, m; the pitch
             gets ``noise_m * PITCH_NOISE_PER_M`` rad.
         seed: Seed of the noise.
-        effects: Hidden effects, SPEC section 6 name to parameter value.
+        effects: Hidden effects, doc/interfaces.md, 'Missing effects' name to parameter value.
         markers_rate_hz: Rate of ``/beam_markers``, Hz; 0 writes none.
     """
 
@@ -76,7 +76,7 @@ def parse_effect(text: str) -> tuple[str, float]:
         text: The option's value, e.g. ``'coulomb_friction=1.0'``.
 
     Returns:
-        The effect's SPEC name and its parameter.
+        The effect's contract name and its parameter.
 
     Raises:
         LumpbeamError: Not ``NAME=VALUE``, an unknown name, or a value outside the effect's

@@ -3,7 +3,7 @@
 Like the paper's Leica AT960 (Fig. B.8), it follows a retroreflector at the tip: the true
 motion of the beam (every physical effect, but no camera latency), sampled fast on its own
 clock, with its own noise, in its own frame, published as ``/tracker/point``
-(``geometry_msgs/msg/PointStamped``, SPEC section 3).
+(``geometry_msgs/msg/PointStamped``, doc/interfaces.md, 'Topics').
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Rigid transforms of the camera rig: tip pose, camera mount and board pose.
 
-Frame ``beam_base`` (SPEC section 2): x along the undeformed beam, z up, y = z cross x. The
+Frame ``beam_base`` (doc/interfaces.md): x along the undeformed beam, z up, y = z cross x. The
 tip moves in the x-z plane; its pitch is a rotation about +y (positive: the tip points
 down). The camera is rigidly mounted on the tip; the checkerboard is fixed in ``beam_base``.
 """

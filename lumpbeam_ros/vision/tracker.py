@@ -54,7 +54,7 @@ from lumpbeam_ros.vision.pose import (
     tip_pose_from_board_pose,
 )
 
-#: Image encodings :meth:`TipTracker.process` takes (those of SPEC section 3).
+#: Image encodings :meth:`TipTracker.process` takes (those of doc/interfaces.md, 'Topics').
 ENCODINGS = ('mono8', 'bgr8', 'rgb8')
 
 

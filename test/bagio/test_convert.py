@@ -15,7 +15,7 @@ def test_pitch_round_trip(pitch):
 
 
 def test_positive_pitch_points_the_tip_down():
-    # Rotating e_x by +pitch about +y must give a negative z component (REP-103, SPEC 2).
+    # Rotating e_x by +pitch about +y must give a negative z component (REP-103).
     qx, qy, qz, qw = convert.pitch_to_quaternion(0.3)
     d_z = 2.0 * (qx * qz - qw * qy)
     assert d_z == pytest.approx(-math.sin(0.3))

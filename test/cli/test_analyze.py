@@ -5,7 +5,7 @@ import shutil
 import pytest
 
 from lumpbeam_ros.bagio import BagWriter, read_load_events, read_tip_poses
-from lumpbeam_ros.cli.analyze import SPEC_KEYS
+from lumpbeam_ros.cli.analyze import CONTRACT_KEYS
 from lumpbeam_ros.cli.main import main
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.modes import chain_modes
@@ -28,7 +28,7 @@ def test_analyze_prints_writes_json_and_plots(drop_bag, tmp_path, capsys):
     assert 'status: OK' in text and 'natural frequency: 3.0588 +-' in text
     data = json.loads(out.read_text())
     truth = chain_modes(LumpedChain.from_beam(BeamParameters(), 0.0))
-    for key in SPEC_KEYS:
+    for key in CONTRACT_KEYS:
         assert data[key] > 0 and data[f'{key}_std'] > 0
     assert abs(data['natural_frequency_hz'] - truth.natural_frequency_hz[0]) < (
         3 * data['natural_frequency_hz_std']

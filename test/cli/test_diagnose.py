@@ -8,7 +8,7 @@ from lumpbeam_ros.model.parameters import DropTestConfig, load_beam_config
 from lumpbeam_ros.plots.diagnosis import FIGURES
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 
-SPEC_KEYS = ['missing_effect', 'effect_parameters', 'gap_before', 'gap_after', 'candidates']
+CONTRACT_KEYS = ['missing_effect', 'effect_parameters', 'gap_before', 'gap_after', 'candidates']
 
 
 @pytest.fixture(scope='module')
@@ -29,7 +29,7 @@ def test_diagnose_writes_json_figures_and_a_model_that_reads_back(late_bag, tmp_
     assert 'missing effect: sensor_latency' in printed
     assert 'gap before' in printed and 'gap after' in printed
     result = json.loads(json_path.read_text())
-    assert list(result)[:5] == SPEC_KEYS
+    assert list(result)[:5] == CONTRACT_KEYS
     assert result['missing_effect'] == 'sensor_latency'
     assert result['effect_parameters']['latency_s'] == pytest.approx(0.015, rel=0.1)
     assert result['gap_after']['rms_m'] < 0.3 * result['gap_before']['rms_m']

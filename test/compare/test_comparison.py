@@ -12,7 +12,7 @@ from .helpers import CAMERA_NOISE, TRACKER_NOISE, make_pair
 
 COMBINED = math.hypot(CAMERA_NOISE, TRACKER_NOISE)
 
-SPEC_KEYS = [
+CONTRACT_KEYS = [
     'natural_frequency_hz',
     'damped_frequency_hz',
     'damping_ratio',
@@ -54,7 +54,7 @@ def test_json_keys(comparison):
     assert result['time_offset_s'] == pytest.approx(7.3e-3, abs=0.2e-3)
     assert set(result['per_sensor']) == {'camera', 'tracker'}
     for sensor in result['per_sensor'].values():
-        for key in SPEC_KEYS:
+        for key in CONTRACT_KEYS:
             assert key in sensor
         assert sensor['status'] == 'OK'
     transform = result['transform']

@@ -2,7 +2,7 @@
 
 The clamp's torque gains ``-k3 (phi_1 - phi_ref)^3`` about the unloaded rest angle
 ``phi_ref``, so the beam stiffens with the swing and its frequency falls as the decay dies
-out: no effect of SPEC section 6 does that. At rest after the drop the beam sits exactly
+out: no effect of doc/interfaces.md does that. At rest after the drop the beam sits exactly
 where the nominal model puts it; only the loaded rest and the dynamics differ.
 """
 

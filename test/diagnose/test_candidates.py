@@ -17,7 +17,7 @@ def _candidate(name):
 
 
 def _x(candidate, value, k_factor=1.0, beta_factor=1.0):
-    """x for an effect's SPEC parameter value."""
+    """x for an effect's contract parameter value."""
     strength = candidate.reference / value if candidate.reciprocal else value
     return np.array([math.log(k_factor), math.log(beta_factor), strength / candidate.scale])
 

@@ -1,7 +1,7 @@
 """End to end on hidden-effect data: the right name, its parameter, the gap closed.
 
-Each record is the synthetic drop test (SPEC section 5 defaults) with one effect of SPEC
-section 6 hidden at a realistic strength and 20 um of pose noise; the diagnoses run once per
+Each record is the synthetic drop test (doc/interfaces.md defaults) with one effect of
+the library hidden at a realistic strength and 20 um of pose noise; the diagnoses run once per
 module and every test reads them.
 """
 

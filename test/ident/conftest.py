@@ -1,7 +1,7 @@
 """Synthetic drop tests for the identifier tests, from the nonlinear lumped model.
 
 ``make_drop_case`` is the one place that makes test data: it runs
-:func:`lumpbeam_ros.model.simulate.simulate_drop_test` (the identified beam of SPEC section 1,
+:func:`lumpbeam_ros.model.simulate.simulate_drop_test` (the identified beam of doc/interfaces.md,
 n_s = 10) and adds white pose noise. The truth comes from the model itself, never from the
 identifier's own formulas: the first mode of the beam linearised about its unloaded
 equilibrium, and the difference of the two static equilibria.
@@ -106,7 +106,7 @@ def make_drop_case(
     """A drop test: the tip at rest under the load, released, then 10 s of free decay.
 
     Args:
-        beam: The beam (default: the identified beam of SPEC section 1, n_s = 10).
+        beam: The beam (default: the identified beam of doc/interfaces.md, 'Beam model', n_s = 10).
         drop: Load and release time (default: 4.5 kg at 2 s); the record ends
             :data:`DECAY_S` after the release whatever its ``duration_s``.
         damping_scale: Multiplies the beam's ``beta_identified`` (10 gives beta = 120).

@@ -15,7 +15,7 @@ def test_every_paper_number_is_compared():
 
 
 def test_free_end_frequencies_are_the_physical_ones():
-    # SPEC section 1: with the masses at the free end, about 3.22, 3.06 and 2.36 Hz.
+    # doc/interfaces.md: with the masses at the free end, about 3.22, 3.06 and 2.36 Hz.
     free = reproduce().frequencies_free_end_hz
     assert free['analytic'] == pytest.approx(3.22, abs=0.01)
     assert free['identified'] == pytest.approx(3.06, abs=0.01)

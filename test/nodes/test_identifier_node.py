@@ -174,7 +174,7 @@ def test_replayed_drop_test_gives_ok_estimates(ros_graph, drop_record, arrival):
     assert sum(level == 0 for level, _, _ in statuses) >= 5  # 1 Hz on the bag's clock
     _check_replay(statuses, batch, truth, ARRIVALS[arrival])
     last = statuses[-1][2]
-    # SPEC section 3: every float is a repr, every key has its std.
+    # doc/interfaces.md, 'Topics': every float is a repr, every key has its std.
     for key in ESTIMATES:
         assert repr(float(last[key])) == last[key] and float(last[f'{key}_std']) > 0
     for key in ('window_start_s', 'window_end_s', 'cycles', 'method', 'release_time_s_std'):
