@@ -163,23 +163,27 @@ def saddle_fit(
     s_y = (unit_x[:, 0, None] * dy - unit_x[:, 1, None] * dx) * orient
     s_x = (dx * unit_y[:, 1, None] - dy * unit_y[:, 0, None]) * orient
     n = values.shape[1]
-    best_misfit = np.full(len(corners), np.inf)
-    best_amplitude = np.zeros(len(corners))
-    for sigma in BLURS_PX:
-        shape = erf(s_x / (np.sqrt(2.0) * sigma)) * erf(s_y / (np.sqrt(2.0) * sigma))
-        # Linear least squares for m and A, per corner, in closed form.
-        mean_s, mean_v = shape.mean(axis=1), values.mean(axis=1)
-        var_s = (shape * shape).mean(axis=1) - mean_s**2
-        cov = (shape * values).mean(axis=1) - mean_s * mean_v
-        amplitude = cov / np.maximum(var_s, 1e-12)
-        level = mean_v - amplitude * mean_s
-        residual = values - level[:, None] - amplitude[:, None] * shape
-        with np.errstate(divide='ignore', invalid='ignore'):
-            misfit = np.sqrt(np.sum(residual**2, axis=1) / max(n - 2, 1)) / np.abs(amplitude)
-        misfit = np.where(np.isfinite(misfit), misfit, np.inf)
-        better = misfit < best_misfit
-        best_misfit = np.where(better, misfit, best_misfit)
-        best_amplitude = np.where(better, amplitude, best_amplitude)
+    # All blurs at once (blur x corner x pixel), erf in place: this runs on every frame.
+    scale = (1.0 / (np.sqrt(2.0) * np.asarray(BLURS_PX)))[:, None, None]
+    shape = erf(s_x * scale)
+    shape *= erf(s_y * scale)
+    # Linear least squares for m and A, per blur and corner, in closed form; the residual
+    # sum of squares follows from the moments, n (var_v - A cov), without the residuals.
+    mean_v = values.mean(axis=1)
+    var_v = np.einsum('mn,mn->m', values, values) / n - mean_v**2
+    mean_s = shape.mean(axis=2)
+    var_s = np.einsum('kmn,kmn->km', shape, shape) / n - mean_s**2
+    cov = np.einsum('kmn,mn->km', shape, values) / n - mean_s * mean_v
+    amplitude = cov / np.maximum(var_s, 1e-12)
+    sum_squares = np.maximum(n * (var_v - amplitude * cov), 0.0)
+    with np.errstate(divide='ignore', invalid='ignore'):
+        misfit = np.sqrt(sum_squares / max(n - 2, 1)) / np.abs(amplitude)
+    misfit = np.where(np.isfinite(misfit), misfit, np.inf)
+    # The first best blur, as a strict improvement over the blurs in order would keep.
+    best = np.argmin(misfit, axis=0)
+    columns = np.arange(len(corners))
+    best_misfit = misfit[best, columns]
+    best_amplitude = np.where(np.isfinite(best_misfit), amplitude[best, columns], 0.0)
     return best_amplitude, best_misfit
 
 
