@@ -10,10 +10,15 @@ import pytest
 
 from lumpbeam_ros.vision.corners import refine_corners
 from lumpbeam_ros.vision.partial import (
+    MAX_SADDLE_MISFIT,
+    MISFIT_CEILING,
+    MISFIT_MEDIANS,
+    checked_saddle_fit,
     coverage_problem,
     grid_axes,
     labelling_is_unambiguous,
     reject_outliers,
+    saddle_fit,
     select_corners,
 )
 from lumpbeam_ros.vision.pose import PlaneModel
@@ -178,6 +183,45 @@ def test_an_edge_across_a_corner_never_biases_it(config, angle):
             else:
                 dropped += 1
     assert dropped > 0 and kept > 0
+
+
+@pytest.mark.parametrize(
+    ('blur', 'noise'), [(0.0, 0.0), (0.8, 0.0), (1.6, 0.0), (0.0, 10.0), (0.8, 4.0)]
+)  # fmt: skip
+def test_the_staged_blur_search_decides_as_the_full_one(config, blur, noise):
+    """Sharp, defocused and noisy frames with bars over the board: the same corners pass."""
+    pose = np.array([2.3107, -0.012, 0.004])
+    truth = PlaneModel(config.rig, config.camera_info).project(pose)
+    pattern = config.rig.board.pattern_size
+    along_x, along_y = grid_axes(truth, pattern)
+    rng = np.random.default_rng(3)
+    image = SyntheticCamera(config).render(pose)
+    if blur:
+        image = cv2.GaussianBlur(image, (0, 0), blur)
+    # Bars of any grey level, width and angle, near or through a few corners.
+    for k in (3, 12, 20, 29, 33, 42):
+        offset, angle = rng.uniform(-5.0, 5.0, 2), rng.uniform(0.0, np.pi)
+        width, value = rng.integers(1, 5), rng.integers(0, 256)
+        image = _bar(image, truth[k] + offset, angle, width, value)
+    if noise:
+        image = np.clip(image + rng.normal(0.0, noise, image.shape), 0, 255).astype(np.uint8)
+    refined = refine_corners(image, truth + 0.3, 5)
+    misfits, decisions = [], []
+    for fit in (saddle_fit, checked_saddle_fit):
+        _, misfit = fit(image, refined, along_x, along_y, 7)
+        median = MISFIT_MEDIANS * float(np.median(misfit))
+        limit = min(max(MAX_SADDLE_MISFIT, median), MISFIT_CEILING)
+        misfits.append(misfit)
+        decisions.append(misfit <= limit)
+    full, staged = misfits
+    np.testing.assert_array_equal(decisions[0], decisions[1])
+    # Why they agree: a misfit kept from the first blur is never better than the best one,
+    # is within the limit's floor, and leaves the median below where it raises the limit.
+    assert np.all(staged >= full - 1e-12)
+    differ = staged > full + 1e-12
+    assert np.all(staged[differ] <= MAX_SADDLE_MISFIT)
+    assert not np.any(differ) or np.median(staged) <= MAX_SADDLE_MISFIT / MISFIT_MEDIANS
+    assert 0 < np.count_nonzero(decisions[0]) < 48
 
 
 def test_clean_corners_all_pass(config, rest_pose):
