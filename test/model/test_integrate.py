@@ -43,11 +43,14 @@ def test_energy_decays_with_damping():
         (Effects(drag_c_q=0.5), 5e-6),
         (Effects(k_base_nm_per_rad=2e4, added_mass_kg=0.3), 1e-7),
         # Radau needs the friction sign smoothed; the modal solver steps it exactly.
-        (Effects(coulomb_torque_nm=1.0), 1e-4),
+        # Dry friction: Radau needs the sign smoothed and a tight step (about 20 s).
+        pytest.param(Effects(coulomb_torque_nm=1.0), 1e-4, marks=pytest.mark.slow),
         (Effects(k3_nm_per_rad3=1e8), 1e-6),
         (Effects(k3_nm_per_rad3=-5e7), 1e-6),
         (Effects(tilt_rad=0.2), 1e-7),
-        (Effects(k3_nm_per_rad3=1e8, coulomb_torque_nm=1.0), 1e-4),
+        pytest.param(
+            Effects(k3_nm_per_rad3=1e8, coulomb_torque_nm=1.0), 1e-4, marks=pytest.mark.slow
+        ),
     ],
 )
 def test_modal_solver_matches_radau(effects, tolerance_m):
@@ -87,6 +90,7 @@ def _duffing_period(omega0: float, epsilon: float, amplitude: float) -> float:
     return 4.0 * quad(integrand, 0.0, np.pi / 2, epsabs=1e-14, epsrel=1e-12)[0]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize('k3', [4e4, -3e4])
 def test_cubic_stiffness_shifts_the_frequency_as_duffing_predicts(k3):
     # One rigid segment without gravity or damping: J theta'' + k theta + k3 theta^3 = 0,

@@ -33,6 +33,7 @@ def test_error_stats_keep_the_bias():
     assert 2.9 < stats.p99 <= 3.0
 
 
+@pytest.mark.slow
 def test_full_resolution_meets_the_targets(drop_test):
     """2048 x 2048, 2 DN noise, blur, 1 ms exposure, the board 5 mm off its configured depth.
 
