@@ -6,16 +6,6 @@ import argparse
 import sys
 
 
-def _workers(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'not a whole number: {text!r}') from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f'must be 1 or more, got {text!r}')
-    return value
-
-
 def run(args: argparse.Namespace) -> int:
     """Expands the bags, runs the campaign, prints its summary, writes the report."""
     from lumpbeam_ros.campaign.bags import expand_bags

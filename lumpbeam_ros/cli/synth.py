@@ -11,16 +11,6 @@ from lumpbeam_ros.synthetic.images import ImageOptions, parse_image_size
 from lumpbeam_ros.synthetic.tracker import TrackerOptions
 
 
-def _tracker_pose(text: str) -> tuple[float, ...]:
-    try:
-        values = tuple(float(v) for v in text.split(','))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'expected 6 numbers, got {text!r}') from None
-    if len(values) != 6:
-        raise argparse.ArgumentTypeError(f'expected 6 comma-separated numbers, got {text!r}')
-    return values
-
-
 def _tracker_options(args: argparse.Namespace) -> TrackerOptions | None:
     if not args.tracker:
         return None

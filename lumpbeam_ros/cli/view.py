@@ -14,16 +14,6 @@ import time
 from typing import Any
 
 
-def _port(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'{text!r} is not a port number') from None
-    if not 0 <= value <= 65535:
-        raise argparse.ArgumentTypeError(f'port must be in 0..65535, got {value}')
-    return value
-
-
 def run(args: argparse.Namespace) -> int:
     """Serves until stopped.
 
