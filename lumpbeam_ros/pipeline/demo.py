@@ -99,6 +99,10 @@ TRAILING_TOPICS = {
     '/tip_pose': 'geometry_msgs/msg/PoseStamped',
     '/tip_pose_predicted': 'geometry_msgs/msg/PoseStamped',
 }
+#: Camera frames are replayed at this fraction of real time: the graph runs on the player's
+#: /clock, so only the wall time changes, and on 2 cores the camera node, the identifier,
+#: the simulator and the diagnosis node's worker then keep up with best-effort frames.
+CAMERA_REPLAY_RATE = 0.5
 #: The player waits this long before its first message: its publishers must be discovered
 #: by the recorder's subscriptions first (a new process takes 1-3 s on a busy machine).
 PLAYER_DELAY_S = 4.0
@@ -303,10 +307,12 @@ def replay(run: DemoRun) -> None:
                 *played,
                 '--delay',
                 str(PLAYER_DELAY_S),
+                '--rate',
+                str(CAMERA_REPLAY_RATE if run.with_camera else 1.0),
             ),
         )
         others = [name for name in graph.children if name != 'player']
-        graph.wait('player', run.options.duration_s * 2 + 30.0, watch=others)
+        graph.wait('player', run.options.duration_s * 4 + 30.0, watch=others)
         # Only a record that holds the whole ring-down gets a verdict to wait for.
         ends = run.drop.release_time_s + LIVE_DECAY_S < run.options.duration_s
         live = DIAGNOSIS_NODE_MODULE in run.nodes and ends
