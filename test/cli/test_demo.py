@@ -140,7 +140,10 @@ def test_demo_names_the_hidden_latency_live_and_the_simulator_adopts_it(tmp_path
     # delivered late shortens the latency it can see by as much (a busy machine: 5-20 ms).
     late_s = live['window_s'][0] + 1.0 - 2.0  # pre_release_s before the 2 s release
     if abs(late_s) > 0.002:
-        pytest.skip(f'/tip_load reached the diagnosis node {late_s * 1e3:.1f} ms late')
+        # Then the latency it sees is shorter than the hidden one: a smaller latency, or no
+        # confident answer, but never another effect's name.
+        assert live['missing_effect'] in ('sensor_latency', 'unexplained', 'none'), late_s
+        return
     assert live['missing_effects'] == ['sensor_latency'] and live['level'] == 1
     assert live['window_s'][1] - live['window_s'][0] == pytest.approx(3.3, abs=0.05)
     assert live['gap_after_rms_m'] < 0.1 * live['gap_before_rms_m']
