@@ -265,6 +265,11 @@ class BagWriter:
         """Messages written so far (flushed or pending)."""
         return sum(self._writer.counts.values()) + len(self._pending)
 
+    @property
+    def flushed_log_time_ns(self) -> int:
+        """The latest log time already in the file (-1 before the first flush), ns."""
+        return self._flushed_log_time
+
     def flush(self) -> None:
         """Puts every message written so far into the file and refreshes ``metadata.yaml``.
 

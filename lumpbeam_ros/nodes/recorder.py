@@ -6,8 +6,11 @@ deserialized. Each topic's offered QoS (from ``get_publishers_info_by_topic``) g
 bag's metadata; the subscription matches it (best effort if any publisher is, transient local
 only if every publisher is, so a latched ``/tip_load`` is received on joining). The bag is
 flushed at least every ``flush_period_s`` (see :class:`~lumpbeam_ros.bagio.BagWriter`), so a
-killed recorder loses at most that much. A message's log time is the time it was received
-(wall clock, kept monotonic), so the bag is in log-time order.
+killed recorder loses at most that much. A message's log time is the time the middleware
+received it (the message info's ``received_timestamp``, wall clock), as rosbag2 records it: the
+time the callback runs would date a message that waited in the queue behind others too late,
+and put ``/tip_load`` out of its order with ``/clock`` on a busy machine. The writer sorts what
+it holds by log time, so the bag is in log-time order.
 """
 
 from __future__ import annotations
@@ -57,7 +60,6 @@ class Recorder(Node):
         self.error: LumpbeamError | None = None
         self._skipped: set[str] = set()
         self._taps: dict[str, object] = {}
-        self._last_log_ns = 0
         self.create_timer(discovery_period_s, self.discover)
         self.create_timer(flush_period_s, self._flush)
         self.discover()
@@ -109,14 +111,15 @@ class Recorder(Node):
         self.bag.add_topic(topic, msgtype, qos=[to_bag_qos(p) for p in offered])
         self.received[topic] = 0
 
-        def write(data: bytes, topic: str = topic) -> None:
+        def write(data: bytes, info: dict[str, int], topic: str = topic) -> None:
             if self.error is not None:
                 return
-            # Log time is the receive time, never earlier than the previous message's: a
-            # wall clock stepped back (NTP) must not put the bag out of log-time order.
-            self._last_log_ns = max(time.time_ns(), self._last_log_ns)
+            received = info.get('received_timestamp') or time.time_ns()
+            # Never before what was flushed already: a wall clock stepped back (NTP) must not
+            # put the bag out of log-time order.
+            log_ns = max(received, self.bag.flushed_log_time_ns)
             try:
-                self.bag.write_raw(topic, self._last_log_ns, data)
+                self.bag.write_raw(topic, log_ns, data)
             except LumpbeamError as exc:
                 self.error = exc  # the caller stops spinning and reports it
                 return
