@@ -366,6 +366,28 @@ def add_repair(subparsers: Subparsers) -> argparse.ArgumentParser:
     return parser
 
 
+def add_doctor(subparsers: Subparsers) -> argparse.ArgumentParser:
+    """Declares ``lumpbeam doctor BAG [BAG ...]``.
+
+    Args:
+        subparsers: The top-level parser's subcommands.
+
+    Returns:
+        The subcommand's parser.
+    """
+    parser = subparsers.add_parser(
+        'doctor',
+        help="check bags as the mcap CLI's doctor does",
+        description="Checks each bag's MCAP files (record framing, chunk CRCs and time "
+        'ranges, log-time order, message and chunk indexes, statistics) and that '
+        'metadata.yaml counts what the files hold, as `mcap doctor` does. Prints each '
+        'problem on its own line, or that the bag is clean; exit code 1 when any bag has '
+        'a problem.',
+    )
+    parser.add_argument('bags', nargs='+', metavar='BAG', help='rosbag2 folders (MCAP)')
+    return parser
+
+
 def add_play(subparsers: Subparsers) -> argparse.ArgumentParser:
     """Declares ``lumpbeam play BAG``.
 

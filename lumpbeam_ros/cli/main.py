@@ -49,6 +49,7 @@ COMMANDS = (
     Command('compare', arguments.add_compare, 'lumpbeam_ros.cli.compare:run'),
     Command('record', arguments.add_record, 'lumpbeam_ros.cli.record:run'),
     Command('repair', arguments.add_repair, 'lumpbeam_ros.cli.repair:run'),
+    Command('doctor', arguments.add_doctor, 'lumpbeam_ros.cli.doctor:run'),
     Command('play', arguments.add_play, 'lumpbeam_ros.cli.play:run'),
     Command('bench', arguments.add_bench, 'lumpbeam_ros.cli.bench:run'),
     Command('demo', arguments.add_demo, 'lumpbeam_ros.cli.demo:run'),
