@@ -141,7 +141,8 @@ class DiagnosisNode(Node):
         self._problem: str | None = None  # why the last stretch was not diagnosed
         self._running: tuple[Stretch, float, AsyncResult[LiveDiagnosis]] | None = None
         self._pool = self._make_pool(values['worker'])
-        self._parameters = AsyncParameterClient(self, values['simulator_node'])
+        # Not `_parameters`: that is rclpy's own table of this node's parameters.
+        self._simulator_parameters = AsyncParameterClient(self, values['simulator_node'])
 
         self._output = publisher(self, DiagnosticArray, MODEL_DISCREPANCY)
         subscription(self, PoseStamped, TIP_POSE, self._on_pose)
@@ -291,17 +292,17 @@ class DiagnosisNode(Node):
             )
             self.get_logger().warning(self.adoption)
             return
-        if not self._parameters.services_are_ready():
-            self.adoption = f'not adopted: {self._parameters.remote_node_name} not found'
+        if not self._simulator_parameters.services_are_ready():
+            self.adoption = f'not adopted: {self._simulator_parameters.remote_node_name} not found'
             self.get_logger().warning(self.adoption)
             return
         parameters = [Parameter(name, value=value) for name, value in values.items()]
-        future = self._parameters.set_parameters(parameters)
+        future = self._simulator_parameters.set_parameters(parameters)
         self.adoption = 'asked'
         future.add_done_callback(lambda f: self._adopted(f, values))
 
     def _adopted(self, future: RclpyFuture, values: Mapping[str, float]) -> None:
-        node = self._parameters.remote_node_name
+        node = self._simulator_parameters.remote_node_name
         try:
             results = future.result().results
         except Exception as exc:  # noqa: BLE001 - a failed service call is reported

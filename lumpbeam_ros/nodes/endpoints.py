@@ -10,7 +10,10 @@ Every node creates its endpoints here, so that each one:
 - lets parameters override that profile's history, depth and reliability (rclpy's
   :class:`~rclpy.qos_overriding_options.QoSOverridingOptions`): read-only parameters
   ``qos_overrides.<resolved topic>.<publisher|subscription>.<policy>``, e.g.
-  ``qos_overrides./tip_pose.publisher.depth``, set by ``--params-file`` or ``-p``.
+  ``qos_overrides./tip_pose.publisher.depth``, set by ``--params-file`` or ``-p``. A value
+  rclpy cannot use (a depth below 1, an unknown policy name, the wrong type) is a
+  :class:`~lumpbeam_ros.errors.ConfigError` naming the parameter, so the node stops at start
+  with one line (exit code 2).
 """
 
 from __future__ import annotations
@@ -18,13 +21,35 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 from rclpy.publisher import Publisher
-from rclpy.qos_overriding_options import QoSOverridingOptions
+from rclpy.qos import HistoryPolicy, QoSProfile
+from rclpy.qos_overriding_options import InvalidQosOverridesError, QoSOverridingOptions
 from rclpy.subscription import Subscription
 
+from lumpbeam_ros.errors import ConfigError
 from lumpbeam_ros.interface import node_topic
 from lumpbeam_ros.nodes.msgtypes import topic_qos
+
+
+def _check_overrides(profile: QoSProfile) -> SetParametersResult:
+    """Refuses an overridden profile that DDS would refuse with an unreadable error."""
+    if profile.history == HistoryPolicy.KEEP_LAST and profile.depth < 1:
+        return SetParametersResult(successful=False, reason=f'depth {profile.depth} < 1')
+    return SetParametersResult(successful=True)
+
+
+def _create(node: Node, kind: str, topic: str, create: Callable[..., Any]) -> Any:
+    """Creates an endpoint with the overridable profile; a bad override is a ConfigError."""
+    name = node_topic(topic)
+    options = QoSOverridingOptions.with_default_policies(callback=_check_overrides)
+    try:
+        return create(name, topic_qos(topic), qos_overriding_options=options)
+    except (ParameterException, InvalidQosOverridesError, RuntimeError) as exc:
+        key = f'qos_overrides.{node.resolve_topic_name(name)}.{kind}'
+        raise ConfigError(f'{node.get_name()} parameters', key, str(exc)) from None
 
 
 def publisher(node: Node, msg_class: type[Any], topic: str) -> Publisher:
@@ -37,13 +62,15 @@ def publisher(node: Node, msg_class: type[Any], topic: str) -> Publisher:
 
     Returns:
         The publisher.
+
+    Raises:
+        ConfigError: A ``qos_overrides`` parameter of the topic is invalid.
     """
-    return node.create_publisher(
-        msg_class,
-        node_topic(topic),
-        topic_qos(topic),
-        qos_overriding_options=QoSOverridingOptions.with_default_policies(),
-    )
+
+    def create(name: str, qos: QoSProfile, **options: Any) -> Publisher:
+        return node.create_publisher(msg_class, name, qos, **options)
+
+    return _create(node, 'publisher', topic, create)
 
 
 def subscription(
@@ -64,12 +91,12 @@ def subscription(
 
     Returns:
         The subscription.
+
+    Raises:
+        ConfigError: A ``qos_overrides`` parameter of the topic is invalid.
     """
-    return node.create_subscription(
-        msg_class,
-        node_topic(topic),
-        callback,
-        topic_qos(topic),
-        qos_overriding_options=QoSOverridingOptions.with_default_policies(),
-        raw=raw,
-    )
+
+    def create(name: str, qos: QoSProfile, **options: Any) -> Subscription:
+        return node.create_subscription(msg_class, name, callback, qos, raw=raw, **options)
+
+    return _create(node, 'subscription', topic, create)
