@@ -61,6 +61,7 @@ from lumpbeam_ros.interface import (
     CAMERA_STATUS,
     DIAGNOSTICS,
     IMAGE,
+    IMAGE_TYPE,
     TIP_POSE,
     TIP_POSE_COVARIANCE,
 )
@@ -174,7 +175,7 @@ class CameraNode(Node):
                 f'camera_info ignored: {exc}', throttle_duration_sec=self._warning_period
             )
 
-    def on_image(self, data: bytes, msgtype: str = 'sensor_msgs/msg/Image') -> None:
+    def on_image(self, data: bytes, msgtype: str = IMAGE_TYPE) -> None:
         """Tracks one serialized image (``Image`` or ``CompressedImage``), publishes its pose."""
         frame, result = self.session.process_message(data, msgtype)
         self._publish_or_warn(None if frame is None else frame.stamp_ns, result)

@@ -60,6 +60,7 @@ from lumpbeam_ros.interface import (
     BASE_FRAME,
     DIAGNOSIS_STATUS,
     MODEL_DISCREPANCY,
+    SIMULATOR_NODE,
     TIP_LOAD,
     TIP_POSE,
     TIP_POSE_PREDICTED,
@@ -142,7 +143,7 @@ class DiagnosisNode(Node):
         self._running: tuple[Stretch, float, AsyncResult[LiveDiagnosis]] | None = None
         self._pool = self._make_pool(values['worker'])
         # Not `_parameters`: that is rclpy's own table of this node's parameters.
-        self._simulator_parameters = AsyncParameterClient(self, values['simulator_node'])
+        self._simulator_parameters = AsyncParameterClient(self, values[SIMULATOR_NODE])
 
         self._output = publisher(self, DiagnosticArray, MODEL_DISCREPANCY)
         subscription(self, PoseStamped, TIP_POSE, self._on_pose)

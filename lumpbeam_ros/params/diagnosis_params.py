@@ -84,7 +84,7 @@ DIAGNOSIS_SCHEMA = ParameterSchema(
             read_only=False,
         ),
         ParameterSpec(
-            'simulator_node',
+            SIMULATOR_NODE,
             'string',
             SIMULATOR_NODE,
             'the node whose parameters adopt sets',
