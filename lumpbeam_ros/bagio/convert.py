@@ -18,6 +18,16 @@ import numpy as np
 
 from lumpbeam_ros.bagio.typestore import message_class
 from lumpbeam_ros.errors import BagError
+from lumpbeam_ros.interface import (
+    CAMERA_INFO_TYPE,
+    CLOCK_TYPE,
+    COMPRESSED_IMAGE_TYPE,
+    DIAGNOSTIC_ARRAY,
+    FLOAT64,
+    IMAGE_TYPE,
+    POINT_STAMPED,
+    POSE_STAMPED,
+)
 
 NS_PER_S = 1_000_000_000
 
@@ -105,7 +115,7 @@ def pose_stamped(ns: int, x: float, z: float, pitch: float, frame_id: str) -> An
     point = message_class('geometry_msgs/msg/Point')(x=float(x), y=0.0, z=float(z))
     orientation = message_class('geometry_msgs/msg/Quaternion')(x=qx, y=qy, z=qz, w=qw)
     pose = message_class('geometry_msgs/msg/Pose')(position=point, orientation=orientation)
-    return message_class('geometry_msgs/msg/PoseStamped')(header=header(ns, frame_id), pose=pose)
+    return message_class(POSE_STAMPED)(header=header(ns, frame_id), pose=pose)
 
 
 def pose_stamped_6dof(
@@ -126,7 +136,7 @@ def pose_stamped_6dof(
     qx, qy, qz, qw = (float(v) for v in quaternion)
     orientation = message_class('geometry_msgs/msg/Quaternion')(x=qx, y=qy, z=qz, w=qw)
     pose = message_class('geometry_msgs/msg/Pose')(position=point, orientation=orientation)
-    return message_class('geometry_msgs/msg/PoseStamped')(header=header(ns, frame_id), pose=pose)
+    return message_class(POSE_STAMPED)(header=header(ns, frame_id), pose=pose)
 
 
 def pose_values(msg: Any) -> tuple[int, float, float, float, str]:
@@ -139,15 +149,13 @@ def pose_values(msg: Any) -> tuple[int, float, float, float, str]:
 
 def float64(value: float) -> Any:
     """Builds a ``std_msgs/msg/Float64``."""
-    return message_class('std_msgs/msg/Float64')(data=float(value))
+    return message_class(FLOAT64)(data=float(value))
 
 
 def point_stamped(ns: int, x: float, y: float, z: float, frame_id: str) -> Any:
     """Builds a ``geometry_msgs/msg/PointStamped``."""
     point = message_class('geometry_msgs/msg/Point')(x=float(x), y=float(y), z=float(z))
-    return message_class('geometry_msgs/msg/PointStamped')(
-        header=header(ns, frame_id), point=point
-    )
+    return message_class(POINT_STAMPED)(header=header(ns, frame_id), point=point)
 
 
 def point_values(msg: Any) -> tuple[int, float, float, float, str]:
@@ -158,7 +166,7 @@ def point_values(msg: Any) -> tuple[int, float, float, float, str]:
 
 def clock(ns: int) -> Any:
     """Builds a ``rosgraph_msgs/msg/Clock``."""
-    return message_class('rosgraph_msgs/msg/Clock')(clock=time_msg(ns))
+    return message_class(CLOCK_TYPE)(clock=time_msg(ns))
 
 
 def image(ns: int, pixels: np.ndarray, frame_id: str, encoding: str | None = None) -> Any:
@@ -193,7 +201,7 @@ def image(ns: int, pixels: np.ndarray, frame_id: str, encoding: str | None = Non
         raise BagError(f'image of shape {pixels.shape} does not fit encoding {encoding}')
     height, width = pixels.shape[:2]
     data = np.ascontiguousarray(pixels, dtype=np.dtype(dtype).newbyteorder('<'))
-    return message_class('sensor_msgs/msg/Image')(
+    return message_class(IMAGE_TYPE)(
         header=header(ns, frame_id),
         height=height,
         width=width,
@@ -255,7 +263,7 @@ def compressed_image(ns: int, data: bytes, image_format: str, frame_id: str) -> 
     Returns:
         The message.
     """
-    return message_class('sensor_msgs/msg/CompressedImage')(
+    return message_class(COMPRESSED_IMAGE_TYPE)(
         header=header(ns, frame_id),
         format=image_format,
         data=np.frombuffer(bytes(data), dtype=np.uint8),
@@ -307,7 +315,7 @@ def camera_info(ns: int, info: CameraInfoData) -> Any:
     roi = message_class('sensor_msgs/msg/RegionOfInterest')(
         x_offset=0, y_offset=0, height=0, width=0, do_rectify=False
     )
-    return message_class('sensor_msgs/msg/CameraInfo')(
+    return message_class(CAMERA_INFO_TYPE)(
         header=header(ns, info.frame_id),
         height=int(info.height),
         width=int(info.width),
@@ -377,9 +385,7 @@ def diagnostic_array(ns: int, statuses: Iterable[Status], frame_id: str = '') ->
                 values=values,
             )
         )
-    return message_class('diagnostic_msgs/msg/DiagnosticArray')(
-        header=header(ns, frame_id), status=built
-    )
+    return message_class(DIAGNOSTIC_ARRAY)(header=header(ns, frame_id), status=built)
 
 
 def diagnostic_statuses(msg: Any) -> list[Status]:

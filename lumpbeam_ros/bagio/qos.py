@@ -29,6 +29,8 @@ from rosbags.interfaces import (
     QosTime,
 )
 
+from lumpbeam_ros.interface import CAMERA_INFO_TYPE, IMAGE_TYPE, TIP_LOAD
+
 #: How rosbag2 writes an infinite duration (``RMW_DURATION_INFINITE``).
 INFINITE = QosTime(2147483647, 4294967295)
 ZERO = QosTime(0, 0)
@@ -42,8 +44,8 @@ STREAM_DEPTH = 400
 #: History of the sensor-data profile (images, camera info).
 SENSOR_DEPTH = 5
 
-SENSOR_TYPES = ('sensor_msgs/msg/Image', 'sensor_msgs/msg/CameraInfo')
-LATCHED_TOPICS = ('/tip_load',)
+SENSOR_TYPES = (IMAGE_TYPE, CAMERA_INFO_TYPE)
+LATCHED_TOPICS = (TIP_LOAD,)
 
 
 def profile(reliable: bool, transient_local: bool, depth: int) -> Qos:

@@ -40,6 +40,7 @@ from lumpbeam_ros.bagio import convert, metadata
 from lumpbeam_ros.bagio.qos import default_profile
 from lumpbeam_ros.bagio.typestore import serialize, type_description
 from lumpbeam_ros.errors import BagError
+from lumpbeam_ros.interface import BASE_FRAME, CLOCK
 
 _log = logging.getLogger(__name__)
 
@@ -202,7 +203,7 @@ class BagWriter:
     # -- typed helpers (stamp = measurement time, s; log time = stamp) -------------------------
 
     def write_pose(
-        self, topic: str, stamp: float, x: float, z: float, pitch: float, frame: str = 'beam_base'
+        self, topic: str, stamp: float, x: float, z: float, pitch: float, frame: str = BASE_FRAME
     ) -> None:
         """Writes a planar tip pose as ``geometry_msgs/msg/PoseStamped`` (y = 0).
 
@@ -253,7 +254,7 @@ class BagWriter:
         ns = convert.seconds_to_ns(stamp)
         self.write_message(topic, convert.diagnostic_array(ns, statuses, frame), ns)
 
-    def write_clock(self, stamp: float, topic: str = '/clock') -> None:
+    def write_clock(self, stamp: float, topic: str = CLOCK) -> None:
         """Writes a ``rosgraph_msgs/msg/Clock``."""
         ns = convert.seconds_to_ns(stamp)
         self.write_message(topic, convert.clock(ns), ns)

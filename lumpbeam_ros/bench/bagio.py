@@ -25,6 +25,7 @@ import numpy as np
 from lumpbeam_ros.bagio import BagReader, BagWriter, convert
 from lumpbeam_ros.bagio.typestore import serialize
 from lumpbeam_ros.bench.result import BenchResult
+from lumpbeam_ros.interface import BASE_FRAME, IMAGE, IMAGE_TYPE, POSE_STAMPED, TIP_POSE
 
 FPS = 180.0
 SIDE = 1024
@@ -37,19 +38,19 @@ def _frames(count: int) -> tuple[list[bytes], list[bytes]]:
     for i in range(count):
         ns = round(i / FPS * 1e9)
         images.append(serialize(convert.image(ns, pixels, 'camera')))
-        poses.append(serialize(convert.pose_stamped(ns, 2.3, -0.01, 0.01, 'beam_base')))
+        poses.append(serialize(convert.pose_stamped(ns, 2.3, -0.01, 0.01, BASE_FRAME)))
     return images, poses
 
 
 def _bag_write(folder: Path, images: list[bytes], poses: list[bytes]) -> float:
     start = time.perf_counter()
     with BagWriter(folder / 'bag') as bag:
-        bag.add_topic('/camera/image_raw', 'sensor_msgs/msg/Image')
-        bag.add_topic('/tip_pose', 'geometry_msgs/msg/PoseStamped')
+        bag.add_topic(IMAGE, IMAGE_TYPE)
+        bag.add_topic(TIP_POSE, POSE_STAMPED)
         for i, (image, pose) in enumerate(zip(images, poses, strict=True)):
             ns = round(i / FPS * 1e9)
-            bag.write_raw('/camera/image_raw', ns, image)
-            bag.write_raw('/tip_pose', ns, pose)
+            bag.write_raw(IMAGE, ns, image)
+            bag.write_raw(TIP_POSE, ns, pose)
     return time.perf_counter() - start
 
 
@@ -119,7 +120,7 @@ def _play_benchmark(quick: bool) -> BenchResult:
     try:
         with BagWriter(tmp / 'poses') as bag:
             for ti in t:
-                bag.write_pose('/tip_pose', 1000.0 + ti, 2.3, -0.01, 0.0)
+                bag.write_pose(TIP_POSE, 1000.0 + ti, 2.3, -0.01, 0.0)
         player = Player(BagReader(tmp / 'poses'), context=context)
         stats = player.play()
         player.destroy_node()

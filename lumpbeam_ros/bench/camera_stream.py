@@ -29,6 +29,14 @@ from pathlib import Path
 
 import numpy as np
 
+from lumpbeam_ros.interface import (
+    BASE_FRAME,
+    BEAM_PARAMS,
+    CAMERA_FRAME,
+    CAMERA_INFO,
+    IMAGE,
+    TIP_POSE,
+)
 from lumpbeam_ros.resources import large_frames_profile
 
 #: Longest wait for the consumer processes to start and be discovered, s (a node importing
@@ -105,24 +113,24 @@ def _frames(width: int, height: int) -> list[np.ndarray]:
 def publish(width: int, height: int, rate_hz: float, duration_s: float) -> int:
     """The publisher process: offers frames at ``rate_hz`` and prints what it published."""
     import rclpy
-    from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import CameraInfo, Image
 
     from lumpbeam_ros.bagio import convert
     from lumpbeam_ros.bagio.typestore import serialize
+    from lumpbeam_ros.nodes.endpoints import publisher
     from lumpbeam_ros.vision.config import load_camera_config
     from lumpbeam_ros.vision.messages import camera_info_to_data
 
     # Serialized once; only the stamp (bytes 4..12, after the CDR header) changes.
     messages = [
-        bytearray(serialize(convert.image(0, im, 'camera'))) for im in _frames(width, height)
+        bytearray(serialize(convert.image(0, im, CAMERA_FRAME))) for im in _frames(width, height)
     ]
     info = load_camera_config().with_resolution(width, height).camera_info
     info_message = bytearray(serialize(convert.camera_info(0, camera_info_to_data(info))))
     rclpy.init()
     node = rclpy.create_node('bench_camera')
-    images = node.create_publisher(Image, '/camera/image_raw', qos_profile_sensor_data)
-    infos = node.create_publisher(CameraInfo, '/camera/camera_info', qos_profile_sensor_data)
+    images = publisher(node, Image, IMAGE)
+    infos = publisher(node, CameraInfo, CAMERA_INFO)
     deadline = time.monotonic() + 20.0
     while images.get_subscription_count() < 1 and time.monotonic() < deadline:
         time.sleep(0.05)
@@ -152,26 +160,23 @@ def echo() -> int:
     """The baseline process: decode each image, publish a pose with its stamp, no tracking."""
     import rclpy
     from geometry_msgs.msg import PoseStamped
-    from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import Image
 
-    from lumpbeam_ros.nodes.camera_node import POSE_QOS
+    from lumpbeam_ros.nodes.endpoints import publisher, subscription
     from lumpbeam_ros.vision.messages import decode_image
 
     rclpy.init()
     node = rclpy.create_node('bench_echo')
-    poses = node.create_publisher(PoseStamped, '/tip_pose', POSE_QOS)
+    poses = publisher(node, PoseStamped, TIP_POSE)
 
     def on_image(data: bytes) -> None:
         frame = decode_image(data)
         msg = PoseStamped()
         msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(frame.stamp_ns, 1_000_000_000)
-        msg.header.frame_id = 'beam_base'
+        msg.header.frame_id = BASE_FRAME
         poses.publish(msg)
 
-    node.create_subscription(
-        Image, '/camera/image_raw', on_image, qos_profile_sensor_data, raw=True
-    )
+    subscription(node, Image, IMAGE, on_image, raw=True)
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
@@ -212,8 +217,7 @@ def measure(
     from rclpy.context import Context
     from rclpy.executors import SingleThreadedExecutor
 
-    from lumpbeam_ros.nodes.camera_node import POSE_QOS
-    from lumpbeam_ros.nodes.msgtypes import topic_qos
+    from lumpbeam_ros.nodes.endpoints import subscription
 
     domain = _DOMAINS[(os.getpid() * 13 + int(time.time())) % len(_DOMAINS)]
     env = _env(domain, large_frames)
@@ -239,13 +243,8 @@ def measure(
             if np.isfinite(newest_s):
                 params_latencies.append(published_ns * 1e-6 - newest_s * 1e3)
 
-    node.create_subscription(PoseStamped, '/tip_pose', on_pose, POSE_QOS)
-    node.create_subscription(
-        DiagnosticArray,
-        '/beam_params',
-        on_params,
-        topic_qos('/beam_params', 'diagnostic_msgs/msg/DiagnosticArray'),
-    )
+    subscription(node, PoseStamped, TIP_POSE, on_pose)
+    subscription(node, DiagnosticArray, BEAM_PARAMS, on_params)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
     stop = threading.Event()
@@ -262,7 +261,7 @@ def measure(
         if downstream:
             processes.append(subprocess.Popen(downstream, env=env, stdout=subprocess.DEVNULL))
         deadline = time.monotonic() + STARTUP_TIMEOUT_S
-        wanted = ['/tip_pose', '/beam_params'] if downstream else ['/tip_pose']
+        wanted = [TIP_POSE, BEAM_PARAMS] if downstream else [TIP_POSE]
         while unheard := [t for t in wanted if node.count_publishers(t) < 1]:
             if time.monotonic() > deadline or any(p.poll() is not None for p in processes):
                 raise RuntimeError(f'no publisher of {", ".join(unheard)} appeared')

@@ -28,6 +28,7 @@ from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.identify import identify, identify_from
 from lumpbeam_ros.ident.samples import PoseWindow, clean_loads, clean_window
 from lumpbeam_ros.ident.window import SlidingWindow
+from lumpbeam_ros.interface import TIP_LOAD, TIP_POSE
 from lumpbeam_ros.model import rules
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.modes import chain_modes
@@ -181,8 +182,8 @@ def _analyze(quick: bool, beam: BeamParameters) -> BenchResult:
         with BagWriter(bag) as writer:
             for i, stamp in enumerate(t):
                 while loads and loads[0][0] <= stamp:
-                    writer.write_float('/tip_load', *loads.pop(0))
-                writer.write_pose('/tip_pose', stamp, beam.length_m, z[i], pitch[i])
+                    writer.write_float(TIP_LOAD, *loads.pop(0))
+                writer.write_pose(TIP_POSE, stamp, beam.length_m, z[i], pitch[i])
         ours_s, status = best_time(lambda: _analyze_bag(bag, beam, config, fast=True))
         base_s, _ = best_time(lambda: _analyze_bag(bag, beam, config, fast=False), 1)
     value, baseline_value = t.size / ours_s, t.size / base_s

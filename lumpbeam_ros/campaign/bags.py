@@ -11,6 +11,7 @@ from pathlib import Path
 
 from lumpbeam_ros.bagio import metadata
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import TIP_LOAD, TIP_POSE
 
 #: Data files up to this size are hashed whole (sha256 runs at several hundred MB/s);
 #: larger ones by their size, first and last :data:`EDGE_BYTES` (an MCAP bag is written
@@ -125,6 +126,6 @@ def bag_facts(bag: Path) -> BagFacts:
         duration_s=info.duration_ns / 1e9,
         start_time=start,
         message_count=info.message_count,
-        pose_count=count('/tip_pose'),
-        load_count=count('/tip_load'),
+        pose_count=count(TIP_POSE),
+        load_count=count(TIP_LOAD),
     )

@@ -13,12 +13,13 @@ import argparse
 from pathlib import Path
 
 from lumpbeam_ros.cli.output import non_negative_float, positive_float
+from lumpbeam_ros.interface import CAMERA_INFO, TIP_POSE, TRACKER_POINT
 
 Subparsers = argparse._SubParsersAction
 
-POSE_TOPIC = '/tip_pose'
-REFERENCE_TOPIC = '/tracker/point'
-CAMERA_INFO_TOPIC = '/camera/camera_info'
+POSE_TOPIC = TIP_POSE
+REFERENCE_TOPIC = TRACKER_POINT
+CAMERA_INFO_TOPIC = CAMERA_INFO
 
 #: The simulated laser tracker's defaults (``synthetic.tracker.TrackerOptions``).
 TRACKER_RATE_HZ = 1000.0

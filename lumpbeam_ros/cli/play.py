@@ -7,6 +7,8 @@ import signal
 import sys
 from typing import Any
 
+from lumpbeam_ros.interface import CLOCK
+
 
 def run(args: argparse.Namespace) -> int:
     """Plays the bag.
@@ -58,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
             signal.signal(sig, handler)
     from lumpbeam_ros.nodes.counts import write_counts
 
-    write_counts('player', {**stats.published, '/clock': stats.clock_published})
+    write_counts('player', {**stats.published, CLOCK: stats.clock_published})
     total = sum(stats.published.values())
     print(
         f'played {args.bag} ({passes} pass{"es" if passes > 1 else ""}): {total} messages in '

@@ -11,11 +11,12 @@ from lumpbeam_ros.bagio import BagReader, open_bag, read_load_events, read_point
 from lumpbeam_ros.compare.streams import Track, clean_track
 from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.ident.samples import LoadReadings, clean_loads
+from lumpbeam_ros.interface import BASE_FRAME, TIP_LOAD, TIP_POSE, TRACKER_POINT
 
-CAMERA_TOPIC = '/tip_pose'
-REFERENCE_TOPIC = '/tracker/point'
-LOAD_TOPIC = '/tip_load'
-CAMERA_FRAME = 'beam_base'
+CAMERA_TOPIC = TIP_POSE
+REFERENCE_TOPIC = TRACKER_POINT
+LOAD_TOPIC = TIP_LOAD
+CAMERA_FRAME = BASE_FRAME
 
 
 @dataclass(frozen=True)

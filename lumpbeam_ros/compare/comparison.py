@@ -18,6 +18,7 @@ from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.identify import identify
 from lumpbeam_ros.ident.result import Identification
 from lumpbeam_ros.ident.samples import LoadReadings, clean_window
+from lumpbeam_ros.interface import BASE_FRAME
 from lumpbeam_ros.model.parameters import BeamParameters
 
 AXES = ('x', 'y', 'z')
@@ -86,7 +87,7 @@ class Comparison:
             'coarse_time_offset_s': self.aligned.coarse.offset_s,
             'correlation': self.aligned.coarse.correlation,
             'transform': {
-                'parent_frame': 'beam_base',
+                'parent_frame': BASE_FRAME,
                 'child_frame': self.aligned.reference.track.frame_id,
                 'rotation_matrix': transform.rotation.tolist(),
                 'quaternion_xyzw': transform.quaternion_xyzw().tolist(),

@@ -55,8 +55,18 @@ from sensor_msgs.msg import Image
 from lumpbeam_ros.bagio import BagReader
 from lumpbeam_ros.bagio.convert import NS_PER_S, pitch_to_quaternion
 from lumpbeam_ros.errors import BagError, LumpbeamError
+from lumpbeam_ros.interface import (
+    CAMERA_INFO,
+    CAMERA_NODE,
+    CAMERA_STATUS,
+    DIAGNOSTICS,
+    IMAGE,
+    IMAGE_TYPE,
+    TIP_POSE,
+    TIP_POSE_COVARIANCE,
+)
 from lumpbeam_ros.nodes.counts import write_counts
-from lumpbeam_ros.nodes.msgtypes import topic_qos
+from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.parameters import declare_parameters
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
 from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
@@ -74,12 +84,6 @@ from lumpbeam_ros.vision.sources import (
 )
 from lumpbeam_ros.vision.tracker import TrackResult
 
-#: ``/tip_pose``: reliable, a history of more than a second of poses
-#: (:mod:`lumpbeam_ros.bagio.qos`).
-POSE_QOS = topic_qos('/tip_pose', 'geometry_msgs/msg/PoseStamped')
-#: Images and camera info: the sensor-data profile (best effort, keep last 5).
-IMAGE_QOS = topic_qos('/camera/image_raw', 'sensor_msgs/msg/Image')
-
 # PoseWithCovariance is row-major 6 x 6 over (x, y, z, rot x, rot y, rot z); the tracker
 # measures x, z and the rotation about y (the pitch).
 _COVARIANCE_INDEX = np.array([0, 2, 4])
@@ -95,6 +99,8 @@ class CameraNode(Node):
     Args:
         context: The rclpy context (``None``: the default one).
         parameter_overrides: Parameters instead of a params file (tests).
+        namespace: The node's namespace (``'/beam_a'``); its topics resolve in it.
+        cli_args: Node-specific ``--ros-args`` (e.g. ``--params-file``, ``-r``).
 
     Raises:
         ConfigError: A camera parameter is invalid.
@@ -105,10 +111,14 @@ class CameraNode(Node):
         self,
         context: Context | None = None,
         parameter_overrides: Sequence[Parameter] | None = None,
+        namespace: str = '',
+        cli_args: Sequence[str] | None = None,
     ):
         super().__init__(
             CAMERA_SCHEMA.node,
             context=context,
+            namespace=namespace,
+            cli_args=list(cli_args) if cli_args is not None else None,
             parameter_overrides=list(parameter_overrides or []),
         )
         values = declare_parameters(self, CAMERA_SCHEMA)
@@ -127,30 +137,18 @@ class CameraNode(Node):
         self._period_counts = (0, 0)
         self._period_start = time.monotonic()
 
-        self.pose_publisher = self.create_publisher(PoseStamped, '/tip_pose', POSE_QOS)
-        self.covariance_publisher = self.create_publisher(
-            PoseWithCovarianceStamped, '/tip_pose_covariance', POSE_QOS
-        )
-        self.diagnostics_publisher = self.create_publisher(
-            DiagnosticArray,
-            '/diagnostics',
-            topic_qos('/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray'),
-        )
+        # /tip_pose: reliable, more than a second of poses; images and camera info: the
+        # sensor-data profile (best effort, keep last 5); lumpbeam_ros.bagio.qos.
+        self.pose_publisher = publisher(self, PoseStamped, TIP_POSE)
+        self.covariance_publisher = publisher(self, PoseWithCovarianceStamped, TIP_POSE_COVARIANCE)
+        self.diagnostics_publisher = publisher(self, DiagnosticArray, DIAGNOSTICS)
         self.bag_path = str(self._param('bag_path'))
         self.footage_path = str(self._param('footage_path'))
         self.video_device = str(self._param('video_device'))
         if not self.in_process:
             # Raw: the bytes go to the same decoder as a bag's, without rclpy's copy.
-            self.create_subscription(
-                Image, '/camera/image_raw', self.on_image, IMAGE_QOS, raw=True
-            )
-            self.create_subscription(
-                CameraInfoMsg,
-                '/camera/camera_info',
-                self.on_camera_info,
-                IMAGE_QOS,
-                raw=True,
-            )
+            subscription(self, Image, IMAGE, self.on_image, raw=True)
+            subscription(self, CameraInfoMsg, CAMERA_INFO, self.on_camera_info, raw=True)
         period = float(self._param('diagnostics_period_s'))
         self.create_timer(period if period > 0 else 1.0, self.publish_diagnostics)
 
@@ -177,7 +175,7 @@ class CameraNode(Node):
                 f'camera_info ignored: {exc}', throttle_duration_sec=self._warning_period
             )
 
-    def on_image(self, data: bytes, msgtype: str = 'sensor_msgs/msg/Image') -> None:
+    def on_image(self, data: bytes, msgtype: str = IMAGE_TYPE) -> None:
         """Tracks one serialized image (``Image`` or ``CompressedImage``), publishes its pose."""
         frame, result = self.session.process_message(data, msgtype)
         self._publish_or_warn(None if frame is None else frame.stamp_ns, result)
@@ -328,7 +326,7 @@ class CameraNode(Node):
         values.update({f'lost_{k}': v for k, v in sorted(stats.lost.items())})
         return DiagnosticStatus(
             level=level,
-            name='lumpbeam/camera',
+            name=CAMERA_STATUS,
             message=message,
             hardware_id='camera',
             values=[KeyValue(key=k, value=repr(v) if isinstance(v, float) else str(v))
@@ -376,9 +374,9 @@ def main(args: Sequence[str] | None = None) -> int:
         if node is not None:
             stats = node.session.stats
             write_counts(
-                'camera_node',
-                {'/tip_pose': stats.poses_out, '/tip_pose_covariance': stats.poses_out},
-                {'/camera/image_raw': stats.frames_in},
+                CAMERA_NODE,
+                {TIP_POSE: stats.poses_out, TIP_POSE_COVARIANCE: stats.poses_out},
+                {IMAGE: stats.frames_in},
             )
             node.destroy_node()
         if rclpy.ok():

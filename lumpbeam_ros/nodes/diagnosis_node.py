@@ -56,15 +56,21 @@ from lumpbeam_ros.diagnose.live import (
     status_values,
 )
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import (
+    BASE_FRAME,
+    DIAGNOSIS_STATUS,
+    MODEL_DISCREPANCY,
+    SIMULATOR_NODE,
+    TIP_LOAD,
+    TIP_POSE,
+    TIP_POSE_PREDICTED,
+)
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.nodes.counts import write_counts
-from lumpbeam_ros.nodes.msgtypes import topic_qos
+from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.parameters import declare_parameters
 from lumpbeam_ros.params.diagnosis_params import DIAGNOSIS_SCHEMA
 
-STATUS_NAME = 'lumpbeam/diagnosis'
-TOPIC = '/model_discrepancy'
-BASE_FRAME = 'beam_base'
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0
 #: How much lower than the node's the worker process's scheduling priority is.
@@ -92,6 +98,8 @@ class DiagnosisNode(Node):
     Args:
         context: The rclpy context (default: the global one).
         parameter_overrides: Parameter values by name, on top of any ``--params-file``.
+        namespace: The node's namespace (``'/beam_a'``); its topics resolve in it.
+        cli_args: Node-specific ``--ros-args`` (e.g. ``--params-file``, ``-r``).
 
     Raises:
         ConfigError: A parameter or the beam configuration is invalid.
@@ -101,9 +109,17 @@ class DiagnosisNode(Node):
         self,
         context: Context | None = None,
         parameter_overrides: Mapping[str, Any] | None = None,
+        namespace: str = '',
+        cli_args: Sequence[str] | None = None,
     ):
         overrides = [Parameter(k, value=v) for k, v in (parameter_overrides or {}).items()]
-        super().__init__(DIAGNOSIS_SCHEMA.node, context=context, parameter_overrides=overrides)
+        super().__init__(
+            DIAGNOSIS_SCHEMA.node,
+            context=context,
+            namespace=namespace,
+            cli_args=list(cli_args) if cli_args is not None else None,
+            parameter_overrides=overrides,
+        )
         values = declare_parameters(self, DIAGNOSIS_SCHEMA, self._on_change)
         self.adopt = bool(values['adopt'])
         self.hardware_id = str(values['hardware_id'])
@@ -126,17 +142,13 @@ class DiagnosisNode(Node):
         self._problem: str | None = None  # why the last stretch was not diagnosed
         self._running: tuple[Stretch, float, AsyncResult[LiveDiagnosis]] | None = None
         self._pool = self._make_pool(values['worker'])
-        self._parameters = AsyncParameterClient(self, values['simulator_node'])
+        # Not `_parameters`: that is rclpy's own table of this node's parameters.
+        self._simulator_parameters = AsyncParameterClient(self, values[SIMULATOR_NODE])
 
-        pose_qos = topic_qos('/tip_pose', 'geometry_msgs/msg/PoseStamped')
-        self._output = self.create_publisher(
-            DiagnosticArray, TOPIC, topic_qos(TOPIC, 'diagnostic_msgs/msg/DiagnosticArray')
-        )
-        self.create_subscription(PoseStamped, '/tip_pose', self._on_pose, pose_qos)
-        self.create_subscription(PoseStamped, '/tip_pose_predicted', self._on_predicted, pose_qos)
-        self.create_subscription(
-            Float64, '/tip_load', self._on_load, topic_qos('/tip_load', 'std_msgs/msg/Float64')
-        )
+        self._output = publisher(self, DiagnosticArray, MODEL_DISCREPANCY)
+        subscription(self, PoseStamped, TIP_POSE, self._on_pose)
+        subscription(self, PoseStamped, TIP_POSE_PREDICTED, self._on_predicted)
+        subscription(self, Float64, TIP_LOAD, self._on_load)
         #: Statuses published on ``/model_discrepancy``.
         self.published = 0
         self._heard = False  # any input yet
@@ -180,13 +192,13 @@ class DiagnosisNode(Node):
 
     def _on_pose(self, msg: PoseStamped) -> None:
         self._heard = True
-        pose = self._pose(msg, '/tip_pose')
+        pose = self._pose(msg, TIP_POSE)
         if pose is not None:
             self.buffer.push_measured(*pose)
 
     def _on_predicted(self, msg: PoseStamped) -> None:
         self._heard = True
-        pose = self._pose(msg, '/tip_pose_predicted')
+        pose = self._pose(msg, TIP_POSE_PREDICTED)
         if pose is not None:
             self.buffer.push_predicted(*pose)
 
@@ -281,17 +293,17 @@ class DiagnosisNode(Node):
             )
             self.get_logger().warning(self.adoption)
             return
-        if not self._parameters.services_are_ready():
-            self.adoption = f'not adopted: {self._parameters.remote_node_name} not found'
+        if not self._simulator_parameters.services_are_ready():
+            self.adoption = f'not adopted: {self._simulator_parameters.remote_node_name} not found'
             self.get_logger().warning(self.adoption)
             return
         parameters = [Parameter(name, value=value) for name, value in values.items()]
-        future = self._parameters.set_parameters(parameters)
+        future = self._simulator_parameters.set_parameters(parameters)
         self.adoption = 'asked'
         future.add_done_callback(lambda f: self._adopted(f, values))
 
     def _adopted(self, future: RclpyFuture, values: Mapping[str, float]) -> None:
-        node = self._parameters.remote_node_name
+        node = self._simulator_parameters.remote_node_name
         try:
             results = future.result().results
         except Exception as exc:  # noqa: BLE001 - a failed service call is reported
@@ -343,7 +355,7 @@ class DiagnosisNode(Node):
             level, message, pairs = STALE, f'waiting for {waiting}', []
         return DiagnosticStatus(
             level=bytes([level]),
-            name=STATUS_NAME,
+            name=DIAGNOSIS_STATUS,
             message=message,
             hardware_id=self.hardware_id,
             values=[KeyValue(key=k, value=v) for k, v in [*pairs, *counts]],
@@ -386,7 +398,7 @@ def main(args: Sequence[str] | None = None) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        write_counts(DIAGNOSIS_SCHEMA.node, {TOPIC: node.published})
+        write_counts(DIAGNOSIS_SCHEMA.node, {MODEL_DISCREPANCY: node.published})
         node.destroy_node()
         rclpy.try_shutdown()
     return 0

@@ -42,17 +42,13 @@ from lumpbeam_ros.ident.identify import FitState, identify_from
 from lumpbeam_ros.ident.result import Identification, Status
 from lumpbeam_ros.ident.samples import SampleCounts
 from lumpbeam_ros.ident.window import SlidingWindow
+from lumpbeam_ros.interface import BASE_FRAME, BEAM_PARAMS, IDENTIFIER_STATUS, TIP_LOAD, TIP_POSE
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.nodes.counts import write_counts
-from lumpbeam_ros.nodes.msgtypes import topic_qos
+from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.parameters import declare_parameters
 from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA
 
-STATUS_NAME = 'lumpbeam/identifier'
-BASE_FRAME = 'beam_base'
-_POSE_TYPE = 'geometry_msgs/msg/PoseStamped'
-_LOAD_TYPE = 'std_msgs/msg/Float64'
-_PARAMS_TYPE = 'diagnostic_msgs/msg/DiagnosticArray'
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0
 
@@ -64,6 +60,8 @@ class IdentifierNode(Node):
         context: The rclpy context (default: the global one).
         parameter_overrides: Parameter values by name (e.g. ``{'publish_rate_hz': 5.0}``),
             on top of any ``--params-file``.
+        namespace: The node's namespace (``'/beam_a'``); its topics resolve in it.
+        cli_args: Node-specific ``--ros-args`` (e.g. ``--params-file``, ``-r``).
 
     Raises:
         ConfigError: A parameter or the beam configuration is invalid.
@@ -73,9 +71,17 @@ class IdentifierNode(Node):
         self,
         context: Context | None = None,
         parameter_overrides: Mapping[str, Any] | None = None,
+        namespace: str = '',
+        cli_args: Sequence[str] | None = None,
     ):
         overrides = [Parameter(k, value=v) for k, v in (parameter_overrides or {}).items()]
-        super().__init__(IDENTIFIER_SCHEMA.node, context=context, parameter_overrides=overrides)
+        super().__init__(
+            IDENTIFIER_SCHEMA.node,
+            context=context,
+            namespace=namespace,
+            cli_args=list(cli_args) if cli_args is not None else None,
+            parameter_overrides=overrides,
+        )
         values = declare_parameters(self, IDENTIFIER_SCHEMA)
         settings = {key: values[key] for key in PARAMETER_KEYS.values()}
         self.config: IdentifierConfig = config_from_parameters(
@@ -89,15 +95,9 @@ class IdentifierNode(Node):
         self._resets = 0
         self.wrong_frame = 0
         self.updates = 0
-        self._output = self.create_publisher(
-            DiagnosticArray, '/beam_params', topic_qos('/beam_params', _PARAMS_TYPE)
-        )
-        self.create_subscription(
-            PoseStamped, '/tip_pose', self._on_pose, topic_qos('/tip_pose', _POSE_TYPE)
-        )
-        self.create_subscription(
-            Float64, '/tip_load', self._on_load, topic_qos('/tip_load', _LOAD_TYPE)
-        )
+        self._output = publisher(self, DiagnosticArray, BEAM_PARAMS)
+        subscription(self, PoseStamped, TIP_POSE, self._on_pose)
+        subscription(self, Float64, TIP_LOAD, self._on_load)
         self.create_timer(1.0 / self.config.publish_rate_hz, self._on_timer)
 
     def _on_pose(self, msg: PoseStamped) -> None:
@@ -174,7 +174,7 @@ class IdentifierNode(Node):
         ]
         status = DiagnosticStatus(
             level=bytes([int(result.status)]),
-            name=STATUS_NAME,
+            name=IDENTIFIER_STATUS,
             message=message,
             hardware_id=self.hardware_id,
             values=[KeyValue(key=k, value=v) for k, v in pairs],
@@ -206,7 +206,7 @@ def main(args: list[str] | None = None) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        write_counts(IDENTIFIER_SCHEMA.node, {'/beam_params': node.updates})
+        write_counts(IDENTIFIER_SCHEMA.node, {BEAM_PARAMS: node.updates})
         node.destroy_node()
         rclpy.try_shutdown()
     return 0

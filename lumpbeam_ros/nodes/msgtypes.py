@@ -28,6 +28,7 @@ from rosbags.interfaces import (
 
 from lumpbeam_ros.bagio.qos import INFINITE, SENSOR_DEPTH, STREAM_DEPTH, default_profile
 from lumpbeam_ros.errors import BagError
+from lumpbeam_ros.interface import TOPIC_TYPES
 
 _MAX_SEC = 2**31 - 1
 
@@ -88,17 +89,17 @@ def from_bag_qos(qos: Qos) -> QoSProfile:
     )
 
 
-def topic_qos(topic: str, msgtype: str) -> QoSProfile:
+def topic_qos(topic: str, msgtype: str | None = None) -> QoSProfile:
     """The project's profile of a topic (:func:`~lumpbeam_ros.bagio.qos.default_profile`).
 
     Every node's publishers and subscriptions take their profile from here, so both ends of
-    a topic always agree.
+    a topic always agree. Each call builds a new profile (a QoS override changes it in place).
 
     Args:
-        topic: Topic name, e.g. ``'/tip_pose'``.
-        msgtype: Its type, e.g. ``'geometry_msgs/msg/PoseStamped'``.
+        topic: The interface's (absolute) topic name, e.g. ``'/tip_pose'``.
+        msgtype: Its type; ``None``: the interface's (:data:`~lumpbeam_ros.interface.TOPIC_TYPES`).
 
     Returns:
         The rclpy profile.
     """
-    return from_bag_qos(default_profile(topic, msgtype))
+    return from_bag_qos(default_profile(topic, msgtype or TOPIC_TYPES[topic]))

@@ -8,7 +8,9 @@ Message ``i`` is published at wall time ``start + (log_time_i - log_time_0) / ra
 ``/clock`` carries the log time before each message, so nodes with ``use_sim_time`` follow
 the bag. Each topic is published with the QoS its recorder was offered, or the project's
 default (:mod:`lumpbeam_ros.bagio.qos`): best effort for images, reliable transient-local
-for ``/tip_load``, reliable otherwise.
+for ``/tip_load``, reliable otherwise. Each topic is published by its relative name: in a
+namespace (``/beam_a``) the bag's ``/tip_pose`` goes to ``/beam_a/tip_pose``; ``/clock`` stays
+graph-wide (:func:`~lumpbeam_ros.interface.node_topic`).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from rosgraph_msgs.msg import Clock
 from lumpbeam_ros.bagio import BagReader
 from lumpbeam_ros.bagio.qos import default_profile, from_dict
 from lumpbeam_ros.errors import BagError
+from lumpbeam_ros.interface import CLOCK, PLAYER_NODE, node_topic
 from lumpbeam_ros.nodes.msgtypes import from_bag_qos, message_class, topic_qos
 
 #: Longest wait at the end of playback for reliable subscribers' acknowledgements, s.
@@ -65,6 +68,7 @@ class Player(Node):
         topics: Topics to play; all of the bag's when ``None``.
         rate: Playback speed factor (2.0 plays twice as fast).
         context: The rclpy context.
+        namespace: Publish the bag's topics in this namespace (``'/beam_a'``).
 
     Raises:
         BagError: A requested topic is not in the bag, or its type is not installed.
@@ -76,8 +80,9 @@ class Player(Node):
         topics: Sequence[str] | None = None,
         rate: float = 1.0,
         context: Context | None = None,
+        namespace: str = '',
     ):
-        super().__init__('lumpbeam_player', context=context)
+        super().__init__(PLAYER_NODE, context=context, namespace=namespace)
         if not rate > 0.0:
             raise BagError(f'playback rate must be positive, got {rate!r}')
         self.reader = reader
@@ -87,10 +92,9 @@ class Player(Node):
         for name in names:
             entry = reader.require(name)
             cls = message_class(entry.msgtype)
-            self._outlets[name] = self.create_publisher(cls, name, self._qos(name, entry))
-        self._clock = self.create_publisher(
-            Clock, '/clock', topic_qos('/clock', 'rosgraph_msgs/msg/Clock')
-        )
+            outlet = node_topic(name)
+            self._outlets[name] = self.create_publisher(cls, outlet, self._qos(name, entry))
+        self._clock = self.create_publisher(Clock, CLOCK, topic_qos(CLOCK))
 
     def play(self, should_stop: Callable[[], bool] = lambda: False) -> PlayStats:
         """Plays the bag once, sleeping between messages to keep their relative timing.

@@ -11,6 +11,10 @@ received it (the message info's ``received_timestamp``, wall clock), as rosbag2 
 time the callback runs would date a message that waited in the queue behind others too late,
 and put ``/tip_load`` out of its order with ``/clock`` on a busy machine. The writer sorts what
 it holds by log time, so the bag is in log-time order.
+
+A bag holds the interface's names (``/tip_pose``). A recorder in a namespace (``/beam_a``)
+records that beam's topics (``/beam_a/tip_pose``) under those names, and the graph-wide ones
+(``/clock``) as they are; a player in the same namespace publishes them back where they were.
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ from lumpbeam_ros.bagio import BagWriter
 from lumpbeam_ros.bagio.qos import STREAM_DEPTH
 from lumpbeam_ros.bagio.typestore import is_known
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import GLOBAL_TOPICS, RECORDER_NODE
 from lumpbeam_ros.nodes.msgtypes import message_class, to_bag_qos
 
 #: Subscription depth of a best-effort topic (images): a 180 fps camera must not overflow it
@@ -43,6 +48,7 @@ class Recorder(Node):
         context: The rclpy context.
         discovery_period_s: How often the graph is scanned for new topics, s.
         flush_period_s: How often pending messages are flushed to disk, s.
+        namespace: Record this namespace's topics (``'/beam_a'``), named as without it.
     """
 
     def __init__(
@@ -52,8 +58,9 @@ class Recorder(Node):
         context: Context | None = None,
         discovery_period_s: float = 0.2,
         flush_period_s: float = 0.5,
+        namespace: str = '',
     ):
-        super().__init__('lumpbeam_recorder', context=context)
+        super().__init__(RECORDER_NODE, context=context, namespace=namespace)
         self.bag = bag
         self.wanted = None if topics is None else {_absolute(t) for t in topics}
         self.received: dict[str, int] = {}
@@ -66,21 +73,37 @@ class Recorder(Node):
 
     def discover(self) -> None:
         """Subscribes to wanted topics that have publishers and no subscription yet."""
-        for topic, types in self.get_topic_names_and_types():
-            if topic in self._taps or topic in self._skipped:
+        for graph_topic, types in self.get_topic_names_and_types():
+            topic = self.bag_topic(graph_topic)
+            if topic is None or topic in self._taps or topic in self._skipped:
                 continue
             if self.wanted is None:
                 if topic in ('/rosout', '/parameter_events'):
                     continue
             elif topic not in self.wanted:
                 continue
-            self._subscribe(topic, types)
+            self._subscribe(topic, types, graph_topic)
+
+    def bag_topic(self, graph_topic: str) -> str | None:
+        """The name a graph topic has in the bag; ``None`` when outside the namespace.
+
+        Args:
+            graph_topic: A fully qualified name, e.g. ``'/beam_a/tip_pose'``.
+
+        Returns:
+            E.g. ``'/tip_pose'`` in namespace ``/beam_a``; the name itself without a namespace.
+        """
+        namespace = self.get_namespace()
+        if namespace == '/' or graph_topic in GLOBAL_TOPICS:
+            return graph_topic
+        prefix = f'{namespace}/'
+        return graph_topic[len(prefix) - 1 :] if graph_topic.startswith(prefix) else None
 
     def missing(self) -> list[str]:
         """Wanted topics not seen yet (empty with ``--all``)."""
         return sorted((self.wanted or set()) - set(self._taps))
 
-    def _subscribe(self, topic: str, types: list[str]) -> None:
+    def _subscribe(self, topic: str, types: list[str], graph_topic: str) -> None:
         msgtype = types[0]
         if len(types) > 1:
             self.get_logger().warning(f'{topic} has several types {types}; recording {msgtype}')
@@ -94,7 +117,7 @@ class Recorder(Node):
             self.get_logger().warning(f'not recording {topic}: {exc}')
             self._skipped.add(topic)
             return
-        infos = self.get_publishers_info_by_topic(topic)
+        infos = self.get_publishers_info_by_topic(graph_topic)
         offered = [info.qos_profile for info in infos]
         best_effort = any(p.reliability == ReliabilityPolicy.BEST_EFFORT for p in offered)
         latched = bool(offered) and all(
@@ -125,8 +148,8 @@ class Recorder(Node):
                 return
             self.received[topic] += 1
 
-        self._taps[topic] = self.create_subscription(cls, topic, write, qos, raw=True)
-        self.get_logger().info(f'recording {topic} ({msgtype})')
+        self._taps[topic] = self.create_subscription(cls, graph_topic, write, qos, raw=True)
+        self.get_logger().info(f'recording {graph_topic} ({msgtype}) as {topic}')
 
     def _flush(self) -> None:
         if self.error is None:

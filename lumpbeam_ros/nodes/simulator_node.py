@@ -40,18 +40,26 @@ from visualization_msgs.msg import MarkerArray
 
 from lumpbeam_ros.bagio.convert import NS_PER_S, pitch_to_quaternion, seconds_to_ns
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import (
+    BASE_FRAME,
+    BEAM_MARKERS,
+    BEAM_PARAMS,
+    IDENTIFIER_STATUS,
+    TIP_LOAD,
+    TIP_POSE,
+    TIP_POSE_PREDICTED,
+)
 from lumpbeam_ros.model.adopt import adopt_identified
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters, load_beam_config
 from lumpbeam_ros.model.statics import static_tip_deflection
 from lumpbeam_ros.model.stream import PredictionStream
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.nodes.counts import write_counts
-from lumpbeam_ros.nodes.msgtypes import topic_qos
+from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.parameters import declare_parameters
 from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA, effect_parameter_name
 from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.viz.markers import (
-    MARKERS_TOPIC,
     BeamScene,
     BoardPlacement,
     TipPoint,
@@ -60,8 +68,6 @@ from lumpbeam_ros.viz.markers import (
 )
 from lumpbeam_ros.viz.messages import scene_cdr
 
-FRAME_ID = 'beam_base'
-IDENTIFIER_STATUS = 'lumpbeam/identifier'
 #: DiagnosticStatus.OK as a number (rclpy gives levels as one byte).
 OK_LEVEL = 0
 #: A throttled warning repeats at most this often, s.
@@ -95,6 +101,8 @@ class SimulatorNode(Node):
     Args:
         context: The rclpy context (``None``: the default one).
         parameter_overrides: Parameter values that replace the defaults (as ``-p`` would).
+        namespace: The node's namespace (``'/beam_a'``); its topics resolve in it.
+        cli_args: Node-specific ``--ros-args`` (e.g. ``--params-file``, ``-r``).
 
     Raises:
         ConfigError: The beam file is missing or malformed, or a parameter is of the wrong
@@ -105,10 +113,14 @@ class SimulatorNode(Node):
         self,
         context: Context | None = None,
         parameter_overrides: Sequence[Parameter] | None = None,
+        namespace: str = '',
+        cli_args: Sequence[str] | None = None,
     ):
         super().__init__(
             SIMULATOR_SCHEMA.node,
             context=context,
+            namespace=namespace,
+            cli_args=list(cli_args) if cli_args is not None else None,
             parameter_overrides=list(parameter_overrides or []),
         )
         values = declare_parameters(self, SIMULATOR_SCHEMA, self._on_change)
@@ -131,31 +143,11 @@ class SimulatorNode(Node):
 
         # A late tick publishes several periods' samples in one burst: the stream profile's
         # history holds them (lumpbeam_ros.bagio.qos).
-        self._pose_out = self.create_publisher(
-            PoseStamped,
-            '/tip_pose_predicted',
-            topic_qos('/tip_pose_predicted', 'geometry_msgs/msg/PoseStamped'),
-        )
-        self.create_subscription(
-            Float64, '/tip_load', self._on_load, topic_qos('/tip_load', 'std_msgs/msg/Float64')
-        )
-        self.create_subscription(
-            DiagnosticArray,
-            '/beam_params',
-            self._on_beam_params,
-            topic_qos('/beam_params', 'diagnostic_msgs/msg/DiagnosticArray'),
-        )
-        self._markers_out = self.create_publisher(
-            MarkerArray,
-            MARKERS_TOPIC,
-            topic_qos(MARKERS_TOPIC, 'visualization_msgs/msg/MarkerArray'),
-        )
-        self.create_subscription(
-            PoseStamped,
-            '/tip_pose',
-            self._on_measured,
-            topic_qos('/tip_pose', 'geometry_msgs/msg/PoseStamped'),
-        )
+        self._pose_out = publisher(self, PoseStamped, TIP_POSE_PREDICTED)
+        subscription(self, Float64, TIP_LOAD, self._on_load)
+        subscription(self, DiagnosticArray, BEAM_PARAMS, self._on_beam_params)
+        self._markers_out = publisher(self, MarkerArray, BEAM_MARKERS)
+        subscription(self, PoseStamped, TIP_POSE, self._on_measured)
         # A steady timer: under use_sim_time the node must notice a stalled or jumping /clock,
         # which a timer on that clock would not fire to see.
         self._steady = Clock(clock_type=ClockType.STEADY_TIME)
@@ -232,7 +224,7 @@ class SimulatorNode(Node):
     def _on_measured(self, msg: PoseStamped) -> None:
         p = msg.pose.position
         tip = TipPoint(float(p.x), float(p.z))
-        if msg.header.frame_id != FRAME_ID or not tip.is_finite():
+        if msg.header.frame_id != BASE_FRAME or not tip.is_finite():
             self.get_logger().warning(
                 f'ignoring /tip_pose in frame {msg.header.frame_id!r} at {tip}',
                 throttle_duration_sec=WARN_PERIOD_S,
@@ -412,7 +404,7 @@ class SimulatorNode(Node):
             self._latest = samples
         for i in range(len(samples)):
             msg = PoseStamped()
-            msg.header.frame_id = FRAME_ID
+            msg.header.frame_id = BASE_FRAME
             sec, nanosec = divmod(seconds_to_ns(float(samples.t[i])), NS_PER_S)
             msg.header.stamp.sec, msg.header.stamp.nanosec = sec, nanosec
             msg.pose.position.x = float(samples.x[i])
@@ -460,7 +452,7 @@ def main(args: Sequence[str] | None = None) -> int:
         if node is not None:
             write_counts(
                 SIMULATOR_SCHEMA.node,
-                {'/tip_pose_predicted': node.published, MARKERS_TOPIC: node.markers_published},
+                {TIP_POSE_PREDICTED: node.published, BEAM_MARKERS: node.markers_published},
             )
             node.destroy_node()
         rclpy.try_shutdown()

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 
+from lumpbeam_ros.interface import BASE_FRAME, CAMERA_INFO, CAMERA_NODE, IMAGE
 from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec
 from lumpbeam_ros.vision.free_pose import POSE_MODELS
 
@@ -191,20 +192,18 @@ _TRACKER = (
 )
 
 _NODE = (
-    ParameterSpec('frame_id', 'string', 'beam_base', 'header.frame_id of the published poses'),
+    ParameterSpec('frame_id', 'string', BASE_FRAME, 'header.frame_id of the published poses'),
     ParameterSpec(
         'bag_path',
         'string',
         '',
         'read frames from this bag in-process instead of subscribing (empty: off)',
     ),
-    ParameterSpec(
-        'bag_image_topic', 'string', '/camera/image_raw', 'image topic read from bag_path'
-    ),
+    ParameterSpec('bag_image_topic', 'string', IMAGE, 'image topic read from bag_path'),
     ParameterSpec(
         'bag_camera_info_topic',
         'string',
-        '/camera/camera_info',
+        CAMERA_INFO,
         'camera info topic read from bag_path',
     ),
     ParameterSpec(
@@ -275,7 +274,7 @@ _NODE = (
 CONFIG_KEYS = tuple(spec.name for spec in (*_CAMERA, *_BOARD, *_SYNTHETIC, *_TRACKER))
 
 CAMERA_SCHEMA = ParameterSchema(
-    node='camera_node',
+    node=CAMERA_NODE,
     summary=(
         'Camera frames in, the tip pose out. The `camera.*`, `board.*`, `synthetic.*` and '
         '`tracker.*` values are those of config/camera.yaml (`synthetic.*` is read by '

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+from lumpbeam_ros.interface import DIAGNOSIS_NODE, SIMULATOR_NODE
 from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec
 
 _POSITIVE = Bounds(0.0, low_open=True)
 
 DIAGNOSIS_SCHEMA = ParameterSchema(
-    node='diagnosis_node',
+    node=DIAGNOSIS_NODE,
     summary=(
         'The discrepancy workflow of `lumpbeam diagnose` run live on each completed ring-down '
         '(or window) of /tip_pose and /tip_load, publishing /model_discrepancy; with adopt, '
@@ -83,9 +84,9 @@ DIAGNOSIS_SCHEMA = ParameterSchema(
             read_only=False,
         ),
         ParameterSpec(
-            'simulator_node',
+            SIMULATOR_NODE,
             'string',
-            'simulator_node',
+            SIMULATOR_NODE,
             'the node whose parameters adopt sets',
         ),
         ParameterSpec(

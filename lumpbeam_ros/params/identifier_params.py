@@ -8,6 +8,7 @@ and the file equal.
 from __future__ import annotations
 
 from lumpbeam_ros.ident.config import NONLINEAR_CHOICES
+from lumpbeam_ros.interface import IDENTIFIER_NODE
 from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec
 
 _POSITIVE = Bounds(0.0, low_open=True)
@@ -20,7 +21,7 @@ def _double(name: str, default: float, description: str, unit: str = '') -> Para
 
 
 IDENTIFIER_SCHEMA = ParameterSchema(
-    node='identifier_node',
+    node=IDENTIFIER_NODE,
     summary=(
         'Frequency, damping and stiffness from the tip oscillations after a load drop '
         '(paper section B.3.2, eqs. B.12 and B.20-B.22), published on /beam_params. '

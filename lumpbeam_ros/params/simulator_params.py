@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from lumpbeam_ros.interface import SIMULATOR_NODE
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, Effects
 from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec
 
@@ -39,7 +40,7 @@ def _effect_spec(effect: str, parameter: str) -> ParameterSpec:
 
 
 SIMULATOR_SCHEMA = ParameterSchema(
-    node='simulator_node',
+    node=SIMULATOR_NODE,
     summary=(
         'The lumped beam run in step with the node clock, publishing the predicted tip pose. '
         'Every parameter can be changed while it runs (`ros2 param set`).'

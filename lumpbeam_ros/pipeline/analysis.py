@@ -24,14 +24,27 @@ from lumpbeam_ros.ident.identify import identify
 from lumpbeam_ros.ident.result import Identification
 from lumpbeam_ros.ident.samples import clean_loads, clean_window
 from lumpbeam_ros.ident.segments import keep_release_segment
+from lumpbeam_ros.interface import (
+    BEAM_PARAMS,
+    CLOCK,
+    CLOCK_TYPE,
+    DIAGNOSTIC_ARRAY,
+    FLOAT64,
+    IDENTIFIER_STATUS,
+    MODEL_DISCREPANCY,
+    POSE_STAMPED,
+    TIP_LOAD,
+    TIP_POSE,
+    TIP_POSE_PREDICTED,
+    TIP_POSE_TRUTH,
+)
 from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.plots.demo import Residual, prediction_residual
 from lumpbeam_ros.viz.markers import MARKERS_TOPIC
 from lumpbeam_ros.viz.messages import MARKER_ARRAY_TYPE
 
-IDENTIFIER_STATUS = 'lumpbeam/identifier'
 #: Pose topics a normalized recording keeps.
-POSE_TOPICS = ('/tip_pose', '/tip_pose_predicted', '/tip_pose_truth')
+POSE_TOPICS = (TIP_POSE, TIP_POSE_PREDICTED, TIP_POSE_TRUTH)
 
 
 @dataclass(frozen=True)
@@ -87,7 +100,7 @@ def read_clock(bag: str | Path) -> tuple[np.ndarray, np.ndarray]:
     """
     rows = [
         (convert.ns_to_seconds(ns), convert.ns_to_seconds(convert.time_ns(msg.clock)))
-        for ns, msg in BagReader(bag).messages('/clock', 'rosgraph_msgs/msg/Clock')
+        for ns, msg in BagReader(bag).messages(CLOCK, CLOCK_TYPE)
     ]
     if not rows:
         raise BagError(f'{bag}: /clock has no message, so /tip_load cannot be put in sim time')
@@ -96,7 +109,7 @@ def read_clock(bag: str | Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 #: Status topics a normalized recording keeps, each message at its header stamp.
-DIAGNOSTIC_TOPICS = ('/beam_params', '/model_discrepancy')
+DIAGNOSTIC_TOPICS = (BEAM_PARAMS, MODEL_DISCREPANCY)
 
 
 def normalize_recording(recorded: str | Path, out: str | Path) -> Path:
@@ -124,8 +137,8 @@ def normalize_recording(recorded: str | Path, out: str | Path) -> Path:
     # (sim time ns, topic, message), merged into log-time order before writing: each topic
     # comes in its own order, and a bag's messages are in log-time order.
     rows: list[tuple[int, str, object]] = []
-    types = {topic: 'geometry_msgs/msg/PoseStamped' for topic in POSE_TOPICS}
-    types.update({topic: 'diagnostic_msgs/msg/DiagnosticArray' for topic in DIAGNOSTIC_TOPICS})
+    types = {topic: POSE_STAMPED for topic in POSE_TOPICS}
+    types.update({topic: DIAGNOSTIC_ARRAY for topic in DIAGNOSTIC_TOPICS})
     for topic, msgtype in types.items():
         if topic in reader.topics:
             rows += [
@@ -133,7 +146,7 @@ def normalize_recording(recorded: str | Path, out: str | Path) -> Path:
                 for _, msg in reader.messages(topic, msgtype)
             ]
     rows += [
-        (convert.seconds_to_ns(float(t)), '/tip_load', convert.float64(float(kg)))
+        (convert.seconds_to_ns(float(t)), TIP_LOAD, convert.float64(float(kg)))
         for t, kg in zip(load_t, loads.kg, strict=True)
         if np.isfinite(t)
     ]
@@ -148,7 +161,7 @@ def normalize_recording(recorded: str | Path, out: str | Path) -> Path:
         for topic in POSE_TOPICS:
             if topic in reader.topics:
                 bag.add_topic(topic, types[topic])
-        bag.add_topic('/tip_load', 'std_msgs/msg/Float64')
+        bag.add_topic(TIP_LOAD, FLOAT64)
         for ns, topic, msg in sorted(rows, key=lambda row: row[0]):
             bag.write_message(topic, msg, ns)
     return Path(out)
@@ -164,7 +177,7 @@ def last_live_status(bag: str | Path) -> tuple[dict[str, str], int]:
     Returns:
         The values (``repr`` strings, as published) and the last level; ``({}, -1)`` if none.
     """
-    if '/beam_params' not in BagReader(bag).topics:
+    if BEAM_PARAMS not in BagReader(bag).topics:
         return {}, -1
     latest: dict[str, str] = {}
     level = -1
@@ -204,9 +217,9 @@ def analyze_recording(
         BagError: A topic is missing or empty.
         LumpbeamError: The poses do not hold a usable drop test.
     """
-    measured = read_tip_poses(bag, '/tip_pose')
-    predicted = read_tip_poses(bag, '/tip_pose_predicted')
-    for name, series in (('/tip_pose', measured), ('/tip_pose_predicted', predicted)):
+    measured = read_tip_poses(bag, TIP_POSE)
+    predicted = read_tip_poses(bag, TIP_POSE_PREDICTED)
+    for name, series in ((TIP_POSE, measured), (TIP_POSE_PREDICTED, predicted)):
         if series.t.size == 0:
             raise BagError(f'{bag}: {name} has no message')
     loads = read_load_events(bag)

@@ -19,12 +19,12 @@ from lumpbeam_ros.ident.identify import FitState, identify_from
 from lumpbeam_ros.ident.result import Identification
 from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow, clean_loads, clean_window
 from lumpbeam_ros.ident.segments import keep_release_segment
+from lumpbeam_ros.interface import BASE_FRAME, TIP_LOAD, TIP_POSE
 from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.progress import Progress
 
-POSE_TOPIC = '/tip_pose'
-LOAD_TOPIC = '/tip_load'
-BASE_FRAME = 'beam_base'
+POSE_TOPIC = TIP_POSE
+LOAD_TOPIC = TIP_LOAD
 
 #: The keys scripts rely on (doc/interfaces.md, "lumpbeam analyze"), each also with ``_std``.
 CONTRACT_KEYS = (

@@ -35,6 +35,27 @@ from typing import Any
 
 from lumpbeam_ros.bagio import BagReader, read_tip_poses
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import (
+    BEAM_MARKERS,
+    BEAM_PARAMS,
+    CAMERA_INFO,
+    CAMERA_NODE,
+    CLOCK,
+    CLOCK_TYPE,
+    DIAGNOSIS_NODE,
+    DIAGNOSTIC_ARRAY,
+    FLOAT64,
+    IDENTIFIER_NODE,
+    IMAGE,
+    MARKER_ARRAY,
+    MODEL_DISCREPANCY,
+    POSE_STAMPED,
+    RECORDER_NODE,
+    SIMULATOR_NODE,
+    TIP_LOAD,
+    TIP_POSE,
+    TIP_POSE_PREDICTED,
+)
 from lumpbeam_ros.model.adopt import first_mode
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, load_beam_config
 from lumpbeam_ros.nodes.counts import COUNTS_DIR_ENV, read_counts
@@ -71,33 +92,33 @@ LIVE_DECAY_S = 2.3
 VERDICT_WAIT_S = 120.0
 DIAGNOSE_MODULE = 'lumpbeam_ros.cli.diagnose'
 CLI_MODULE = 'lumpbeam_ros.cli.main'
-IMAGE_TOPIC = '/camera/image_raw'
-CAMERA_INFO_TOPIC = '/camera/camera_info'
+IMAGE_TOPIC = IMAGE
+CAMERA_INFO_TOPIC = CAMERA_INFO
 #: What the recorder records, with the types the probe announces them with.
 RECORDED_TOPICS = {
-    '/tip_pose': 'geometry_msgs/msg/PoseStamped',
-    '/tip_load': 'std_msgs/msg/Float64',
-    '/tip_pose_predicted': 'geometry_msgs/msg/PoseStamped',
-    '/beam_params': 'diagnostic_msgs/msg/DiagnosticArray',
-    '/clock': 'rosgraph_msgs/msg/Clock',
-    '/beam_markers': 'visualization_msgs/msg/MarkerArray',
-    '/model_discrepancy': 'diagnostic_msgs/msg/DiagnosticArray',
+    TIP_POSE: POSE_STAMPED,
+    TIP_LOAD: FLOAT64,
+    TIP_POSE_PREDICTED: POSE_STAMPED,
+    BEAM_PARAMS: DIAGNOSTIC_ARRAY,
+    CLOCK: CLOCK_TYPE,
+    BEAM_MARKERS: MARKER_ARRAY,
+    MODEL_DISCREPANCY: DIAGNOSTIC_ARRAY,
 }
 #: Who publishes each recorded topic, by the name of its counts file
 #: (:mod:`lumpbeam_ros.nodes.counts`); ``/tip_pose`` comes from the camera node when it runs.
 PUBLISHERS = {
-    '/tip_pose': 'player',
-    '/tip_load': 'player',
-    '/tip_pose_predicted': 'simulator_node',
-    '/beam_markers': 'simulator_node',
-    '/beam_params': 'identifier_node',
-    '/model_discrepancy': 'diagnosis_node',
-    '/clock': 'player',
+    TIP_POSE: 'player',
+    TIP_LOAD: 'player',
+    TIP_POSE_PREDICTED: SIMULATOR_NODE,
+    BEAM_MARKERS: SIMULATOR_NODE,
+    BEAM_PARAMS: IDENTIFIER_NODE,
+    MODEL_DISCREPANCY: DIAGNOSIS_NODE,
+    CLOCK: 'player',
 }
 #: The topics the nodes are still producing when the player is done.
 TRAILING_TOPICS = {
-    '/tip_pose': 'geometry_msgs/msg/PoseStamped',
-    '/tip_pose_predicted': 'geometry_msgs/msg/PoseStamped',
+    TIP_POSE: POSE_STAMPED,
+    TIP_POSE_PREDICTED: POSE_STAMPED,
 }
 #: Camera frames are replayed at this fraction of real time: the graph runs on the player's
 #: /clock, so only the wall time changes, and on 2 cores the camera node, the identifier,
@@ -262,9 +283,9 @@ def replay(run: DemoRun) -> None:
     # Readers each recorded topic must have before the replay: the probe's and the
     # recorder's, plus the simulator's own inputs.
     readers = dict.fromkeys(RECORDED_TOPICS, 2)
-    readers['/tip_load'] += 1
-    readers['/clock'] += 1
-    readers['/beam_params'] += 1
+    readers[TIP_LOAD] += 1
+    readers[CLOCK] += 1
+    readers[BEAM_PARAMS] += 1
     shutil.rmtree(run.counts_dir, ignore_errors=True)
     with ProcessGraph(run.log_dir, run.options.domain_id) as graph:
         graph.env[COUNTS_DIR_ENV] = str(run.counts_dir)
@@ -274,8 +295,8 @@ def replay(run: DemoRun) -> None:
         if module_available(IDENTIFIER_MODULE):
             graph.start('identifier', node_command(IDENTIFIER_MODULE, *sim_time))
             run.nodes.append(IDENTIFIER_MODULE)
-            readers['/tip_pose'] += 1
-            readers['/tip_load'] += 1
+            readers[TIP_POSE] += 1
+            readers[TIP_LOAD] += 1
         if module_available(DIAGNOSIS_NODE_MODULE):
             _start_diagnosis_node(graph, run, readers)
         if run.with_camera:
@@ -288,13 +309,13 @@ def replay(run: DemoRun) -> None:
         )
         wait_for_graph(
             graph,
-            ['simulator_node', 'lumpbeam_recorder']
-            + (['diagnosis_node'] if DIAGNOSIS_NODE_MODULE in run.nodes else []),
+            [SIMULATOR_NODE, RECORDER_NODE]
+            + ([DIAGNOSIS_NODE] if DIAGNOSIS_NODE_MODULE in run.nodes else []),
             readers,
             run.options.ready_timeout_s,
             announce=RECORDED_TOPICS,
         )
-        played = [IMAGE_TOPIC, '/tip_load'] if run.with_camera else ['/tip_pose', '/tip_load']
+        played = [IMAGE_TOPIC, TIP_LOAD] if run.with_camera else [TIP_POSE, TIP_LOAD]
         if run.with_camera and CAMERA_INFO_TOPIC in topics:
             played.append(CAMERA_INFO_TOPIC)
         graph.start(
@@ -322,7 +343,7 @@ def replay(run: DemoRun) -> None:
         # stop them before the recorder, which takes in what they sent last.
         trailing = dict(TRAILING_TOPICS)
         if not run.with_camera:
-            del trailing['/tip_pose']  # the player's, and it is done
+            del trailing[TIP_POSE]  # the player's, and it is done
         wait_for_quiet(graph, trailing, timeout_s=run.options.ready_timeout_s)
         for name in others:
             if name != 'recorder':
@@ -341,7 +362,7 @@ def count(run: DemoRun) -> None:
     recorded = {name: entry.count for name, entry in BagReader(run.recorded_bag).topics.items()}
     publishers = dict(PUBLISHERS)
     if run.with_camera:
-        publishers['/tip_pose'] = 'camera_node'
+        publishers[TIP_POSE] = CAMERA_NODE
     run.topic_counts = {}
     for topic in RECORDED_TOPICS:
         publisher = publishers[topic]
@@ -352,11 +373,11 @@ def count(run: DemoRun) -> None:
             'recorded': recorded.get(topic, 0),
         }
     if run.with_camera:
-        camera = counts.get('camera_node', {})
+        camera = counts.get(CAMERA_NODE, {})
         run.image_counts = {
             'offered': counts.get('player', {}).get('published', {}).get(IMAGE_TOPIC),
             'received': camera.get('received', {}).get(IMAGE_TOPIC),
-            'tracked': camera.get('published', {}).get('/tip_pose'),
+            'tracked': camera.get('published', {}).get(TIP_POSE),
         }
     for line in count_lines(run.topic_counts, run.image_counts):
         run.echo(line)
@@ -392,7 +413,7 @@ def _start_diagnosis_node(graph: ProcessGraph, run: DemoRun, readers: dict[str, 
         args += ['-p', f'beam_config:={run.options.beam_config}']
     graph.start('diagnosis', node_command(DIAGNOSIS_NODE_MODULE, *args))
     run.nodes.append(DIAGNOSIS_NODE_MODULE)
-    for topic in ('/tip_pose', '/tip_load', '/tip_pose_predicted'):
+    for topic in (TIP_POSE, TIP_LOAD, TIP_POSE_PREDICTED):
         readers[topic] += 1
 
 

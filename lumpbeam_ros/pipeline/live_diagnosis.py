@@ -17,11 +17,12 @@ import numpy as np
 
 from lumpbeam_ros.bagio import BagReader
 from lumpbeam_ros.bagio.series import read_diagnostics
+from lumpbeam_ros.interface import DIAGNOSIS_STATUS, MODEL_DISCREPANCY
 from lumpbeam_ros.pipeline.graph import ProcessGraph
 from lumpbeam_ros.plots.demo import Residual
 
-TOPIC = '/model_discrepancy'
-STATUS_NAME = 'lumpbeam/diagnosis'
+TOPIC = MODEL_DISCREPANCY
+STATUS_NAME = DIAGNOSIS_STATUS
 #: The live gap after an adoption starts this long after it: the prediction published in
 #: the tick that applied it still carries the old model.
 SETTLE_S = 0.2

@@ -18,6 +18,7 @@ import numpy as np
 
 from lumpbeam_ros.bagio import BagWriter
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import TIP_LOAD, TIP_POSE, TIP_POSE_TRUTH
 from lumpbeam_ros.model.parameters import (
     EFFECT_PARAMETERS,
     BeamParameters,
@@ -203,18 +204,18 @@ def write_drop_test_bag(
         pending = next(loads, None)
         for i, stamp in enumerate(measured.t):
             while pending is not None and pending[0] <= stamp:
-                bag.write_float('/tip_load', pending[0], pending[1])
+                bag.write_float(TIP_LOAD, pending[0], pending[1])
                 pending = next(loads, None)
             if points is not None:
                 written = write_tracker_points(bag, points, written, stamp)
             bag.write_pose(
-                '/tip_pose',
+                TIP_POSE,
                 stamp,
                 measured.x[i] + noise[0, i],
                 measured.z[i] + noise[1, i],
                 measured.pitch[i] + noise[2, i],
             )
-            bag.write_pose('/tip_pose_truth', stamp, truth.x[i], truth.z[i], truth.pitch[i])
+            bag.write_pose(TIP_POSE_TRUTH, stamp, truth.x[i], truth.z[i], truth.pitch[i])
             if i in drawn:
                 scene = BeamScene(
                     beam.segment_length_m,

@@ -15,13 +15,14 @@ from pathlib import Path
 
 from lumpbeam_ros.bagio import BagWriter
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import CAMERA_INFO, IMAGE
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.vision.messages import camera_info_to_data
 from lumpbeam_ros.vision.synthetic import SyntheticCamera, SyntheticFrame
 
-IMAGE_TOPIC = '/camera/image_raw'
-CAMERA_INFO_TOPIC = '/camera/camera_info'
+IMAGE_TOPIC = IMAGE
+CAMERA_INFO_TOPIC = CAMERA_INFO
 #: ``header.frame_id`` of the images and the camera info.
 CAMERA_FRAME = 'camera'
 

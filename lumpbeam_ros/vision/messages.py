@@ -16,12 +16,10 @@ import numpy as np
 from lumpbeam_ros.bagio import CameraInfoData, convert
 from lumpbeam_ros.bagio.typestore import deserialize
 from lumpbeam_ros.errors import BagError
+from lumpbeam_ros.interface import CAMERA_INFO_TYPE, COMPRESSED_IMAGE_TYPE, IMAGE_TYPE
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.sources.pixels import decode_compressed, tracker_pixels
 
-IMAGE_TYPE = 'sensor_msgs/msg/Image'
-COMPRESSED_IMAGE_TYPE = 'sensor_msgs/msg/CompressedImage'
-CAMERA_INFO_TYPE = 'sensor_msgs/msg/CameraInfo'
 #: The image message types the tracker reads.
 IMAGE_TYPES = (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE)
 

@@ -33,6 +33,16 @@ from lumpbeam_ros.bagio import BagReader, BagWriter, convert, read_camera_info, 
 from lumpbeam_ros.bagio.qos import from_dict
 from lumpbeam_ros.bagio.typestore import is_known
 from lumpbeam_ros.errors import BagError, LumpbeamError
+from lumpbeam_ros.interface import (
+    BASE_FRAME,
+    CAMERA_INFO,
+    CAMERA_INFO_TYPE,
+    COMPRESSED_IMAGE,
+    IMAGE,
+    POSE_STAMPED,
+    TIP_POSE,
+    TIP_POSE_TRUTH,
+)
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import CameraConfig
 from lumpbeam_ros.vision.free_pose import rpy_quaternion
@@ -55,11 +65,11 @@ from lumpbeam_ros.viz.markers import (
 )
 from lumpbeam_ros.viz.messages import write_scene
 
-POSE_TOPIC = '/tip_pose'
-TRUTH_TOPIC = '/tip_pose_truth'
-IMAGE_TOPIC = '/camera/image_raw'
-COMPRESSED_IMAGE_TOPIC = '/camera/image_raw/compressed'
-CAMERA_INFO_TOPIC = '/camera/camera_info'
+POSE_TOPIC = TIP_POSE
+TRUTH_TOPIC = TIP_POSE_TRUTH
+IMAGE_TOPIC = IMAGE
+COMPRESSED_IMAGE_TOPIC = COMPRESSED_IMAGE
+CAMERA_INFO_TOPIC = CAMERA_INFO
 
 #: Rate of ``/beam_markers`` in OUT, Hz: at most one array per period of it.
 MARKERS_RATE_HZ = 30.0
@@ -229,7 +239,7 @@ class _Run:
         self.summary = TrackSummary()
         self.tracking_s = 0.0
         self.done = 0
-        writer.add_topic(POSE_TOPIC, 'geometry_msgs/msg/PoseStamped')
+        writer.add_topic(POSE_TOPIC, POSE_STAMPED)
         self._board = board_placement(session.config)
         self._next_markers_ns = -1
 
@@ -305,10 +315,10 @@ def pose_message(stamp_ns: int, result: TrackResult) -> object:
     if result.pose6 is not None:
         p = result.pose6
         return convert.pose_stamped_6dof(
-            stamp_ns, tuple(p[:3]), rpy_quaternion(*p[3:]), 'beam_base'
+            stamp_ns, tuple(p[:3]), rpy_quaternion(*p[3:]), BASE_FRAME
         )
     x, z, pitch = (float(v) for v in result.pose)
-    return convert.pose_stamped(stamp_ns, x, z, pitch, 'beam_base')
+    return convert.pose_stamped(stamp_ns, x, z, pitch, BASE_FRAME)
 
 
 def track_bag(
@@ -356,7 +366,7 @@ def track_bag(
         raise BagError(f'{reader.path}: topic {image_topic} has no images')
     follow_info = camera_info is None
     if camera_info is None:
-        reader.require(camera_info_topic, 'sensor_msgs/msg/CameraInfo')
+        reader.require(camera_info_topic, CAMERA_INFO_TYPE)
         data = read_camera_info(reader, camera_info_topic)
         try:
             camera_info = camera_info_from_data(data)

@@ -15,10 +15,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import IMAGE_TYPE
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import CameraConfig
 from lumpbeam_ros.vision.free_pose import POSE_MODELS
-from lumpbeam_ros.vision.messages import IMAGE_TYPE, CameraFrame, decode_frame
+from lumpbeam_ros.vision.messages import CameraFrame, decode_frame
 from lumpbeam_ros.vision.tracker import TipTracker, TrackResult, TrackStatus
 
 

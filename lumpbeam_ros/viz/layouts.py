@@ -24,13 +24,14 @@ import yaml
 
 from lumpbeam_ros.bagio import BagReader
 from lumpbeam_ros.bagio.typestore import deserialize
+from lumpbeam_ros.interface import MARKER_ARRAY, POSE_STAMPED
 
 #: 3D panel topics: the types Foxglove's 3D panel draws that the layout relies on.
-THREE_D_TYPES = ('visualization_msgs/msg/MarkerArray', 'geometry_msgs/msg/PoseStamped')
+THREE_D_TYPES = (MARKER_ARRAY, POSE_STAMPED)
 #: The message type each RViz display class subscribes with.
 RVIZ_DISPLAY_TYPES = {
-    'rviz_default_plugins/MarkerArray': 'visualization_msgs/msg/MarkerArray',
-    'rviz_default_plugins/Pose': 'geometry_msgs/msg/PoseStamped',
+    'rviz_default_plugins/MarkerArray': MARKER_ARRAY,
+    'rviz_default_plugins/Pose': POSE_STAMPED,
 }
 #: Panels whose ``paths`` are message paths to plotted values.
 PATH_PANELS = ('Plot', 'StateTransitions')

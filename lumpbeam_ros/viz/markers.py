@@ -21,11 +21,12 @@ from enum import IntEnum
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from lumpbeam_ros.interface import BASE_FRAME, BEAM_MARKERS
 from lumpbeam_ros.vision.config import CameraConfig
 
 #: The topic and frame of the markers.
-MARKERS_TOPIC = '/beam_markers'
-FRAME_ID = 'beam_base'
+MARKERS_TOPIC = BEAM_MARKERS
+FRAME_ID = BASE_FRAME
 
 #: Namespaces, one per object; each object has id 0 in its namespace.
 NS_BEAM = 'beam'

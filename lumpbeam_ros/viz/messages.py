@@ -15,6 +15,7 @@ import numpy as np
 
 from lumpbeam_ros.bagio import BagReader, BagWriter, convert
 from lumpbeam_ros.bagio.typestore import message_class, serialize
+from lumpbeam_ros.interface import COMPRESSED_IMAGE_TYPE, MARKER_ARRAY
 from lumpbeam_ros.viz.markers import (
     FRAME_ID,
     MARKERS_TOPIC,
@@ -25,7 +26,7 @@ from lumpbeam_ros.viz.markers import (
     scene_markers,
 )
 
-MARKER_ARRAY_TYPE = 'visualization_msgs/msg/MarkerArray'
+MARKER_ARRAY_TYPE = MARKER_ARRAY
 
 
 def _duration(seconds: float) -> Any:
@@ -66,7 +67,7 @@ def marker_message(spec: MarkerSpec, stamp_ns: int, frame_id: str = FRAME_ID) ->
         points=[point(*(float(v) for v in p)) for p in spec.points],
         colors=[],
         texture_resource='',
-        texture=message_class('sensor_msgs/msg/CompressedImage')(
+        texture=message_class(COMPRESSED_IMAGE_TYPE)(
             header=convert.header(0, ''), format='', data=np.empty(0, dtype=np.uint8)
         ),
         uv_coordinates=[],

@@ -167,3 +167,47 @@ def test_a_bag_out_of_order_plays_every_message_with_a_monotonic_clock(ros_graph
     z = sorted(round(-p.pose.position.z * 1000) for p in poses)
     assert z == list(range(10))
     assert (stats.out_of_order > 0) == cut
+
+
+def test_a_namespaced_player_and_recorder_keep_the_bag_names(ros_graph, short_bag, tmp_path):
+    from lumpbeam_ros.nodes.recorder import Recorder
+
+    spaced = ros_graph.collect('/beam_a/tip_pose', PoseStamped, 100)
+    unspaced = ros_graph.collect('/tip_pose', PoseStamped, 100)
+    clock = ros_graph.collect('/clock', Clock, 100)
+    # A beam outside the namespace: its topic is not the namespaced recorder's.
+    ros_graph.publish('/tip_load', Float64(data=1.0), 10)
+    bag = BagWriter(tmp_path / 'again')
+    recorder = Recorder(
+        bag, ['/tip_pose', '/tip_load', '/clock'], context=ros_graph.context, namespace='/beam_a'
+    )
+    ros_graph.add_node(recorder)
+    player = Player(
+        BagReader(short_bag),
+        ['/tip_pose', '/tip_load'],
+        context=ros_graph.context,
+        namespace='/beam_a',
+    )
+    assert ros_graph.spin_until(lambda: not recorder.missing(), 10.0)
+    outlet = player._outlets['/tip_pose']
+    assert ros_graph.spin_until(lambda: outlet.get_subscription_count() >= 2)
+    ros_graph.spin_for(0.3)  # the subscriptions settle on the publishers
+    result = {}
+    thread = threading.Thread(target=lambda: result.update(stats=player.play()))
+    thread.start()
+    ros_graph.spin_until(lambda: not thread.is_alive(), 10.0)
+    thread.join()
+    stats = result['stats']
+    assert stats.published == {'/tip_load': 1, '/tip_pose': 60}
+    assert ros_graph.spin_until(lambda: len(spaced) == 60, 5.0)
+    assert ros_graph.spin_until(lambda: len(clock) == 61, 5.0)  # /clock is graph-wide
+    assert unspaced == []
+    assert recorder.bag_topic('/beam_a/tip_pose') == '/tip_pose'
+    assert recorder.bag_topic('/beam_b/tip_pose') is None
+    assert recorder.bag_topic('/clock') == '/clock'
+    assert ros_graph.spin_until(lambda: recorder.received.get('/tip_pose') == 60, 5.0)
+    bag.close()
+    reader = BagReader(tmp_path / 'again')
+    assert set(reader.topics) == {'/tip_pose', '/tip_load', '/clock'}
+    loads = [m.data for _, m in reader.messages('/tip_load', 'std_msgs/msg/Float64')]
+    assert loads == [4.5]  # the namespace's load, not the other beam's 1.0

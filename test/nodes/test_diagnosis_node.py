@@ -14,8 +14,10 @@ from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio.convert import pitch_to_quaternion
 from lumpbeam_ros.diagnose.live import LiveDiagnosis, Stretch
+from lumpbeam_ros.interface import DIAGNOSIS_STATUS as STATUS_NAME
+from lumpbeam_ros.interface import MODEL_DISCREPANCY as TOPIC
 from lumpbeam_ros.model.parameters import load_beam_config
-from lumpbeam_ros.nodes.diagnosis_node import STATUS_NAME, TOPIC, DiagnosisNode
+from lumpbeam_ros.nodes.diagnosis_node import DiagnosisNode
 from lumpbeam_ros.nodes.simulator_node import SimulatorNode
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, simulate_experiment
 
@@ -186,7 +188,7 @@ def test_a_simulator_that_refuses_the_parameters_is_one_message_and_no_adoption(
     fixed.declare_parameter(LATENCY, 0.0, ParameterDescriptor(read_only=True))
     ros_graph.add_node(fixed)
     node = _start(ros_graph, adopt=True)
-    assert ros_graph.spin_until(node._parameters.services_are_ready, 30.0)
+    assert ros_graph.spin_until(node._simulator_parameters.services_are_ready, 30.0)
     node.offer_adoption(_found(2e-5), 3e-3)
     assert ros_graph.spin_until(lambda: 'refused' in node.adoption, 30.0), node.adoption
     assert node.adoption.startswith(f'simulator_node refused the adoption: {LATENCY}')
@@ -197,7 +199,7 @@ def test_a_model_that_fits_worse_than_the_running_one_is_not_adopted(ros_graph):
     simulator = SimulatorNode(context=ros_graph.context)
     ros_graph.add_node(simulator)
     node = _start(ros_graph, adopt=True)
-    assert ros_graph.spin_until(node._parameters.services_are_ready, 30.0)
+    assert ros_graph.spin_until(node._simulator_parameters.services_are_ready, 30.0)
     node.offer_adoption(_found(4e-3), 3e-3)
     assert node.adoption.startswith('not adopted: the augmented model')
     node.offer_adoption(_found(2e-5), math.nan)  # no prediction to compare with

@@ -18,12 +18,13 @@ from lumpbeam_ros.cli.analyze import read_window
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.identify import identify
+from lumpbeam_ros.interface import IDENTIFIER_STATUS as STATUS_NAME
 from lumpbeam_ros.model import rules
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.modes import chain_modes
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.model.statics import static_tip_deflection
-from lumpbeam_ros.nodes.identifier_node import STATUS_NAME, IdentifierNode
+from lumpbeam_ros.nodes.identifier_node import IdentifierNode
 from lumpbeam_ros.resources import config_path
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 
