@@ -134,7 +134,7 @@ def test_second_mode_is_fitted_only_when_above_the_noise(drop_case):
 
 def test_static_window_is_an_error_not_an_exception(drop_case):
     trajectory, _ = drop_case()
-    quiet = trajectory.slice_time(0.0, 1.9)
+    quiet = trajectory.between(0.0, 1.9)
     r = identify(clean_window(quiet.t, quiet.z, quiet.pitch), BEAM, strict=True)
     assert r.status == Status.ERROR and 'no oscillation' in r.message
     assert math.isnan(r.natural_frequency_hz)
@@ -142,13 +142,13 @@ def test_static_window_is_an_error_not_an_exception(drop_case):
 
 def test_too_few_samples_is_error_live_and_raises_in_batch(drop_case):
     trajectory, _ = drop_case()
-    few = trajectory.slice_time(2.5, 2.6)
+    few = trajectory.between(2.5, 2.6)
     window = clean_window(few.t, few.z, few.pitch)
     r = identify(window, BEAM)
     assert r.status == Status.ERROR and 'valid pose samples' in r.message
     with pytest.raises(LumpbeamError, match='valid pose samples'):
         identify(window, BEAM, strict=True)
-    late = trajectory.slice_time(0.0, 2.1)
+    late = trajectory.between(0.0, 2.1)
     with pytest.raises(LumpbeamError, match='after the release'):
         identify(clean_window(late.t, late.z, late.pitch), BEAM, strict=True)
 
@@ -174,7 +174,7 @@ def test_bad_samples_and_gaps_are_tolerated(drop_case):
 
 def test_short_decay_warns(drop_case):
     trajectory, truth = drop_case()
-    part = trajectory.slice_time(0.0, 2.6)
+    part = trajectory.between(0.0, 2.6)
     r = identify(clean_window(part.t, part.z, part.pitch), BEAM)
     assert r.status == Status.WARN and 'cycles' in r.message
     assert r.natural_frequency_hz == pytest.approx(truth.natural_frequency_hz, rel=0.01)
@@ -182,7 +182,7 @@ def test_short_decay_warns(drop_case):
 
 def test_window_without_release_gives_dynamics_but_warns_on_stiffness(drop_case):
     trajectory, truth = drop_case()
-    part = trajectory.slice_time(3.0, 12.0)
+    part = trajectory.between(3.0, 12.0)
     r = identify(clean_window(part.t, part.z, part.pitch), BEAM)
     assert r.status == Status.WARN and 'stiffness' in r.message
     assert math.isnan(r.stiffness_total_nm_per_rad)
@@ -206,7 +206,7 @@ def test_warm_updates_follow_the_full_identification(drop_case):
     config = IdentifierConfig(recheck_every_s=2.0)
     state, checks = None, set()
     for end in np.arange(9.0, 11.51, 0.5):  # a live window at 2 Hz, the release kept in it
-        part = trajectory.slice_time(end - 10.0, end)
+        part = trajectory.between(end - 10.0, end)
         window = _window(part, True)
         warm, state = identify_from(window, BEAM, config, previous=state)
         cold = identify(window, BEAM, config)

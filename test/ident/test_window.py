@@ -77,7 +77,7 @@ def test_bad_window_settings():
 
 def test_live_stream_identifies_like_a_batch(drop_case):
     trajectory, truth = drop_case()
-    trajectory = trajectory.slice_time(0.0, 11.0)  # the window holds 1 s before the release
+    trajectory = trajectory.between(0.0, 11.0)  # the window holds 1 s before the release
     config = IdentifierConfig(window_s=10.0)
     window = SlidingWindow.from_config(config)
     for t, z, p, kg in zip(
