@@ -153,7 +153,7 @@ def _check_replay(statuses, batch, truth, arrival):
     errors = {}
     for key in ESTIMATES:
         value = float(last[key])
-        errors[key] = (value - truth[key]) / getattr(batch, f'{key}_std')
+        errors[key] = (value - truth[key]) / batch.figure(key).std
         # lumpbeam analyze's own std on the whole record is the tolerance.
         assert abs(errors[key]) < 3.0, (key, value, truth[key])
     return release_error / FRAME_S, errors
