@@ -24,7 +24,7 @@ from lumpbeam_ros.cli.analyze import CONTRACT_KEYS
 from lumpbeam_ros.cli.main import COMMANDS, build_parser
 from lumpbeam_ros.diagnose.gap import Gap
 from lumpbeam_ros.diagnose.signatures import Signatures
-from lumpbeam_ros.ident.result import Identification
+from lumpbeam_ros.ident.result import Identification, Status
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS
 from lumpbeam_ros.model.reproduce import Comparison, TableRow
 
@@ -126,7 +126,7 @@ def code_topics() -> frozenset[str]:
 @cache
 def json_keys() -> dict[str, set[str]]:
     """The keys each output of the product writes, by where they come from."""
-    identification = field_names(Identification)
+    identification = set(Identification(Status.ERROR, '').as_dict())
     return {
         'reproduce': dict_keys('cli/reproduce.py', 'result_json')
         | field_names(TableRow)

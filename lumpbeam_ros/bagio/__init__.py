@@ -8,7 +8,7 @@ Writing::
 
 Reading::
 
-    t, x, z, pitch, frame = read_tip_poses('out/drop')
+    poses = read_tip_poses('out/drop')                # TipSeries: t, x, z, pitch, frame_id
     load = read_load_events('out/drop').changes()
 """
 
@@ -19,7 +19,6 @@ from lumpbeam_ros.bagio.series import (
     ImageFrame,
     LoadSeries,
     PointSeries,
-    PoseSeries,
     iter_images,
     read_camera_info,
     read_diagnostics,
@@ -28,6 +27,7 @@ from lumpbeam_ros.bagio.series import (
     read_points,
     read_tip_poses,
 )
+from lumpbeam_ros.bagio.tipseries import TipSeries
 from lumpbeam_ros.bagio.writer import BagWriter
 
 __all__ = [
@@ -37,10 +37,10 @@ __all__ = [
     'ImageFrame',
     'LoadSeries',
     'PointSeries',
-    'PoseSeries',
     'RawMessage',
     'RepairSummary',
     'Status',
+    'TipSeries',
     'iter_images',
     'open_bag',
     'read_camera_info',

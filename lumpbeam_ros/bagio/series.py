@@ -15,19 +15,11 @@ import numpy as np
 
 from lumpbeam_ros.bagio import convert, fastscan
 from lumpbeam_ros.bagio.reader import BagReader, open_bag
+from lumpbeam_ros.bagio.tipseries import TipSeries
 from lumpbeam_ros.errors import BagError
+from lumpbeam_ros.interface import TIP_LOAD, TIP_POSE
 
 Bag = str | Path | BagReader
-
-
-class PoseSeries(NamedTuple):
-    """Planar tip poses: ``t, x, z, pitch`` arrays (s, m, m, rad) and their frame."""
-
-    t: np.ndarray
-    x: np.ndarray
-    z: np.ndarray
-    pitch: np.ndarray
-    frame_id: str
 
 
 class LoadSeries(NamedTuple):
@@ -79,8 +71,8 @@ def _sorted_columns(rows: list[tuple[float, ...]], width: int) -> list[np.ndarra
     return [table[:, i].copy() for i in range(width)]
 
 
-def read_tip_poses(bag: Bag, topic: str = '/tip_pose', *, fast: bool = True) -> PoseSeries:
-    """Reads a ``geometry_msgs/PoseStamped`` topic as planar tip poses.
+def read_tip_poses(bag: Bag, topic: str = TIP_POSE, *, fast: bool = True) -> TipSeries:
+    """Reads a ``geometry_msgs/PoseStamped`` topic as planar tip poses: the one reader of them.
 
     Args:
         bag: Bag folder or open reader.
@@ -106,7 +98,7 @@ def read_tip_poses(bag: Bag, topic: str = '/tip_pose', *, fast: bool = True) -> 
         rows.append((convert.ns_to_seconds(ns), x, z, pitch))
         frames.add(frame)
     t, x, z, pitch = _sorted_columns(rows, 4)
-    return PoseSeries(t, x, z, pitch, _single_frame(frames, reader, topic))
+    return TipSeries(t, x, z, pitch, frame_id=_single_frame(frames, reader, topic))
 
 
 def _fast_scan(reader: BagReader, topic: str) -> tuple[list[int], list[bytes]] | None:
@@ -125,7 +117,7 @@ def _fast_scan(reader: BagReader, topic: str) -> tuple[list[int], list[bytes]] |
     return log_times, payloads
 
 
-def _fast_poses(reader: BagReader, topic: str) -> PoseSeries | None:
+def _fast_poses(reader: BagReader, topic: str) -> TipSeries | None:
     """The poses by :mod:`~lumpbeam_ros.bagio.fastscan`, or ``None`` to read them in full."""
     scanned = _fast_scan(reader, topic)
     decoded = None if scanned is None else fastscan.decode_pose_stamped(scanned[1])
@@ -134,8 +126,8 @@ def _fast_poses(reader: BagReader, topic: str) -> PoseSeries | None:
     ns, position, orientation, frame = decoded
     order = np.argsort(ns, kind='stable')
     pitch = convert.quaternions_to_pitch(orientation[order])
-    return PoseSeries(
-        ns[order] / convert.NS_PER_S, position[order, 0], position[order, 2], pitch, frame
+    return TipSeries(
+        ns[order] / convert.NS_PER_S, position[order, 0], position[order, 2], pitch, frame_id=frame
     )
 
 
@@ -161,7 +153,7 @@ def read_floats(bag: Bag, topic: str) -> tuple[np.ndarray, np.ndarray]:
     return t, value
 
 
-def read_load_events(bag: Bag, topic: str = '/tip_load') -> LoadSeries:
+def read_load_events(bag: Bag, topic: str = TIP_LOAD) -> LoadSeries:
     """Reads ``/tip_load`` (kg at the tip); ``.changes()`` keeps the drops and additions.
 
     Raises:

@@ -101,11 +101,11 @@ def _frames(width: int, height: int) -> list[np.ndarray]:
     from lumpbeam_ros.vision.config import load_camera_config
 
     trajectory = drop_test_trajectory()
-    after = trajectory.slice_time(4.0, 5.0)
+    after = trajectory.between(4.0, 5.0)
     top = int(np.argmax(after.z))
     bottom = top + int(np.argmin(after.z[top : top + 40]))
     config = load_camera_config().with_resolution(width, height)
-    swing = render_frames(config, after.slice_time(after.t[top], after.t[bottom] + 1e-6))
+    swing = render_frames(config, after.between(after.t[top], after.t[bottom] + 1e-6))
     images = [f.image for f in swing]
     return images + images[-2:0:-1]
 

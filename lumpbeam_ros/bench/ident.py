@@ -246,7 +246,9 @@ def _live(quick: bool, beam: BeamParameters, truth: dict[str, float]) -> BenchRe
             'ours_median_ms': 1e3 * float(np.median(ours_times)),
             'ours_max_ms': 1e3 * max(ours_times),
             'ours_full_identification_ms': 1e3 * cold_s,
-            'ours_natural_frequency_hz_rel_error': abs(result.natural_frequency_hz / f_true - 1),
+            'ours_natural_frequency_hz_rel_error': abs(
+                result.estimates.natural_frequency_hz.value / f_true - 1
+            ),
             'baseline_natural_frequency_hz_rel_error': abs(
                 base['natural_frequency_hz'] / f_true - 1
             ),

@@ -105,7 +105,7 @@ def speed(
     """
     config = load_camera_config().with_resolution(width, height)
     config = replace(config, camera_info=replace(config.camera_info, d=np.asarray(distortion)))
-    trajectory = drop_test_trajectory().slice_time(1.9, 12.0)
+    trajectory = drop_test_trajectory().between(1.9, 12.0)
     frames = render_frames(config, trajectory, n_frames)
     threads = cv2.getNumThreads()
     cv2.setNumThreads(1)

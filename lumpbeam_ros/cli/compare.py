@@ -16,6 +16,7 @@ from lumpbeam_ros.compare.bag import (
 )
 from lumpbeam_ros.compare.comparison import Comparison, compare_sensors
 from lumpbeam_ros.ident.config import load_identifier_config
+from lumpbeam_ros.ident.result import Identification
 from lumpbeam_ros.model.parameters import load_beam_config
 
 
@@ -92,11 +93,10 @@ def _vector(values: np.ndarray, stds: np.ndarray, scale: float, unit: str) -> st
     return f'({parts}) +- ({errors}) {unit}'
 
 
-def _cell(ident: object, key: str, scale: float, spec: str) -> str:
-    value = getattr(ident, key)
+def _cell(ident: Identification, key: str, scale: float, spec: str) -> str:
     if key == 'status':
-        return value.name
-    std = getattr(ident, f'{key}_std', math.nan)
+        return ident.status.name
+    value, std = ident.figure(key).value, ident.figure(key).std
     if not math.isfinite(value):
         return 'n/a'
     text = f'{value * scale:{spec}}'

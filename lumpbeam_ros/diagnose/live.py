@@ -6,7 +6,7 @@ stretch is complete: a *ring-down* (from ``pre_release_s`` before a load change 
 decay has lasted ``decay_s``, or earlier once its amplitude fell below ``min_amplitude_m``),
 or a fixed *window* of the latest ``window_s``. The stretch becomes the same
 :class:`~lumpbeam_ros.diagnose.record.Record` that ``lumpbeam diagnose`` builds from a bag
-(:func:`~lumpbeam_ros.diagnose.record.make_record`), and :func:`diagnose_live` runs the same
+(:func:`~lumpbeam_ros.diagnose.record.record_from_series`), and :func:`diagnose_live` runs the same
 workflow on it (:func:`~lumpbeam_ros.diagnose.workflow.diagnose`), reduced to the small,
 picklable :class:`LiveDiagnosis` a worker process sends back. :func:`status_values` turns that
 into the status level, message and key-value pairs of ``doc/interfaces.md``
@@ -23,9 +23,11 @@ from typing import Any, Literal
 
 import numpy as np
 
-from lumpbeam_ros.diagnose.record import MIN_SAMPLES_AFTER_EVENT, Record, make_record
+from lumpbeam_ros.bagio.tipseries import TipSeries
+from lumpbeam_ros.diagnose.record import MIN_SAMPLES_AFTER_EVENT, Record, record_from_series
 from lumpbeam_ros.diagnose.workflow import diagnose
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import TIP_POSE
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters
 
 Trigger = Literal['ring_down', 'window']
@@ -221,12 +223,12 @@ class _Series:
             self.z.popleft()
             self.pitch.popleft()
 
-    def between(self, start: float, end: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def between(self, start: float, end: float) -> TipSeries:
+        """The buffered poses with ``start <= t <= end``."""
         t = np.fromiter(self.t, float, len(self.t))
-        keep = (t >= start) & (t <= end)
-        z = np.fromiter(self.z, float, len(self.z))[keep]
-        pitch = np.fromiter(self.pitch, float, len(self.pitch))[keep]
-        return t[keep], z, pitch
+        z = np.fromiter(self.z, float, len(self.z))
+        pitch = np.fromiter(self.pitch, float, len(self.pitch))
+        return TipSeries.vertical(t, z, pitch).select((t >= start) & (t <= end))
 
 
 class LiveBuffer:
@@ -329,8 +331,9 @@ class LiveBuffer:
         s = self.settings
         if latest >= release + s.decay_s:
             return release + s.decay_s
-        t, z, _ = self.measured.between(latest - AMPLITUDE_SPAN_S, latest)
-        after = self.measured.between(release, latest)[0] > release
+        recent = self.measured.between(latest - AMPLITUDE_SPAN_S, latest)
+        t, z = recent.t, recent.z
+        after = self.measured.between(release, latest).t > release
         enough = np.count_nonzero(after) >= MIN_SAMPLES_AFTER_EVENT  # what a record needs
         if s.min_amplitude_m > 0.0 and enough and t.size > 2:
             if float(np.ptp(z)) < 2.0 * s.min_amplitude_m:
@@ -354,7 +357,7 @@ class LiveBuffer:
         Raises:
             LumpbeamError: No load change inside the stretch, too few poses after it.
         """
-        t, z, pitch = self.measured.between(stretch.start_s, stretch.end_s)
+        poses = self.measured.between(stretch.start_s, stretch.end_s)
         initial = self.loads[0][1]
         events = []
         for time, kg in self.loads[1:]:
@@ -367,7 +370,7 @@ class LiveBuffer:
                 f'no load change between {stretch.start_s:.3f} and {stretch.end_s:.3f} s: '
                 'a diagnosis needs a release to compare against'
             )
-        return make_record(t, z, pitch, initial, events, '/tip_pose')
+        return record_from_series(poses, initial, events, TIP_POSE)
 
     def prediction_gap(self, start_s: float, end_s: float) -> float:
         """RMS of measured minus predicted tip z over a stretch (the running model's gap).
@@ -379,8 +382,9 @@ class LiveBuffer:
         Returns:
             The RMS in m, NaN when the prediction does not cover the measured stamps.
         """
-        t, z, _ = self.measured.between(start_s, end_s)
-        tp, zp, _ = self.predicted.between(start_s - 1.0, end_s + 1.0)
+        measured = self.measured.between(start_s, end_s)
+        predicted = self.predicted.between(start_s - 1.0, end_s + 1.0)
+        t, z, tp, zp = measured.t, measured.z, predicted.t, predicted.z
         covered = (t >= tp[0]) & (t <= tp[-1]) if tp.size > 1 else np.zeros(t.size, bool)
         if np.count_nonzero(covered) < 0.9 * max(t.size, 1) or t.size == 0:
             return math.nan

@@ -7,8 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
-from lumpbeam_ros.bagio import read_load_events, read_tip_poses
+from lumpbeam_ros.bagio import TipSeries, read_load_events, read_tip_poses
 from lumpbeam_ros.errors import BagError, LumpbeamError
+from lumpbeam_ros.interface import BASE_FRAME
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
 #: Fewest poses after the last load change: two seconds at 180 Hz (six periods of the beam).
@@ -32,23 +33,34 @@ class Record:
     """Tip poses in ``beam_base`` and the ``/tip_load`` schedule (doc/interfaces.md).
 
     Attributes:
-        t: Pose stamps, s, increasing.
-        z: Vertical tip position, m.
-        pitch: Tip slope, rad.
+        poses: The tip series, stamps increasing.
         initial_load_kg: The load hanging at the start; the beam is at rest with it.
         load_events: ``(time, kg)`` load changes after the start, in time order.
         notes: What was trimmed from the poses given (stamp jumps), for the user.
     """
 
-    t: np.ndarray
-    z: np.ndarray
-    pitch: np.ndarray
+    poses: TipSeries
     initial_load_kg: float
     load_events: tuple[tuple[float, float], ...]
     notes: tuple[str, ...] = ()
 
+    @property
+    def t(self) -> np.ndarray:
+        """Pose stamps, s, increasing."""
+        return self.poses.t
+
+    @property
+    def z(self) -> np.ndarray:
+        """Vertical tip position, m."""
+        return self.poses.z
+
+    @property
+    def pitch(self) -> np.ndarray:
+        """Tip slope, rad."""
+        return self.poses.pitch
+
     def __len__(self) -> int:
-        return int(self.t.size)
+        return len(self.poses)
 
     @property
     def event_time_s(self) -> float:
@@ -106,7 +118,7 @@ def make_record(
     load_events: list[tuple[float, float]] | tuple[tuple[float, float], ...],
     source: str = 'record',
 ) -> Record:
-    """Checks and assembles a record; non-finite poses are dropped.
+    """Checks and assembles a record from pose arrays (:func:`record_from_series`).
 
     Args:
         t: Pose stamps, s.
@@ -117,24 +129,47 @@ def make_record(
         source: Name for error messages (a bag path).
 
     Returns:
-        The record, sorted by time, with events before the first pose folded into the
-        initial load and events after the last pose dropped.
+        The record (see :func:`record_from_series`).
 
     Raises:
-        LumpbeamError: Mismatched arrays, a negative or non-finite load, no load change
-            inside the record, or fewer than ``MIN_SAMPLES_AFTER_EVENT`` poses after it.
+        LumpbeamError: As :func:`record_from_series`.
     """
     t, z, pitch = (np.asarray(a, dtype=float).ravel() for a in (t, z, pitch))
     if not t.size == z.size == pitch.size:
         raise LumpbeamError(f'{source}: pose arrays differ in length')
-    keep = np.isfinite(t) & np.isfinite(z) & np.isfinite(pitch)
-    t, z, pitch = t[keep], z[keep], pitch[keep]
-    order = np.argsort(t, kind='stable')
-    t, z, pitch = t[order], z[order], pitch[order]
-    if t.size and np.any(np.diff(t) <= 0.0):
-        unique = np.concatenate([[True], np.diff(t) > 0.0])
-        t, z, pitch = t[unique], z[unique], pitch[unique]
-    t, z, pitch, note = _stretch_with_event(t, z, pitch, load_events)
+    return record_from_series(
+        TipSeries.vertical(t, z, pitch), initial_load_kg, load_events, source
+    )
+
+
+def record_from_series(
+    poses: TipSeries,
+    initial_load_kg: float,
+    load_events: list[tuple[float, float]] | tuple[tuple[float, float], ...],
+    source: str = 'record',
+) -> Record:
+    """Checks and assembles a record; non-finite poses are dropped.
+
+    Args:
+        poses: The tip series (``x`` is carried along, not checked).
+        initial_load_kg: Load at the start, kg.
+        load_events: ``(time, kg)`` load changes; at least one must fall inside the poses.
+        source: Name for error messages (a bag path).
+
+    Returns:
+        The record, sorted by time, with events before the first pose folded into the
+        initial load and events after the last pose dropped.
+
+    Raises:
+        LumpbeamError: A negative or non-finite load, no load change inside the record, or
+            fewer than ``MIN_SAMPLES_AFTER_EVENT`` poses after it.
+    """
+    poses = poses.select(np.isfinite(poses.t) & np.isfinite(poses.z) & np.isfinite(poses.pitch))
+    poses = poses.select(np.argsort(poses.t, kind='stable'))
+    if len(poses) and np.any(np.diff(poses.t) <= 0.0):
+        poses = poses.select(np.concatenate([[True], np.diff(poses.t) > 0.0]))
+    poses, note = _stretch_with_event(poses, load_events)
+    t = poses.t
     if t.size < MIN_SAMPLES_AFTER_EVENT:
         raise LumpbeamError(f'{source}: {t.size} valid tip poses, need a longer record')
     load = float(initial_load_kg)
@@ -159,26 +194,25 @@ def make_record(
             f'{source}: {after} poses after the last load change at {events[-1][0]:.3f} s, '
             f'need at least {MIN_SAMPLES_AFTER_EVENT}'
         )
-    return Record(t, z, pitch, load, tuple(events), (note,) if note else ())
+    return Record(poses, load, tuple(events), (note,) if note else ())
 
 
 def _stretch_with_event(
-    t: np.ndarray,
-    z: np.ndarray,
-    pitch: np.ndarray,
+    poses: TipSeries,
     load_events: list[tuple[float, float]] | tuple[tuple[float, float], ...],
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+) -> tuple[TipSeries, str]:
     """The stretch of poses a diagnosis can use when the stamps pause or jump.
 
     Increasing stamps are split at pauses over ``MAX_GAP_S``; the first stretch that holds
     a load event is kept (else the longest).
 
     Returns:
-        The kept ``t``, ``z``, ``pitch`` and what was dropped (``''``: nothing).
+        The kept poses and what was dropped (``''``: nothing).
     """
+    t = poses.t
     gaps = np.flatnonzero(np.diff(t) > MAX_GAP_S)
     if gaps.size == 0:
-        return t, z, pitch, ''
+        return poses, ''
     bounds = [0, *(gaps + 1).tolist(), t.size]
     stretches = list(zip(bounds[:-1], bounds[1:], strict=True))
     times = [float(time) for time, _ in load_events]
@@ -189,7 +223,7 @@ def _stretch_with_event(
         f'/tip_pose stamps jump {jumps}: kept {t[a]:.3f} to {t[b - 1]:.3f} s ({b - a} poses), '
         f'dropped {t.size - (b - a)}'
     )
-    return t[a:b], z[a:b], pitch[a:b], note
+    return poses.select(slice(a, b)), note
 
 
 def record_from_trajectory(
@@ -198,16 +232,17 @@ def record_from_trajectory(
     """A record from a simulated (or synthetic) trajectory.
 
     Args:
-        trajectory: Tip poses.
+        trajectory: Tip poses (its load and angles are not kept: the events give the load).
         load_events: ``(time, kg)`` load changes.
         initial_load_kg: Load at the start.
 
     Returns:
         The record.
     """
-    return make_record(
-        trajectory.t, trajectory.z, trajectory.pitch, initial_load_kg, load_events, 'trajectory'
+    poses = TipSeries(
+        trajectory.t, trajectory.x, trajectory.z, trajectory.pitch, frame_id=trajectory.frame_id
     )
+    return record_from_series(poses, initial_load_kg, load_events, 'trajectory')
 
 
 def read_record(bag: str | Path) -> Record:
@@ -227,13 +262,13 @@ def read_record(bag: str | Path) -> Record:
             ``beam_base``, or the record holds no usable load change.
     """
     poses = read_tip_poses(bag)
-    if poses.frame_id not in ('beam_base', ''):
+    if poses.frame_id not in (BASE_FRAME, ''):
         raise BagError(f'{bag}: /tip_pose is in frame {poses.frame_id!r}, expected beam_base')
     loads = read_load_events(bag).changes()
     if loads.t.size == 0:
         raise BagError(f'{bag}: /tip_load holds no message')
     events = list(zip(loads.t[1:].tolist(), loads.kg[1:].tolist(), strict=True))
     try:
-        return make_record(poses.t, poses.z, poses.pitch, float(loads.kg[0]), events, str(bag))
+        return record_from_series(poses, float(loads.kg[0]), events, str(bag))
     except LumpbeamError as exc:
         raise BagError(str(exc)) from None

@@ -10,7 +10,7 @@ the paper's own log decrement (B.20, B.21) for comparison; grade the result.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -22,7 +22,18 @@ from lumpbeam_ros.ident.logdec import LogDecrement, LogDecrementResult, differen
 from lumpbeam_ros.ident.modes import TWO_PI, ModeEstimate
 from lumpbeam_ros.ident.pencil import MatrixPencil
 from lumpbeam_ros.ident.release import Release, detect_release
-from lumpbeam_ros.ident.result import Identification, Status
+from lumpbeam_ros.ident.result import (
+    UNKNOWN,
+    AnalysedWindow,
+    CrossCheckFigures,
+    Estimate,
+    Estimates,
+    FitQuality,
+    Identification,
+    ReleaseFigures,
+    SampleTally,
+    Status,
+)
 from lumpbeam_ros.ident.samples import PoseWindow
 from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParams, ModeGuess
 from lumpbeam_ros.model import rules
@@ -134,17 +145,18 @@ def _identify(
     strict: bool,
     previous: FitState | None,
 ) -> tuple[Identification, FitState | None]:
-    base = {
-        'window_start_s': window.start_s,
-        'window_end_s': window.end_s,
-        'n_samples': len(window),
-        'n_rejected': window.counts.non_finite + window.counts.duplicates,
-    }
+    span = AnalysedWindow(window.start_s, window.end_s)
+    tally = SampleTally(len(window), window.counts.non_finite + window.counts.duplicates)
 
-    def fail(message: str, unusable: bool = False, **extra: object) -> tuple[Identification, None]:
+    def fail(
+        message: str, unusable: bool = False, release: ReleaseFigures | None = None
+    ) -> tuple[Identification, None]:
         if strict and unusable:
             raise LumpbeamError(message)
-        return Identification(Status.ERROR, message, **base, **extra), None  # type: ignore[arg-type]
+        figures = release or ReleaseFigures()
+        return Identification(
+            Status.ERROR, message, window=span, release=figures, samples=tally
+        ), None
 
     if len(window) < config.min_samples:
         return fail(
@@ -152,11 +164,9 @@ def _identify(
             unusable=True,
         )
     release = detect_release(window, config)
-    release_keys = {
-        'release_time_s': release.time_s,
-        'release_confidence': release.confidence,
-        'release_source': release.source,
-    }
+    found = ReleaseFigures(
+        time_s=Estimate(release.time_s), confidence=release.confidence, source=release.source
+    )
     start = window.start_s
     if release.found and release.time_s >= window.start_s:
         start = release.time_s + config.skip_after_release_s
@@ -170,21 +180,21 @@ def _identify(
             f'{t.size} pose samples after the release at {release.time_s:.3f} s, need '
             f'{config.min_samples}',
             unusable=True,
-            **release_keys,
+            release=found,
         )
     state = _warm_fit(t, z, start, release, previous, config)
     if state is None:
         noise = difference_noise_std(z)
         guesses = _initial_modes(t, z, noise, config)
         if not guesses:
-            return fail('no oscillation in the window', **release_keys)
+            return fail('no oscillation in the window', release=found)
         try:
             params = _fit_decay(t, z, guesses, start, config)
         except LumpbeamError as exc:
-            return fail(f'no oscillation in the window ({exc})', **release_keys)
+            return fail(f'no oscillation in the window ({exc})', release=found)
         rejection = _reject_mode(params.mode(0), params, config)
         if rejection:
-            return fail(rejection, **release_keys)
+            return fail(rejection, release=found)
         checks = CrossChecks(
             _pencil_first(guesses),
             _log_decrement(t, z, params),
@@ -194,8 +204,8 @@ def _identify(
     mode = state.params.mode(0)
     rejection = _reject_mode(mode, state.params, config)
     if rejection:
-        return fail(rejection, **release_keys)
-    result = _assemble(beam, config, release, t, state, mode, base)
+        return fail(rejection, release=found)
+    result = _assemble(beam, config, release, t, state, mode, span, tally)
     return result, state
 
 
@@ -348,7 +358,8 @@ def _assemble(
     t: np.ndarray,
     state: FitState,
     mode: ModeEstimate,
-    base: dict[str, float | int],
+    span: AnalysedWindow,
+    tally: SampleTally,
 ) -> Identification:
     params, checks = state.params, state.checks
     warnings: list[str] = []
@@ -429,52 +440,58 @@ def _assemble(
         status=status,
         message=message,
         method=method,
-        natural_frequency_hz=mode.natural_frequency_hz,
-        natural_frequency_hz_std=mode.natural_frequency_hz_std,
-        damped_frequency_hz=mode.damped_frequency_hz,
-        damped_frequency_hz_std=mode.damped_frequency_hz_std,
-        damping_ratio=mode.damping_ratio,
-        damping_ratio_std=mode.damping_ratio_std,
-        log_decrement=mode.log_decrement,
-        log_decrement_std=mode.log_decrement_std,
-        stiffness_total_nm_per_rad=static.total_nm_per_rad,
-        stiffness_total_nm_per_rad_std=static.total_nm_per_rad_std,
-        stiffness_vertical_n_per_m=static.vertical_n_per_m,
-        stiffness_vertical_n_per_m_std=static.vertical_n_per_m_std,
-        damping_total=damping_total,
-        damping_total_std=damping_total_std,
-        cycles=cycles,
-        release_time_s=release.time_s,
-        release_time_s_std=release.time_std_s,
-        static_deflection_m=deflection,
-        static_deflection_m_std=deflection_std,
-        release_confidence=release.confidence,
-        release_source=release.source,
-        released_load_kg=load,
-        level_before_m=release.level_before_m,
-        level_before_m_std=release.level_before_std_m,
-        level_after_m=level_after,
-        level_after_m_std=level_after_std,
-        log_decrement_b20=logdec.log_decrement if logdec else NAN,
-        log_decrement_b20_std=logdec.log_decrement_std if logdec else NAN,
-        damping_ratio_b20=logdec.damping_ratio if logdec else NAN,
-        damping_ratio_b20_std=logdec.damping_ratio_std if logdec else NAN,
-        damped_frequency_b20_hz=logdec.damped_frequency_hz if logdec else NAN,
-        damped_frequency_b20_hz_std=logdec.damped_frequency_hz_std if logdec else NAN,
-        natural_frequency_pencil_hz=pencil[0],
-        damping_ratio_pencil=pencil_zeta,
-        stiffness_vertical_from_frequency_n_per_m=k_freq,
-        stiffness_vertical_from_frequency_n_per_m_std=k_freq_std,
-        stiffness_total_from_pitch_nm_per_rad=k_pitch,
-        stiffness_total_from_pitch_nm_per_rad_std=k_pitch_std,
-        amplitude_m=mode.amplitude,
-        residual_rms_m=params.residual_rms,
-        covariance_inflation=params.covariance.inflation,
-        second_mode_hz=params.mode(1).damped_frequency_hz if params.n_modes > 1 else NAN,
-        amplitude_frequency_shift_hz=params.frequency_shift_hz,
-        amplitude_level_shift_m=params.level_shift_m,
-        solver_evaluations=params.n_evaluations,
-        **base,  # type: ignore[arg-type]
+        estimates=Estimates(
+            natural_frequency_hz=Estimate(
+                mode.natural_frequency_hz, mode.natural_frequency_hz_std
+            ),
+            damped_frequency_hz=Estimate(mode.damped_frequency_hz, mode.damped_frequency_hz_std),
+            damping_ratio=Estimate(mode.damping_ratio, mode.damping_ratio_std),
+            log_decrement=Estimate(mode.log_decrement, mode.log_decrement_std),
+            stiffness_total_nm_per_rad=Estimate(
+                static.total_nm_per_rad, static.total_nm_per_rad_std
+            ),
+            stiffness_vertical_n_per_m=Estimate(
+                static.vertical_n_per_m, static.vertical_n_per_m_std
+            ),
+            damping_total=Estimate(damping_total, damping_total_std),
+        ),
+        window=replace(span, cycles=cycles),
+        release=ReleaseFigures(
+            time_s=Estimate(release.time_s, release.time_std_s),
+            static_deflection_m=Estimate(deflection, deflection_std),
+            confidence=release.confidence,
+            source=release.source,
+            released_load_kg=load,
+            level_before_m=Estimate(release.level_before_m, release.level_before_std_m),
+            level_after_m=Estimate(level_after, level_after_std),
+        ),
+        cross_checks=CrossCheckFigures(
+            log_decrement_b20=Estimate(logdec.log_decrement, logdec.log_decrement_std)
+            if logdec
+            else UNKNOWN,
+            damping_ratio_b20=Estimate(logdec.damping_ratio, logdec.damping_ratio_std)
+            if logdec
+            else UNKNOWN,
+            damped_frequency_b20_hz=Estimate(
+                logdec.damped_frequency_hz, logdec.damped_frequency_hz_std
+            )
+            if logdec
+            else UNKNOWN,
+            natural_frequency_pencil_hz=pencil[0],
+            damping_ratio_pencil=pencil_zeta,
+            stiffness_vertical_from_frequency_n_per_m=Estimate(k_freq, k_freq_std),
+            stiffness_total_from_pitch_nm_per_rad=Estimate(k_pitch, k_pitch_std),
+        ),
+        quality=FitQuality(
+            amplitude_m=mode.amplitude,
+            residual_rms_m=params.residual_rms,
+            covariance_inflation=params.covariance.inflation,
+            second_mode_hz=params.mode(1).damped_frequency_hz if params.n_modes > 1 else NAN,
+            amplitude_frequency_shift_hz=params.frequency_shift_hz,
+            amplitude_level_shift_m=params.level_shift_m,
+            solver_evaluations=params.n_evaluations,
+        ),
+        samples=tally,
     )
 
 

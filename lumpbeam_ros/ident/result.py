@@ -1,9 +1,14 @@
-"""The identification result: doc/interfaces.md (``/beam_params``) and section 5 (``analyze``)."""
+"""The identification result: doc/interfaces.md (``/beam_params`` and ``lumpbeam analyze``).
+
+Each figure is an :class:`Estimate` (value, std); :class:`Identification` groups them with
+the release, the window and the fit's quality, and flattens them to the contract's keys.
+"""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from collections.abc import Iterator
+from dataclasses import dataclass, field, fields, is_dataclass
 from enum import IntEnum
 from typing import Any
 
@@ -19,46 +24,118 @@ class Status(IntEnum):
 
 
 @dataclass(frozen=True)
-class Identification:
-    """Frequency, damping and stiffness identified from one window, each with its std.
-
-    Keys follow doc/interfaces.md; a ``<key>_std`` field is the standard deviation of
-    ``<key>``. NaN marks a figure the window does not determine (e.g. no stiffness without a
-    release in it). Paper equation numbers: B.12 (stiffness), B.20 and B.21 (decrement and
-    damping ratio), B.22 (total damping).
+class Estimate:
+    """An identified figure and its standard deviation (NaN: not determined).
 
     Attributes:
-        status: OK, WARN (low confidence) or ERROR (no oscillation, no estimate).
-        message: Human-readable reason for the status.
-        method: The estimator behind the headline figures.
-        natural_frequency_hz: f_n = f_d / sqrt(1 - zeta^2) of the first mode.
-        damped_frequency_hz: f_d of the first mode.
-        damping_ratio: zeta of the first mode, from the least-squares decay fit.
+        value: The figure.
+        std: Its standard deviation (the ``<key>_std`` of doc/interfaces.md).
+    """
+
+    value: float = NAN
+    std: float = NAN
+
+
+UNKNOWN = Estimate()
+
+
+def _key(name: str, default: Any = UNKNOWN) -> Any:
+    """A field published as ``name`` (and ``name_std`` for an :class:`Estimate`)."""
+    return field(default=default, metadata={'key': name})
+
+
+@dataclass(frozen=True)
+class Estimates:
+    """The first mode's figures and the stiffness from the release (doc/interfaces.md).
+
+    Attributes:
+        natural_frequency_hz: f_n = f_d / sqrt(1 - zeta^2).
+        damped_frequency_hz: f_d.
+        damping_ratio: zeta, from the least-squares decay fit.
         log_decrement: delta = 2 pi sigma / omega_d, consistent with zeta by B.21.
         stiffness_total_nm_per_rad: k_tE = 2 F L^2 / (3 delta_vE) (B.12).
         stiffness_vertical_n_per_m: F / delta_vE.
         damping_total: c_tE = 2 zeta omega_d (B.22).
-        window_start_s: First stamp analysed.
-        window_end_s: Last stamp analysed.
+    """
+
+    natural_frequency_hz: Estimate = UNKNOWN
+    damped_frequency_hz: Estimate = UNKNOWN
+    damping_ratio: Estimate = UNKNOWN
+    log_decrement: Estimate = UNKNOWN
+    stiffness_total_nm_per_rad: Estimate = UNKNOWN
+    stiffness_vertical_n_per_m: Estimate = UNKNOWN
+    damping_total: Estimate = UNKNOWN
+
+
+@dataclass(frozen=True)
+class AnalysedWindow:
+    """The stretch of poses analysed.
+
+    Attributes:
+        start_s: First stamp analysed (``window_start_s``).
+        end_s: Last stamp analysed (``window_end_s``).
         cycles: Damped periods in the fitted stretch.
-        release_time_s: When the load left (NaN when not in the window), from the onset of
-            the free response in the tip poses.
-        release_time_s_std: Its standard deviation from the onset fit.
+    """
+
+    start_s: float = _key('window_start_s', NAN)
+    end_s: float = _key('window_end_s', NAN)
+    cycles: float = 0.0
+
+
+@dataclass(frozen=True)
+class ReleaseFigures:
+    """The release of the load and the static levels around it.
+
+    Attributes:
+        time_s: When the load left (NaN when not in the window), from the onset of the free
+            response in the tip poses, with its std from the onset fit (``release_time_s``).
         static_deflection_m: delta_vE, the rise of the static tip level at the release.
-        release_confidence: 0..1.
-        release_source: ``tip_load``, ``data`` or ``none``.
+        confidence: 0..1 (``release_confidence``).
+        source: ``tip_load``, ``data`` or ``none`` (``release_source``).
         released_load_kg: F / g used in B.12.
         level_before_m: Static tip z before the release.
         level_after_m: The level the decay converges to.
+    """
+
+    time_s: Estimate = _key('release_time_s')
+    static_deflection_m: Estimate = UNKNOWN
+    confidence: float = _key('release_confidence', 0.0)
+    source: str = _key('release_source', 'none')
+    released_load_kg: float = NAN
+    level_before_m: Estimate = UNKNOWN
+    level_after_m: Estimate = UNKNOWN
+
+
+@dataclass(frozen=True)
+class CrossCheckFigures:
+    """The same figures by other estimators, to check the fit against.
+
+    Attributes:
         log_decrement_b20: delta by the paper's two-peak rule (B.20).
         damping_ratio_b20: zeta from it by B.21.
         damped_frequency_b20_hz: f_d from the peak times.
-        natural_frequency_pencil_hz: f_n by the matrix pencil (cross-check).
-        damping_ratio_pencil: zeta by the matrix pencil (cross-check).
+        natural_frequency_pencil_hz: f_n by the matrix pencil.
+        damping_ratio_pencil: zeta by the matrix pencil.
         stiffness_vertical_from_frequency_n_per_m: m_eff (2 pi f_n)^2 with
-            m_eff = m_tip + fraction * m_beam (cross-check; model uncertainty not included).
+            m_eff = m_tip + fraction * m_beam (model uncertainty not included).
         stiffness_total_from_pitch_nm_per_rad: k_tE = F L / delta_thetaE, the slope form of
-            B.12 (cross-check).
+            B.12.
+    """
+
+    log_decrement_b20: Estimate = UNKNOWN
+    damping_ratio_b20: Estimate = UNKNOWN
+    damped_frequency_b20_hz: Estimate = UNKNOWN
+    natural_frequency_pencil_hz: float = NAN
+    damping_ratio_pencil: float = NAN
+    stiffness_vertical_from_frequency_n_per_m: Estimate = UNKNOWN
+    stiffness_total_from_pitch_nm_per_rad: Estimate = UNKNOWN
+
+
+@dataclass(frozen=True)
+class FitQuality:
+    """How well the decay model fits, and what else it found.
+
+    Attributes:
         amplitude_m: Amplitude of the first mode at the start of the fit.
         residual_rms_m: RMS of the fit residuals.
         covariance_inflation: Robust over white-noise variance (>1: correlated residuals).
@@ -68,53 +145,8 @@ class Identification:
         amplitude_level_shift_m: How far the oscillation's centre was above the equilibrium
             at the start of the fit (0 likewise).
         solver_evaluations: Model evaluations of the least-squares solver.
-        n_samples: Valid samples in the window.
-        n_rejected: Samples dropped as non-finite or duplicate.
     """
 
-    status: Status
-    message: str
-    method: str = 'none'
-    natural_frequency_hz: float = NAN
-    natural_frequency_hz_std: float = NAN
-    damped_frequency_hz: float = NAN
-    damped_frequency_hz_std: float = NAN
-    damping_ratio: float = NAN
-    damping_ratio_std: float = NAN
-    log_decrement: float = NAN
-    log_decrement_std: float = NAN
-    stiffness_total_nm_per_rad: float = NAN
-    stiffness_total_nm_per_rad_std: float = NAN
-    stiffness_vertical_n_per_m: float = NAN
-    stiffness_vertical_n_per_m_std: float = NAN
-    damping_total: float = NAN
-    damping_total_std: float = NAN
-    window_start_s: float = NAN
-    window_end_s: float = NAN
-    cycles: float = 0.0
-    release_time_s: float = NAN
-    release_time_s_std: float = NAN
-    static_deflection_m: float = NAN
-    static_deflection_m_std: float = NAN
-    release_confidence: float = 0.0
-    release_source: str = 'none'
-    released_load_kg: float = NAN
-    level_before_m: float = NAN
-    level_before_m_std: float = NAN
-    level_after_m: float = NAN
-    level_after_m_std: float = NAN
-    log_decrement_b20: float = NAN
-    log_decrement_b20_std: float = NAN
-    damping_ratio_b20: float = NAN
-    damping_ratio_b20_std: float = NAN
-    damped_frequency_b20_hz: float = NAN
-    damped_frequency_b20_hz_std: float = NAN
-    natural_frequency_pencil_hz: float = NAN
-    damping_ratio_pencil: float = NAN
-    stiffness_vertical_from_frequency_n_per_m: float = NAN
-    stiffness_vertical_from_frequency_n_per_m_std: float = NAN
-    stiffness_total_from_pitch_nm_per_rad: float = NAN
-    stiffness_total_from_pitch_nm_per_rad_std: float = NAN
     amplitude_m: float = NAN
     residual_rms_m: float = NAN
     covariance_inflation: float = NAN
@@ -122,8 +154,66 @@ class Identification:
     amplitude_frequency_shift_hz: float = NAN
     amplitude_level_shift_m: float = NAN
     solver_evaluations: int = 0
+
+
+@dataclass(frozen=True)
+class SampleTally:
+    """The window's samples.
+
+    Attributes:
+        n_samples: Valid samples in the window.
+        n_rejected: Samples dropped as non-finite or duplicate.
+    """
+
     n_samples: int = 0
     n_rejected: int = 0
+
+
+def _flat(group: Any) -> Iterator[tuple[str, Any]]:
+    """A group's ``(key, value)`` pairs in field order; an estimate gives two."""
+    for f in fields(group):
+        value = getattr(group, f.name)
+        key = f.metadata.get('key', f.name)
+        if isinstance(value, Estimate):
+            yield key, value.value
+            yield f'{key}_std', value.std
+        elif is_dataclass(value):
+            yield from _flat(value)
+        else:
+            yield key, value
+
+
+@dataclass(frozen=True)
+class Identification:
+    """Frequency, damping and stiffness identified from one window, each with its std.
+
+    The flat keys of doc/interfaces.md are the groups' fields in order (an
+    :class:`Estimate` ``<key>`` gives ``<key>`` and ``<key>_std``); NaN marks a figure the
+    window does not determine (e.g. no stiffness without a release in it). Paper equation
+    numbers: B.12 (stiffness), B.20 and B.21 (decrement and damping ratio), B.22 (total
+    damping).
+
+    Attributes:
+        status: OK, WARN (low confidence) or ERROR (no oscillation, no estimate).
+        message: Human-readable reason for the status.
+        method: The estimator behind the headline figures.
+        estimates: The headline figures.
+        window: The stretch analysed.
+        release: The release and the static levels.
+        cross_checks: The figures by other estimators.
+        quality: The fit's quality.
+        samples: The window's samples.
+    """
+
+    status: Status
+    message: str
+    method: str = 'none'
+    estimates: Estimates = Estimates()
+    window: AnalysedWindow = AnalysedWindow()
+    release: ReleaseFigures = ReleaseFigures()
+    cross_checks: CrossCheckFigures = CrossCheckFigures()
+    quality: FitQuality = FitQuality()
+    samples: SampleTally = SampleTally()
 
     @property
     def ok(self) -> bool:
@@ -135,11 +225,27 @@ class Identification:
 
         NaN stays NaN (``lumpbeam_ros.cli.output.write_json`` turns it into null).
         """
-        out: dict[str, Any] = {}
-        for f in fields(self):
-            value = getattr(self, f.name)
-            out[f.name] = value.name if isinstance(value, Status) else value
-        return out
+        return {
+            key: value.name if isinstance(value, Status) else value for key, value in _flat(self)
+        }
+
+    def figure(self, key: str) -> Estimate:
+        """The figure published as ``key``, with its ``key_std`` (NaN when it has none).
+
+        Args:
+            key: A key of doc/interfaces.md, e.g. ``'natural_frequency_hz'``.
+
+        Returns:
+            The value and std.
+
+        Raises:
+            KeyError: No numeric figure has that key.
+        """
+        data = self.as_dict()
+        value = data[key]
+        if isinstance(value, str):
+            raise KeyError(key)
+        return Estimate(float(value), float(data.get(f'{key}_std', NAN)))
 
     def key_values(self) -> list[tuple[str, str]]:
         """The ``/beam_params`` KeyValue pairs: floats as Python ``repr`` (doc/interfaces.md).
@@ -147,39 +253,30 @@ class Identification:
         ``status`` and ``message`` are left out: they are the DiagnosticStatus's own level
         and message. Strings (``method``, ``release_source``) are given as they are.
         """
-        pairs = []
-        for f in fields(self):
-            if f.name in ('status', 'message'):
-                continue
-            value = getattr(self, f.name)
-            text = value if isinstance(value, str) else repr(float(value))
-            pairs.append((f.name, text))
-        return pairs
+        return [
+            (key, value if isinstance(value, str) else repr(float(value)))
+            for key, value in _flat(self)
+            if key not in ('status', 'message')
+        ]
 
     def summary(self) -> str:
         """A few human-readable lines for a terminal."""
 
-        def fmt(value: float, std: float, unit: str, digits: int = 5) -> str:
-            if not math.isfinite(value):
+        def fmt(estimate: Estimate, unit: str, digits: int = 5) -> str:
+            if not math.isfinite(estimate.value):
                 return 'n/a'
-            return f'{value:.{digits}g} +- {std:.2g} {unit}'
+            return f'{estimate.value:.{digits}g} +- {estimate.std:.2g} {unit}'
 
+        figures, release = self.estimates, self.release
         return '\n'.join(
             [
                 f'status: {self.status.name} {self.message}'.rstrip(),
-                f'release: {self.release_time_s:.4f} s ({self.release_source}, '
-                f'confidence {self.release_confidence:.2f})',
-                'natural frequency: '
-                + fmt(self.natural_frequency_hz, self.natural_frequency_hz_std, 'Hz'),
-                'damping ratio: ' + fmt(self.damping_ratio, self.damping_ratio_std, ''),
-                'static deflection: '
-                + fmt(self.static_deflection_m, self.static_deflection_m_std, 'm'),
-                'k_tE (B.12): '
-                + fmt(
-                    self.stiffness_total_nm_per_rad,
-                    self.stiffness_total_nm_per_rad_std,
-                    'N m/rad',
-                ),
-                'c_tE (B.22): ' + fmt(self.damping_total, self.damping_total_std, '1/s'),
+                f'release: {release.time_s.value:.4f} s ({release.source}, '
+                f'confidence {release.confidence:.2f})',
+                'natural frequency: ' + fmt(figures.natural_frequency_hz, 'Hz'),
+                'damping ratio: ' + fmt(figures.damping_ratio, ''),
+                'static deflection: ' + fmt(release.static_deflection_m, 'm'),
+                'k_tE (B.12): ' + fmt(figures.stiffness_total_nm_per_rad, 'N m/rad'),
+                'c_tE (B.22): ' + fmt(figures.damping_total, '1/s'),
             ]
         )

@@ -1,7 +1,8 @@
 """Tip-pose samples as the estimators take them, and their validation.
 
-A :class:`PoseWindow` is what the identifier analyses: stamps, vertical tip position and tip
-pitch (doc/interfaces.md), plus the ``/tip_load`` readings that fall in or just before it.
+A :class:`PoseWindow` is what the identifier analyses: a tip series (stamps, vertical tip
+position and tip pitch, doc/interfaces.md) and the ``/tip_load`` readings that fall in or just
+before it.
 :func:`clean_window` turns raw samples (a bag, a live buffer) into strictly increasing, finite
 arrays and counts what it dropped, so a bad sample never becomes an exception in a live node.
 """
@@ -12,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from lumpbeam_ros.bagio.tipseries import TipSeries
 from lumpbeam_ros.errors import LumpbeamError
 
 
@@ -70,34 +72,45 @@ class SampleCounts:
 
 @dataclass(frozen=True)
 class PoseWindow:
-    """Tip poses in frame ``beam_base`` over a stretch of time.
+    """Tip poses in frame ``beam_base`` over a stretch of time, with their load readings.
 
     Attributes:
-        t: Stamps, s (strictly increasing after :func:`clean_window`).
-        z: Vertical tip position, m.
-        pitch: Tip slope about +y, rad.
+        poses: The tip series (stamps strictly increasing after :func:`clean_window`).
         loads: ``/tip_load`` readings in the window (and the last one before it), if any.
         counts: What validation removed.
     """
 
-    t: np.ndarray
-    z: np.ndarray
-    pitch: np.ndarray
+    poses: TipSeries
     loads: LoadReadings = field(default_factory=LoadReadings)
     counts: SampleCounts = field(default_factory=SampleCounts)
 
+    @property
+    def t(self) -> np.ndarray:
+        """Stamps, s."""
+        return self.poses.t
+
+    @property
+    def z(self) -> np.ndarray:
+        """Vertical tip position, m."""
+        return self.poses.z
+
+    @property
+    def pitch(self) -> np.ndarray:
+        """Tip slope about +y, rad."""
+        return self.poses.pitch
+
     def __len__(self) -> int:
-        return int(self.t.size)
+        return len(self.poses)
 
     @property
     def start_s(self) -> float:
         """First stamp (NaN when empty)."""
-        return float(self.t[0]) if self.t.size else float('nan')
+        return self.poses.start_s
 
     @property
     def end_s(self) -> float:
         """Last stamp (NaN when empty)."""
-        return float(self.t[-1]) if self.t.size else float('nan')
+        return self.poses.end_s
 
 
 def _as_1d(name: str, values: object) -> np.ndarray:
@@ -141,6 +154,8 @@ def clean_window(
     z: object,
     pitch: object | None = None,
     loads: LoadReadings | None = None,
+    *,
+    x: object | None = None,
 ) -> PoseWindow:
     """Validates tip-pose samples.
 
@@ -152,6 +167,8 @@ def clean_window(
         z: Vertical tip positions, m.
         pitch: Tip pitches, rad; ``None`` fills NaN (the pitch cross-check is then skipped).
         loads: ``/tip_load`` readings, if any.
+        x: Tip positions along the beam, m; ``None`` fills NaN (the estimators do not use
+            them).
 
     Returns:
         The cleaned window, with the counts of what was removed.
@@ -161,24 +178,26 @@ def clean_window(
     """
     t_arr, z_arr = _as_1d('stamps', t), _as_1d('z', z)
     p_arr = np.full(t_arr.size, np.nan) if pitch is None else _as_1d('pitch', pitch)
+    x_arr = np.full(t_arr.size, np.nan) if x is None else _as_1d('x', x)
     if not t_arr.size == z_arr.size == p_arr.size:
         raise LumpbeamError(
             f'pose samples: {t_arr.size} stamps, {z_arr.size} z and {p_arr.size} pitch values'
         )
+    if x_arr.size != t_arr.size:
+        raise LumpbeamError(f'pose samples: {t_arr.size} stamps but {x_arr.size} x values')
     received = int(t_arr.size)
     keep = np.isfinite(t_arr) & np.isfinite(z_arr)
     if pitch is not None:
         keep &= np.isfinite(p_arr)
     non_finite = received - int(np.count_nonzero(keep))
-    t_arr, z_arr, p_arr = t_arr[keep], z_arr[keep], p_arr[keep]
-    reordered = bool(np.any(np.diff(t_arr) < 0.0))
+    poses = TipSeries(t_arr, x_arr, z_arr, p_arr).select(keep)
+    reordered = bool(np.any(np.diff(poses.t) < 0.0))
     if reordered:
-        order = np.argsort(t_arr, kind='stable')
-        t_arr, z_arr, p_arr = t_arr[order], z_arr[order], p_arr[order]
-    first = np.ones(t_arr.size, dtype=bool)
-    first[1:] = np.diff(t_arr) > 0.0
-    duplicates = int(t_arr.size - np.count_nonzero(first))
+        poses = poses.select(np.argsort(poses.t, kind='stable'))
+    first = np.ones(len(poses), dtype=bool)
+    first[1:] = np.diff(poses.t) > 0.0
+    duplicates = int(len(poses) - np.count_nonzero(first))
     if duplicates:
-        t_arr, z_arr, p_arr = t_arr[first], z_arr[first], p_arr[first]
+        poses = poses.select(first)
     counts = SampleCounts(received, non_finite, duplicates, reordered)
-    return PoseWindow(t_arr, z_arr, p_arr, loads or LoadReadings(), counts)
+    return PoseWindow(poses, loads or LoadReadings(), counts)

@@ -41,9 +41,7 @@ def keep_release_segment(window: PoseWindow, config: IdentifierConfig) -> tuple[
     bounds = [0, *(gaps + 1).tolist(), t.size]
     parts = [
         PoseWindow(
-            t[a:b],
-            window.z[a:b],
-            window.pitch[a:b],
+            window.poses.select(slice(a, b)),
             _loads_within(window.loads, t[a], t[b - 1]),
             window.counts,
         )

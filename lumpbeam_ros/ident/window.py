@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lumpbeam_ros.bagio.tipseries import TipSeries
 from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow, SampleCounts
 
@@ -215,7 +216,7 @@ class SlidingWindow:
             non_finite=c['non_finite'],
             duplicates=c['out_of_order'] + c['duplicates'],
         )
-        return PoseWindow(t, z, pitch, loads, counts)
+        return PoseWindow(TipSeries.vertical(t, z, pitch), loads, counts)
 
     def _prune_loads(self, start: float) -> None:
         """Drops readings before ``start`` but the last of them: it gives the load then."""

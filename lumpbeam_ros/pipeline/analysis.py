@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from lumpbeam_ros.bagio import BagReader, BagWriter, convert, read_diagnostics, read_tip_poses
-from lumpbeam_ros.bagio.series import PoseSeries, read_load_events
+from lumpbeam_ros.bagio.series import read_load_events
+from lumpbeam_ros.bagio.tipseries import TipSeries
 from lumpbeam_ros.errors import BagError
 from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.identify import identify
@@ -62,8 +63,8 @@ class RecordingAnalysis:
         residual: Measured against predicted, on the measured stamps.
     """
 
-    measured: PoseSeries
-    predicted: PoseSeries
+    measured: TipSeries
+    predicted: TipSeries
     load_t: np.ndarray
     load_kg: np.ndarray
     identification: Identification
@@ -250,7 +251,7 @@ def live_value(analysis: RecordingAnalysis, key: str) -> float:
 
 
 def prediction_lag(
-    measured: PoseSeries, predicted: PoseSeries, start_s: float, max_lag_s: float = 0.2
+    measured: TipSeries, predicted: TipSeries, start_s: float, max_lag_s: float = 0.2
 ) -> tuple[float, float]:
     """How late the prediction runs behind the measurement, and the gap once shifted by it.
 

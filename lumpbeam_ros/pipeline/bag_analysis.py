@@ -84,7 +84,7 @@ def read_window(bag: str | Path, show_progress: bool = True) -> PoseWindow:
     if LOAD_TOPIC in reader.topics:
         series = read_load_events(reader, LOAD_TOPIC)
         loads = clean_loads(series.t, series.kg)
-    return clean_window(poses.t, poses.z, poses.pitch, loads)
+    return clean_window(poses.t, poses.z, poses.pitch, loads, x=poses.x)
 
 
 def result_json(result: Identification) -> dict[str, Any]:

@@ -528,8 +528,8 @@ def summarize(run: DemoRun) -> None:
     rows = {}
     for key in truth:
         rows[key] = {
-            'identified': getattr(ident, key),
-            'identified_std': getattr(ident, f'{key}_std'),
+            'identified': ident.figure(key).value,
+            'identified_std': ident.figure(key).std,
             'live': live_value(analysis, key),
             'truth': truth[key],
             'paper': PAPER[key],
@@ -539,7 +539,7 @@ def summarize(run: DemoRun) -> None:
     lag, aligned_rms = prediction_lag(analysis.measured, analysis.predicted, after)
     run.summary = {
         'status': ident.status.name,
-        'release_time_s': ident.release_time_s,
+        'release_time_s': ident.release.time_s.value,
         'quantities': rows,
         'prediction_rms_m': residual.rms(),
         'prediction_rms_after_release_m': residual.rms(start=after),

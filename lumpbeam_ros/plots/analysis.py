@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from lumpbeam_ros.errors import LumpbeamError  # noqa: E402
-from lumpbeam_ros.ident.result import Identification  # noqa: E402
+from lumpbeam_ros.ident.result import Estimate, Identification  # noqa: E402
 from lumpbeam_ros.ident.samples import PoseWindow  # noqa: E402
 
 #: File names written into the plots folder.
@@ -26,8 +26,9 @@ FILES = ('trajectory.png', 'spectrum.png', 'estimates.png')
 
 def _envelope(result: Identification, t: np.ndarray) -> np.ndarray:
     """Amplitude of the fitted first mode about the decay's level (B.20's envelope)."""
-    sigma = result.damping_ratio * 2.0 * math.pi * result.natural_frequency_hz
-    return result.amplitude_m * np.exp(-sigma * (t - t[0]))
+    figures = result.estimates
+    sigma = figures.damping_ratio.value * 2.0 * math.pi * figures.natural_frequency_hz.value
+    return result.quality.amplitude_m * np.exp(-sigma * (t - t[0]))
 
 
 def plot_trajectory(window: PoseWindow, result: Identification, path: Path) -> None:
@@ -40,13 +41,14 @@ def plot_trajectory(window: PoseWindow, result: Identification, path: Path) -> N
     """
     fig, ax = plt.subplots(figsize=(9, 4.5))
     ax.plot(window.t, 1e3 * window.z, lw=0.6, color='0.35', label='tip z')
-    if math.isfinite(result.release_time_s):
-        ax.axvline(result.release_time_s, color='tab:red', ls='--', lw=1, label='release')
-    if result.ok and math.isfinite(result.amplitude_m):
-        start = result.release_time_s if math.isfinite(result.release_time_s) else window.start_s
+    release_s = result.release.time_s.value
+    if math.isfinite(release_s):
+        ax.axvline(release_s, color='tab:red', ls='--', lw=1, label='release')
+    if result.ok and math.isfinite(result.quality.amplitude_m):
+        start = release_s if math.isfinite(release_s) else window.start_s
         after = window.t[window.t >= start]
         if after.size:
-            level = result.level_after_m
+            level = result.release.level_after_m.value
             env = _envelope(result, after)
             for sign in (1.0, -1.0):
                 ax.plot(
@@ -57,13 +59,14 @@ def plot_trajectory(window: PoseWindow, result: Identification, path: Path) -> N
                     label='fitted envelope' if sign > 0 else None,
                 )
             ax.axhline(1e3 * level, color='tab:blue', lw=0.8, ls=':', label='level after')
-    if math.isfinite(result.level_before_m):
-        ax.axhline(1e3 * result.level_before_m, color='tab:green', lw=0.8, ls=':')
+    level_before = result.release.level_before_m.value
+    if math.isfinite(level_before):
+        ax.axhline(1e3 * level_before, color='tab:green', lw=0.8, ls=':')
     ax.set_xlabel('time, s')
     ax.set_ylabel('tip z, mm')
     ax.set_title(
-        f'{result.status.name}: f_n {result.natural_frequency_hz:.4f} Hz, '
-        f'zeta {result.damping_ratio:.4g}'
+        f'{result.status.name}: f_n {result.estimates.natural_frequency_hz.value:.4f} Hz, '
+        f'zeta {result.estimates.damping_ratio.value:.4g}'
     )
     ax.legend(loc='lower right', fontsize=8)
     ax.grid(alpha=0.3)
@@ -78,7 +81,8 @@ def plot_spectrum(window: PoseWindow, result: Identification, path: Path) -> Non
         result: The identification.
         path: PNG file to write.
     """
-    start = result.release_time_s if math.isfinite(result.release_time_s) else window.start_s
+    release_s = result.release.time_s.value
+    start = release_s if math.isfinite(release_s) else window.start_s
     keep = window.t >= start
     t, z = window.t[keep], window.z[keep]
     fig, ax = plt.subplots(figsize=(7, 4))
@@ -89,8 +93,11 @@ def plot_spectrum(window: PoseWindow, result: Identification, path: Path) -> Non
         u = (u - u.mean()) * np.hanning(u.size)
         spectrum = np.abs(np.fft.rfft(u)) * 2.0 / max(np.hanning(u.size).sum(), 1e-12)
         ax.semilogy(np.fft.rfftfreq(u.size, dt), np.maximum(1e3 * spectrum, 1e-12), lw=0.8)
-    for key, style in (('damped_frequency_hz', 'tab:red'), ('second_mode_hz', 'tab:orange')):
-        value = getattr(result, key)
+    lines = (
+        ('damped_frequency_hz', result.estimates.damped_frequency_hz.value, 'tab:red'),
+        ('second_mode_hz', result.quality.second_mode_hz, 'tab:orange'),
+    )
+    for key, value, style in lines:
         if math.isfinite(value):
             ax.axvline(value, color=style, ls='--', lw=1, label=f'{key} {value:.4g}')
     ax.set_xlabel('frequency, Hz')
@@ -108,33 +115,24 @@ def plot_estimates(result: Identification, path: Path) -> None:
         result: The identification.
         path: PNG file to write.
     """
+    figures, checks = result.estimates, result.cross_checks
     rows = [
-        ('f_n: fit', result.natural_frequency_hz, result.natural_frequency_hz_std, 'f'),
-        ('f_n: matrix pencil', result.natural_frequency_pencil_hz, math.nan, 'f'),
-        ('zeta: fit', result.damping_ratio, result.damping_ratio_std, 'z'),
-        ('zeta: log decrement B.21', result.damping_ratio_b20, result.damping_ratio_b20_std, 'z'),
-        ('zeta: matrix pencil', result.damping_ratio_pencil, math.nan, 'z'),
-        (
-            'k_tE: static B.12',
-            result.stiffness_total_nm_per_rad,
-            result.stiffness_total_nm_per_rad_std,
-            'k',
-        ),
-        (
-            'k_tE: pitch',
-            result.stiffness_total_from_pitch_nm_per_rad,
-            result.stiffness_total_from_pitch_nm_per_rad_std,
-            'k',
-        ),
+        ('f_n: fit', figures.natural_frequency_hz, 'f'),
+        ('f_n: matrix pencil', Estimate(checks.natural_frequency_pencil_hz), 'f'),
+        ('zeta: fit', figures.damping_ratio, 'z'),
+        ('zeta: log decrement B.21', checks.damping_ratio_b20, 'z'),
+        ('zeta: matrix pencil', Estimate(checks.damping_ratio_pencil), 'z'),
+        ('k_tE: static B.12', figures.stiffness_total_nm_per_rad, 'k'),
+        ('k_tE: pitch', checks.stiffness_total_from_pitch_nm_per_rad, 'k'),
     ]
     reference = {
-        'f': result.natural_frequency_hz,
-        'z': result.damping_ratio,
-        'k': result.stiffness_total_nm_per_rad,
+        'f': figures.natural_frequency_hz.value,
+        'z': figures.damping_ratio.value,
+        'k': figures.stiffness_total_nm_per_rad.value,
     }
     fig, ax = plt.subplots(figsize=(7, 4))
-    for i, (_, value, std, group) in enumerate(rows):
-        ref = reference[group]
+    for i, (_, estimate, group) in enumerate(rows):
+        value, std, ref = estimate.value, estimate.std, reference[group]
         if not (math.isfinite(value) and math.isfinite(ref) and ref != 0.0):
             continue
         err = 100.0 * std / abs(ref) if math.isfinite(std) else 0.0

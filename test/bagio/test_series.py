@@ -6,6 +6,7 @@ from lumpbeam_ros.bagio import (
     BagWriter,
     CameraInfoData,
     Status,
+    TipSeries,
     iter_images,
     read_camera_info,
     read_diagnostics,
@@ -33,14 +34,15 @@ def test_poses_and_load_round_trip(tmp_path):
     assert frames[1].pixels.shape == (8, 10) and frames[1].encoding == 'mono8'
 
 
-def test_poses_unpack_as_a_tuple_and_sort_by_stamp(tmp_path):
+def test_poses_are_a_tip_series_sorted_by_stamp(tmp_path):
     with BagWriter(tmp_path / 'b') as bag:
         for t in (3.0, 1.0, 2.0):  # written out of order, e.g. late camera frames
             bag.write_pose('/tip_pose', t, 1.0, -t, 0.0, frame='world')
-    t, x, z, pitch, frame = read_tip_poses(tmp_path / 'b')
-    np.testing.assert_array_equal(t, [1.0, 2.0, 3.0])
-    np.testing.assert_array_equal(z, [-1.0, -2.0, -3.0])
-    assert frame == 'world'
+    poses = read_tip_poses(tmp_path / 'b')
+    assert isinstance(poses, TipSeries) and len(poses) == 3
+    np.testing.assert_array_equal(poses.t, [1.0, 2.0, 3.0])
+    np.testing.assert_array_equal(poses.z, [-1.0, -2.0, -3.0])
+    assert poses.frame_id == 'world'
 
 
 def test_mixed_frames_are_an_error(tmp_path):

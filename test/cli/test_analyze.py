@@ -1,6 +1,7 @@
 import json
 import math
 import shutil
+from pathlib import Path
 
 import pytest
 
@@ -11,6 +12,10 @@ from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.modes import chain_modes
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+
+#: ``lumpbeam analyze --json`` of the default synthetic drop test as it was before the result
+#: was nested (and its ``/beam_params`` pairs): the contract's keys, their order and values.
+GOLDEN = json.loads((Path(__file__).parents[1] / 'data' / 'analyze_drop_golden.json').read_text())
 
 
 @pytest.fixture(scope='module')
@@ -41,6 +46,23 @@ def test_analyze_prints_writes_json_and_plots(drop_bag, tmp_path, capsys):
         'spectrum.png',
         'trajectory.png',
     ]
+
+
+def same_value(value, expected):
+    """Equal, floats to 1e-9 relative (another BLAS may round the fit differently)."""
+    if isinstance(expected, float):
+        return value == pytest.approx(expected, rel=1e-9, abs=1e-300)
+    return value == expected
+
+
+def test_analyze_json_keeps_the_keys_their_order_and_values(drop_bag, tmp_path):
+    out = tmp_path / 'result.json'
+    assert main(['analyze', str(drop_bag), '--json', str(out)]) == 0
+    data = json.loads(out.read_text())
+    expected = GOLDEN['analyze_json']
+    assert list(data) == list(expected)
+    assert set(CONTRACT_KEYS) | {f'{key}_std' for key in CONTRACT_KEYS} <= set(data)
+    assert [key for key in expected if not same_value(data[key], expected[key])] == []
 
 
 def _bag(path, poses=(), frame='beam_base', loads=()):

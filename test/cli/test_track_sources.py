@@ -29,7 +29,7 @@ LOSSY_Z_RMS_M, LOSSY_PITCH_RMS_RAD = 8e-6, 0.06e-3
 def footage():
     """40 frames (0.22 s, the tip falling 80 mm) of the drop test at 640 x 480."""
     config = load_camera_config().with_resolution(WIDTH, HEIGHT)
-    frames = render_frames(config, drop_test_trajectory().slice_time(START_S, 2.3), N_FRAMES)
+    frames = render_frames(config, drop_test_trajectory().between(START_S, 2.3), N_FRAMES)
     return config.camera_info, frames
 
 
@@ -262,7 +262,7 @@ def test_the_board_comes_from_the_options(board, tmp_path, footage):
     info, frames = footage
     config = with_board(load_camera_config().with_resolution(WIDTH, HEIGHT), (6, 4), 0.08)
     config = replace(config, camera_info=info)
-    other = render_frames(config, drop_test_trajectory().slice_time(START_S, 2.0), 8)
+    other = render_frames(config, drop_test_trajectory().between(START_S, 2.0), 8)
     src = _bag(tmp_path / 'in', other, 'mono8', info)
     options = [] if board is None else ['--board', board[0], '--square-m', board[1]]
     assert main(['track', str(src), str(tmp_path / 'out'), '--quiet', *options]) == 0

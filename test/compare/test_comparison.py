@@ -39,11 +39,15 @@ def test_difference_is_at_the_noise_level(comparison):
 def test_both_sensors_identify_the_same_beam(comparison):
     camera, tracker = comparison.per_sensor['camera'], comparison.per_sensor['tracker']
     assert camera.status == tracker.status == Status.OK
-    assert camera.natural_frequency_hz == pytest.approx(3.06, rel=0.01)
-    assert tracker.natural_frequency_hz == pytest.approx(camera.natural_frequency_hz, rel=1e-4)
-    assert tracker.damping_ratio == pytest.approx(camera.damping_ratio, rel=0.02)
+    assert camera.estimates.natural_frequency_hz.value == pytest.approx(3.06, rel=0.01)
+    assert tracker.estimates.natural_frequency_hz.value == pytest.approx(
+        camera.estimates.natural_frequency_hz.value, rel=1e-4
+    )
+    assert tracker.estimates.damping_ratio.value == pytest.approx(
+        camera.estimates.damping_ratio.value, rel=0.02
+    )
     # The tracker's clock is moved onto the camera's before identifying.
-    assert tracker.release_time_s == pytest.approx(camera.release_time_s, abs=2e-3)
+    assert tracker.release.time_s.value == pytest.approx(camera.release.time_s.value, abs=2e-3)
 
 
 def test_json_keys(comparison):

@@ -38,8 +38,8 @@ def test_accuracy_and_honest_std(drop_case, case, seed, with_loads):
     trajectory, truth = drop_case(damping_scale=scale, noise_m=noise, seed=seed)
     result = identify(_window(trajectory, with_loads), BEAM)
     assert result.status == Status.OK, result.message
-    assert result.release_source == ('tip_load' if with_loads else 'data')
-    assert abs(result.release_time_s - truth.release_time_s) < 2.0 / 180.0
+    assert result.release.source == ('tip_load' if with_loads else 'data')
+    assert abs(result.release.time_s.value - truth.release_time_s) < 2.0 / 180.0
     checks = [
         ('natural_frequency_hz', truth.natural_frequency_hz, tol_f),
         ('damping_ratio', truth.damping_ratio, tol_zeta),
@@ -47,7 +47,7 @@ def test_accuracy_and_honest_std(drop_case, case, seed, with_loads):
         ('static_deflection_m', truth.static_deflection_m, tol_k),
     ]
     for key, true, tol in checks:
-        value, std = getattr(result, key), getattr(result, f'{key}_std')
+        value, std = result.figure(key).value, result.figure(key).std
         assert abs(value - true) <= tol * true, (key, value, true)
         assert abs(value - true) <= 3.0 * std, (key, value, true, std)
 
@@ -56,28 +56,34 @@ def test_derived_figures_follow_the_paper(drop_case):
     trajectory, truth = drop_case()
     r = identify(_window(trajectory, True), BEAM)
     # B.21 links the decrement and the damping ratio; B.22 gives c_tE; f_n = f_d/sqrt(1-z^2).
-    assert r.damping_ratio == pytest.approx(
-        1 / math.sqrt(1 + (2 * math.pi / r.log_decrement) ** 2)
+    assert r.estimates.damping_ratio.value == pytest.approx(
+        1 / math.sqrt(1 + (2 * math.pi / r.estimates.log_decrement.value) ** 2)
     )
-    assert r.damping_total == pytest.approx(
-        2 * r.damping_ratio * 2 * math.pi * r.damped_frequency_hz
+    assert r.estimates.damping_total.value == pytest.approx(
+        2 * r.estimates.damping_ratio.value * 2 * math.pi * r.estimates.damped_frequency_hz.value
     )
-    assert r.natural_frequency_hz == pytest.approx(
-        r.damped_frequency_hz / math.sqrt(1 - r.damping_ratio**2)
+    assert r.estimates.natural_frequency_hz.value == pytest.approx(
+        r.estimates.damped_frequency_hz.value / math.sqrt(1 - r.estimates.damping_ratio.value**2)
     )
     force = 4.5 * BEAM.gravity_mps2
-    assert r.stiffness_vertical_n_per_m == pytest.approx(force / r.static_deflection_m)
-    assert r.stiffness_total_nm_per_rad == pytest.approx(
-        2 * force * BEAM.length_m**2 / (3 * r.static_deflection_m)
+    assert r.estimates.stiffness_vertical_n_per_m.value == pytest.approx(
+        force / r.release.static_deflection_m.value
+    )
+    assert r.estimates.stiffness_total_nm_per_rad.value == pytest.approx(
+        2 * force * BEAM.length_m**2 / (3 * r.release.static_deflection_m.value)
     )
     # The cross-checks agree with the headline figures within their own accuracy.
-    assert r.damping_ratio_b20 == pytest.approx(r.damping_ratio, rel=0.05)
-    assert r.natural_frequency_pencil_hz == pytest.approx(r.natural_frequency_hz, rel=1e-3)
-    assert r.stiffness_total_from_pitch_nm_per_rad == pytest.approx(
+    assert r.cross_checks.damping_ratio_b20.value == pytest.approx(
+        r.estimates.damping_ratio.value, rel=0.05
+    )
+    assert r.cross_checks.natural_frequency_pencil_hz == pytest.approx(
+        r.estimates.natural_frequency_hz.value, rel=1e-3
+    )
+    assert r.cross_checks.stiffness_total_from_pitch_nm_per_rad.value == pytest.approx(
         truth.stiffness_total_nm_per_rad, rel=0.01
     )
-    assert r.stiffness_vertical_from_frequency_n_per_m == pytest.approx(
-        r.stiffness_vertical_n_per_m, rel=0.05
+    assert r.cross_checks.stiffness_vertical_from_frequency_n_per_m.value == pytest.approx(
+        r.estimates.stiffness_vertical_n_per_m.value, rel=0.05
     )
 
 
@@ -107,8 +113,8 @@ def test_result_carries_the_spec_keys(drop_case):
     assert d['status'] == 'OK' and d['method'].startswith('nls_damped_sinusoid')
     assert 29 < d['cycles'] < 31
     pairs = dict(r.key_values())
-    assert float(pairs['natural_frequency_hz']) == r.natural_frequency_hz
-    assert pairs['natural_frequency_hz'] == repr(r.natural_frequency_hz)
+    assert float(pairs['natural_frequency_hz']) == r.estimates.natural_frequency_hz.value
+    assert pairs['natural_frequency_hz'] == repr(r.estimates.natural_frequency_hz.value)
     assert 'status' not in pairs and pairs['method'] == r.method
 
 
@@ -116,7 +122,7 @@ def test_second_mode_is_fitted_only_when_above_the_noise(drop_case):
     trajectory, truth = drop_case()
     # In the model's tip z the second mode is about 1 um, far below the 20 um noise.
     plain = identify(_window(trajectory, False), BEAM)
-    assert '2modes' not in plain.method and math.isnan(plain.second_mode_hz)
+    assert '2modes' not in plain.method and math.isnan(plain.quality.second_mode_hz)
     # A release that excites it to 0.5 mm (a sharper cut of the load's string):
     tau = np.maximum(trajectory.t - truth.release_time_s, 0.0)
     omega = 2 * math.pi * truth.second_mode_hz
@@ -124,31 +130,32 @@ def test_second_mode_is_fitted_only_when_above_the_noise(drop_case):
     window = clean_window(trajectory.t, excited, trajectory.pitch)
     r = identify(window, BEAM)
     assert '2modes' in r.method
-    assert r.second_mode_hz == pytest.approx(truth.second_mode_hz, rel=0.01)
+    assert r.quality.second_mode_hz == pytest.approx(truth.second_mode_hz, rel=0.01)
     assert (
-        abs(r.natural_frequency_hz - truth.natural_frequency_hz) < 3 * r.natural_frequency_hz_std
+        abs(r.estimates.natural_frequency_hz.value - truth.natural_frequency_hz)
+        < 3 * r.estimates.natural_frequency_hz.std
     )
     single = identify(window, BEAM, IdentifierConfig(max_modes=1))
-    assert '2modes' not in single.method and math.isnan(single.second_mode_hz)
+    assert '2modes' not in single.method and math.isnan(single.quality.second_mode_hz)
 
 
 def test_static_window_is_an_error_not_an_exception(drop_case):
     trajectory, _ = drop_case()
-    quiet = trajectory.slice_time(0.0, 1.9)
+    quiet = trajectory.between(0.0, 1.9)
     r = identify(clean_window(quiet.t, quiet.z, quiet.pitch), BEAM, strict=True)
     assert r.status == Status.ERROR and 'no oscillation' in r.message
-    assert math.isnan(r.natural_frequency_hz)
+    assert math.isnan(r.estimates.natural_frequency_hz.value)
 
 
 def test_too_few_samples_is_error_live_and_raises_in_batch(drop_case):
     trajectory, _ = drop_case()
-    few = trajectory.slice_time(2.5, 2.6)
+    few = trajectory.between(2.5, 2.6)
     window = clean_window(few.t, few.z, few.pitch)
     r = identify(window, BEAM)
     assert r.status == Status.ERROR and 'valid pose samples' in r.message
     with pytest.raises(LumpbeamError, match='valid pose samples'):
         identify(window, BEAM, strict=True)
-    late = trajectory.slice_time(0.0, 2.1)
+    late = trajectory.between(0.0, 2.1)
     with pytest.raises(LumpbeamError, match='after the release'):
         identify(clean_window(late.t, late.z, late.pitch), BEAM, strict=True)
 
@@ -167,36 +174,42 @@ def test_bad_samples_and_gaps_are_tolerated(drop_case):
     window = clean_window(t, z, pitch)
     r = identify(window, BEAM)
     assert r.ok, r.message
-    assert r.n_rejected == window.counts.non_finite + window.counts.duplicates > 40
-    assert r.natural_frequency_hz == pytest.approx(truth.natural_frequency_hz, rel=1e-3)
-    assert r.damping_ratio == pytest.approx(truth.damping_ratio, rel=0.05)
+    assert r.samples.n_rejected == window.counts.non_finite + window.counts.duplicates > 40
+    assert r.estimates.natural_frequency_hz.value == pytest.approx(
+        truth.natural_frequency_hz, rel=1e-3
+    )
+    assert r.estimates.damping_ratio.value == pytest.approx(truth.damping_ratio, rel=0.05)
 
 
 def test_short_decay_warns(drop_case):
     trajectory, truth = drop_case()
-    part = trajectory.slice_time(0.0, 2.6)
+    part = trajectory.between(0.0, 2.6)
     r = identify(clean_window(part.t, part.z, part.pitch), BEAM)
     assert r.status == Status.WARN and 'cycles' in r.message
-    assert r.natural_frequency_hz == pytest.approx(truth.natural_frequency_hz, rel=0.01)
+    assert r.estimates.natural_frequency_hz.value == pytest.approx(
+        truth.natural_frequency_hz, rel=0.01
+    )
 
 
 def test_window_without_release_gives_dynamics_but_warns_on_stiffness(drop_case):
     trajectory, truth = drop_case()
-    part = trajectory.slice_time(3.0, 12.0)
+    part = trajectory.between(3.0, 12.0)
     r = identify(clean_window(part.t, part.z, part.pitch), BEAM)
     assert r.status == Status.WARN and 'stiffness' in r.message
-    assert math.isnan(r.stiffness_total_nm_per_rad)
-    assert r.natural_frequency_hz == pytest.approx(truth.natural_frequency_hz, rel=1e-3)
+    assert math.isnan(r.estimates.stiffness_total_nm_per_rad.value)
+    assert r.estimates.natural_frequency_hz.value == pytest.approx(
+        truth.natural_frequency_hz, rel=1e-3
+    )
 
 
 def test_loads_that_never_drop_fall_back_to_the_data_with_a_warning(drop_case):
     trajectory, truth = drop_case()
     loads = clean_loads(trajectory.t, np.full(trajectory.t.size, 4.5))
     r = identify(clean_window(trajectory.t, trajectory.z, trajectory.pitch, loads), BEAM)
-    assert r.release_source == 'data' and r.status == Status.WARN
+    assert r.release.source == 'data' and r.status == Status.WARN
     assert 'shows no drop' in r.message
-    assert r.release_confidence == pytest.approx(0.5)
-    assert r.stiffness_total_nm_per_rad == pytest.approx(
+    assert r.release.confidence == pytest.approx(0.5)
+    assert r.estimates.stiffness_total_nm_per_rad.value == pytest.approx(
         truth.stiffness_total_nm_per_rad, rel=0.01
     )
 
@@ -206,19 +219,21 @@ def test_warm_updates_follow_the_full_identification(drop_case):
     config = IdentifierConfig(recheck_every_s=2.0)
     state, checks = None, set()
     for end in np.arange(9.0, 11.51, 0.5):  # a live window at 2 Hz, the release kept in it
-        part = trajectory.slice_time(end - 10.0, end)
+        part = trajectory.between(end - 10.0, end)
         window = _window(part, True)
         warm, state = identify_from(window, BEAM, config, previous=state)
         cold = identify(window, BEAM, config)
         assert warm.status == cold.status == Status.OK
         checks.add(state.checked_at_s)
         for key in ('natural_frequency_hz', 'damping_ratio', 'stiffness_total_nm_per_rad'):
-            gap = abs(getattr(warm, key) - getattr(cold, key))
-            assert gap < 0.05 * getattr(cold, f'{key}_std'), key
-        assert warm.solver_evaluations <= cold.solver_evaluations
+            gap = abs(warm.figure(key).value - cold.figure(key).value)
+            assert gap < 0.05 * cold.figure(key).std, key
+        assert warm.quality.solver_evaluations <= cold.quality.solver_evaluations
     # Full identifications at 9 s, 11 s (2 s later); the others restarted from the last fit.
     assert sorted(checks) == pytest.approx([9.0, 11.0], abs=0.01)
-    assert warm.natural_frequency_hz == pytest.approx(truth.natural_frequency_hz, rel=1e-4)
+    assert warm.estimates.natural_frequency_hz.value == pytest.approx(
+        truth.natural_frequency_hz, rel=1e-4
+    )
 
 
 def test_a_new_release_restarts_the_identification(drop_case):
@@ -234,7 +249,7 @@ def test_a_new_release_restarts_the_identification(drop_case):
 def _estimate_errors(result, truth):
     """(estimate - truth) / reported std of f_n, zeta and k_tE."""
     return {
-        key: (getattr(result, key) - getattr(truth, key)) / getattr(result, f'{key}_std')
+        key: (result.figure(key).value - getattr(truth, key)) / result.figure(key).std
         for key in ('natural_frequency_hz', 'damping_ratio', 'stiffness_total_nm_per_rad')
     }
 
@@ -245,7 +260,7 @@ def test_estimates_hold_whenever_tip_load_arrives(drop_case, arrival):
     trajectory, truth = drop_case(drop=DropTestConfig(release_time_s=release_s))
     result = identify(replay_window(trajectory, release_s, arrival), BEAM)
     assert result.status == Status.OK, result.message
-    assert abs(result.release_time_s - release_s) * 180.0 < 0.2
+    assert abs(result.release.time_s.value - release_s) * 180.0 < 0.2
     for key, sigmas in _estimate_errors(result, truth).items():
         assert abs(sigmas) < 3.0, (key, sigmas)
 
@@ -263,9 +278,9 @@ def test_a_load_hung_again_ends_the_decay(drop_case):
     loads = clean_loads([0.0, 2.0, 7.1], [4.5, 0.0, 4.5])  # the second reading 100 ms late
     result = identify(clean_window(t, z, pitch, loads), BEAM)
     assert result.status == Status.OK, result.message
-    assert abs(result.release_time_s - 2.0) * 180.0 < 0.2
+    assert abs(result.release.time_s.value - 2.0) * 180.0 < 0.2
     # Fitted up to 6.0 s (the late reading at 7.1 s less release.hint_late_s): 12 cycles.
-    assert 11.5 < result.cycles < 12.5
+    assert 11.5 < result.window.cycles < 12.5
     for key, sigmas in _estimate_errors(result, truth).items():
         assert abs(sigmas) < 3.0, (key, sigmas)
 
@@ -276,7 +291,7 @@ def test_two_releases_in_one_window_is_not_ok():
     result = identify(clean_window(t, z, pitch, loads), BEAM)
     assert result.status == Status.WARN
     assert 'still moving (since the release at 2.00' in result.message
-    assert math.isnan(result.stiffness_total_nm_per_rad)
+    assert math.isnan(result.estimates.stiffness_total_nm_per_rad.value)
 
 
 def test_a_bag_replayed_twice_gives_the_second_pass(drop_case):
@@ -294,4 +309,4 @@ def test_a_bag_replayed_twice_gives_the_second_pass(drop_case):
     assert window.counts.resets == 1
     result = identify(window.snapshot(), BEAM)
     assert result.status == Status.OK, result.message
-    assert abs(result.release_time_s - 2.0) * 180.0 < 0.2
+    assert abs(result.release.time_s.value - 2.0) * 180.0 < 0.2

@@ -65,7 +65,7 @@ def test_load_changes():
 def test_a_drop_the_tip_does_not_show_is_no_release(drop_case):
     trajectory, _ = drop_case()
     loads = clean_loads([0.0, 1.0], [4.5, 0.0])
-    quiet = trajectory.slice_time(0.0, 1.9)
+    quiet = trajectory.between(0.0, 1.9)
     release = detect_release(_window(quiet, loads), CONFIG)
     assert not release.found and release.source == 'none'
     assert '/tip_load shows a release of 4.5 kg at 1.000 s, but the tip does not' in (
@@ -101,7 +101,7 @@ def test_a_drop_far_from_the_tips_release_is_named(drop_case):
 )
 def test_no_release_found(drop_case, start, end, message):
     trajectory, _ = drop_case()
-    release = detect_release(_window(trajectory.slice_time(start, end)), CONFIG)
+    release = detect_release(_window(trajectory.between(start, end)), CONFIG)
     assert not release.found and release.source == 'none'
     assert message in release.message
 
@@ -123,6 +123,6 @@ def test_small_step_is_rejected():
 
 def test_window_ending_before_the_first_peak_times_to_a_frame(drop_case):
     trajectory, truth = drop_case()
-    release = detect_release(_window(trajectory.slice_time(0.0, 2.1)), CONFIG)
+    release = detect_release(_window(trajectory.between(0.0, 2.1)), CONFIG)
     assert abs(release.time_s - truth.release_time_s) <= FRAME_S
     assert 'before the first peak' in release.message

@@ -42,3 +42,15 @@ def test_clean_loads_keeps_last_reading_per_stamp():
     np.testing.assert_array_equal(loads.kg, [4.5, 2.0])
     with pytest.raises(LumpbeamError, match='2 stamps but 1 masses'):
         clean_loads([0.0, 1.0], [1.0])
+
+
+def test_x_travels_with_its_pose_and_is_nan_when_not_given():
+    window = clean_window(
+        [2.0, 1.0, 1.0, np.nan], [-2.0, -1.0, -9.0, 0.0], None, x=[20, 10, 90, 0]
+    )
+    np.testing.assert_array_equal(window.poses.x, [10.0, 20.0])
+    np.testing.assert_array_equal(window.t, window.poses.t)
+    assert window.poses.frame_id == 'beam_base' and len(window) == 2
+    assert np.isnan(clean_window([1.0], [0.0]).poses.x).all()
+    with pytest.raises(LumpbeamError, match='2 stamps but 1 x values'):
+        clean_window([1.0, 2.0], [0.0, 0.0], x=[0.0])

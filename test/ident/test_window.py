@@ -77,7 +77,7 @@ def test_bad_window_settings():
 
 def test_live_stream_identifies_like_a_batch(drop_case):
     trajectory, truth = drop_case()
-    trajectory = trajectory.slice_time(0.0, 11.0)  # the window holds 1 s before the release
+    trajectory = trajectory.between(0.0, 11.0)  # the window holds 1 s before the release
     config = IdentifierConfig(window_s=10.0)
     window = SlidingWindow.from_config(config)
     for t, z, p, kg in zip(
@@ -89,9 +89,11 @@ def test_live_stream_identifies_like_a_batch(drop_case):
     assert snap.end_s - snap.start_s == pytest.approx(10.0, abs=0.01)
     result = identify(snap, BeamParameters(), config)
     assert result.status == Status.OK, result.message
-    assert result.release_source == 'tip_load'
-    assert result.natural_frequency_hz == pytest.approx(truth.natural_frequency_hz, rel=1e-3)
-    assert result.stiffness_total_nm_per_rad == pytest.approx(
+    assert result.release.source == 'tip_load'
+    assert result.estimates.natural_frequency_hz.value == pytest.approx(
+        truth.natural_frequency_hz, rel=1e-3
+    )
+    assert result.estimates.stiffness_total_nm_per_rad.value == pytest.approx(
         truth.stiffness_total_nm_per_rad, rel=0.01
     )
 

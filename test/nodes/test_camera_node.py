@@ -30,7 +30,7 @@ EPOCH_NS = 1_732_000_000_123_456_789
 @pytest.fixture(scope='module')
 def frames():
     config = load_camera_config().with_resolution(WIDTH, HEIGHT)
-    return render_frames(config, drop_test_trajectory().slice_time(1.95, 2.2), 12)
+    return render_frames(config, drop_test_trajectory().between(1.95, 2.2), 12)
 
 
 @pytest.fixture(scope='module')

@@ -1,3 +1,4 @@
+import json
 import math
 import subprocess
 import sys
@@ -25,6 +26,7 @@ from lumpbeam_ros.model.modes import chain_modes
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.model.statics import static_tip_deflection
 from lumpbeam_ros.nodes.identifier_node import IdentifierNode
+from lumpbeam_ros.pipeline.bag_analysis import analyze_bag
 from lumpbeam_ros.resources import config_path
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 
@@ -152,7 +154,7 @@ def _check_replay(statuses, batch, truth, arrival):
     errors = {}
     for key in ESTIMATES:
         value = float(last[key])
-        errors[key] = (value - truth[key]) / getattr(batch, f'{key}_std')
+        errors[key] = (value - truth[key]) / batch.figure(key).std
         # lumpbeam analyze's own std on the whole record is the tolerance.
         assert abs(errors[key]) < 3.0, (key, value, truth[key])
     return release_error / FRAME_S, errors
@@ -299,3 +301,25 @@ def test_main_takes_the_params_file_and_rejects_a_bad_one(ros_graph, tmp_path):
     assert run.returncode == 2
     assert run.stderr.strip().splitlines()[-1].startswith('identifier_node: ')
     assert 'window.length_s: must be positive' in run.stderr
+
+
+def test_beam_params_keep_the_keys_their_order_and_values(ros_graph, tmp_path):
+    """The /beam_params pairs of the default drop test, as before the result was nested."""
+    golden = json.loads((ROOT / 'test' / 'data' / 'analyze_drop_golden.json').read_text())
+    bag = tmp_path / 'drop'
+    write_drop_test_bag(bag, BeamParameters(), DropTestConfig(), SynthOptions())
+    result = analyze_bag(bag, BeamParameters(), IdentifierConfig(), show_progress=False).result
+    node = IdentifierNode(context=ros_graph.context)
+    ros_graph.add_node(node)
+    status = node.diagnostics(result).status[0]
+    pairs = [(kv.key, kv.value) for kv in status.values]
+    counts = ['samples_wrong_frame', 'samples_non_finite', 'samples_out_of_order', 'window_resets']
+    expected = [*map(tuple, golden['beam_params']), *((key, '0') for key in counts)]
+    assert [key for key, _ in pairs] == [key for key, _ in expected]
+    differ = [
+        key
+        for (key, value), (_, want) in zip(pairs, expected, strict=True)
+        if value != want and float(value) != pytest.approx(float(want), rel=1e-9, nan_ok=True)
+    ]
+    assert differ == []
+    assert status.level == bytes([0]) and status.message == result.message

@@ -57,8 +57,8 @@ def test_normalized_recording_is_identified_and_matches_the_prediction(tmp_path)
     assert loads.t[0] == 0.0 and 2.0 in loads.t  # in sim time now, not wall time
     analysis = analyze_recording(normalized, BEAM)
     ident = analysis.identification
-    assert ident.ok and ident.release_time_s == pytest.approx(2.0, abs=0.01)
-    assert ident.natural_frequency_hz == pytest.approx(3.0588, rel=1e-3)
+    assert ident.ok and ident.release.time_s.value == pytest.approx(2.0, abs=0.01)
+    assert ident.estimates.natural_frequency_hz.value == pytest.approx(3.0588, rel=1e-3)
     assert analysis.residual.rms() == pytest.approx(20e-6, rel=0.15)  # only the noise
     assert analysis.live == {'natural_frequency_hz': '3.06'} and analysis.live_level == 0
     assert last_live_status(recorded)[0] == analysis.live

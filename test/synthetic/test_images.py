@@ -29,7 +29,7 @@ def test_bad_image_size_is_one_clear_error(text):
 
 
 def test_stream_writes_frames_with_their_camera_info_and_stops_at_the_end(tmp_path):
-    trajectory = drop_test_trajectory().slice_time(1.98, 2.01)  # 5 samples over the release
+    trajectory = drop_test_trajectory().between(1.98, 2.01)  # 5 samples over the release
     options = ImageOptions(160, 120, seed=4)
     stream = ImageStream(trajectory, options)
     with BagWriter(tmp_path / 'bag') as bag:

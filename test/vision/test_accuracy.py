@@ -16,7 +16,7 @@ def test_drop_test_is_the_models(drop_test):
     """The identified beam's drop test: loaded sag, release at 2 s, about 3.06 Hz after."""
     assert len(drop_test) == 2161
     assert drop_test.z[0] == pytest.approx(-0.069, abs=0.002)
-    after = drop_test.slice_time(8.0, 12.0)
+    after = drop_test.between(8.0, 12.0)
     assert np.mean(after.z) == pytest.approx(-0.029, abs=0.003)
     crossings = np.flatnonzero(np.diff(np.sign(after.z - np.mean(after.z))) > 0)
     period = np.mean(np.diff(after.t[crossings]))
@@ -41,7 +41,7 @@ def test_full_resolution_meets_the_targets(drop_test):
     release, the decay): 61 frames; about 30 of them calibrate the rig (a frame at rest joins
     only once). All are scored, the calibrating ones too, with the bias in the RMS.
     """
-    report = measure_accuracy(2048, 2048, frame_step=30, trajectory=drop_test.slice_time(1.9, 13))
+    report = measure_accuracy(2048, 2048, frame_step=30, trajectory=drop_test.between(1.9, 13))
     print(report.summary())
     assert report.frames == 61
     assert report.frames_lost == 0

@@ -107,7 +107,7 @@ def _blob(image, centre, axes, value):
 def drop_frames(config, drop_test):
     from lumpbeam_ros.vision.accuracy import render_frames
 
-    return render_frames(config, drop_test.slice_time(1.95, 2.3), 40)
+    return render_frames(config, drop_test.between(1.95, 2.3), 40)
 
 
 def _occluders(frame, config):

@@ -63,7 +63,7 @@ def test_motion_blur_samples_follow_the_image_motion(config):
 
 
 def test_trajectory_frames_carry_truth_at_mid_exposure(config, drop_test):
-    trajectory = drop_test.slice_time(2.0, 2.1)
+    trajectory = drop_test.between(2.0, 2.1)
     frames = list(
         SyntheticCamera(config).render_trajectory(
             trajectory.t, trajectory.x, trajectory.z, trajectory.pitch, trajectory.t[[0, 14]]

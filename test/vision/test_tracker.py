@@ -12,7 +12,7 @@ from lumpbeam_ros.vision.tracker import TipTracker, TrackStatus
 @pytest.fixture(scope='module')
 def frames(config, drop_test):
     # Across the release, where the tip starts moving fastest.
-    return render_frames(config, drop_test.slice_time(1.95, 2.3), 30)
+    return render_frames(config, drop_test.between(1.95, 2.3), 30)
 
 
 @pytest.fixture
