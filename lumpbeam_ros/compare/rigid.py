@@ -47,7 +47,7 @@ class RigidTransform:
 
     def apply(self, points: np.ndarray) -> np.ndarray:
         """Maps ``(n, 3)`` points (or one ``(3,)`` point) into the target frame."""
-        return np.asarray(points) @ self.rotation.T + self.translation
+        return np.asarray(np.asarray(points) @ self.rotation.T + self.translation)
 
     def inverse(self) -> RigidTransform:
         """The transform the other way."""
@@ -56,7 +56,7 @@ class RigidTransform:
 
     def quaternion_xyzw(self) -> np.ndarray:
         """The rotation as a unit quaternion ``(x, y, z, w)`` with ``w >= 0`` (ROS order)."""
-        quat = Rotation.from_matrix(self.rotation).as_quat()
+        quat: np.ndarray = Rotation.from_matrix(self.rotation).as_quat()
         return -quat if quat[3] < 0.0 else quat
 
     def angle_to(self, other: RigidTransform) -> float:

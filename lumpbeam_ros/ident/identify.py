@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -152,7 +153,7 @@ def _identify(
             unusable=True,
         )
     release = detect_release(window, config)
-    release_keys = {
+    release_keys: dict[str, Any] = {
         'release_time_s': release.time_s,
         'release_confidence': release.confidence,
         'release_source': release.source,

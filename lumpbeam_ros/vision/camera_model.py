@@ -175,7 +175,7 @@ class CameraInfo:
             theta_d = theta * (1.0 + t2 * (k1 + t2 * (k2 + t2 * (k3 + t2 * k4))))
             # theta_d / r -> 1 on the optical axis.
             scale = np.divide(theta_d, r, out=np.ones_like(r), where=r > 1e-12)
-            return xy * scale[:, None]
+            return np.asarray(xy * scale[:, None])
         k1, k2, p1, p2, k3 = self.d[:5]
         radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
         if self.distortion_model == RATIONAL_POLYNOMIAL:
@@ -249,7 +249,9 @@ class CameraInfo:
 
     def to_pixels(self, xy: np.ndarray) -> np.ndarray:
         """Applies K to normalized coordinates (N x 2)."""
-        return xy * np.diag(self.k)[:2] + self.k[:2, 2] + np.outer(xy[:, 1], [self.k[0, 1], 0])
+        return np.asarray(
+            xy * np.diag(self.k)[:2] + self.k[:2, 2] + np.outer(xy[:, 1], [self.k[0, 1], 0])
+        )
 
     def to_normalized(self, pixels: np.ndarray) -> np.ndarray:
         """Applies K's inverse to pixels (N x 2)."""
