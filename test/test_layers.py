@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / 'lumpbeam_ros'
 
 #: The layers above the core: they may import the core, the core never imports them.
-UPPER_LAYERS = ('nodes', 'cli', 'pipeline', 'bench')
+UPPER_LAYERS = ('nodes', 'cli', 'demo', 'bench')
 
 #: Top-level names of ROS 2: the client library, its middleware and every interface package.
 _ROS = re.compile(
@@ -208,9 +208,9 @@ OPTIONAL_ROS = {'lumpbeam_ros.resources': {'ament_index_python.packages'}}
 ALLOWED = {
     'core': {'core'},
     'nodes': {'core', 'nodes'},
-    'pipeline': {'core', 'pipeline', 'nodes'},
-    'cli': {'core', 'nodes', 'pipeline', 'cli', 'bench'},
-    'bench': {'core', 'nodes', 'pipeline', 'cli', 'bench'},
+    'demo': {'core', 'demo', 'nodes'},
+    'cli': {'core', 'nodes', 'demo', 'cli', 'bench'},
+    'bench': {'core', 'nodes', 'demo', 'cli', 'bench'},
 }
 
 

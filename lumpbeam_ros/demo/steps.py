@@ -33,30 +33,30 @@ from pathlib import Path
 from typing import Any
 
 from lumpbeam_ros.bagio import BagReader, read_tip_poses
-from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.json_output import plain_json, write_json
-from lumpbeam_ros.model.adopt import first_mode
-from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, load_beam_config
-from lumpbeam_ros.nodes.counts import COUNTS_DIR_ENV, read_counts
-from lumpbeam_ros.pipeline.analysis import (
+from lumpbeam_ros.demo.analysis import (
     RecordingAnalysis,
     analyze_recording,
     live_value,
     normalize_recording,
     prediction_lag,
 )
-from lumpbeam_ros.pipeline.graph import (
+from lumpbeam_ros.demo.graph import (
     ProcessGraph,
     node_command,
     python_command,
     wait_for_graph,
     wait_for_quiet,
 )
-from lumpbeam_ros.pipeline.live_diagnosis import (
+from lumpbeam_ros.demo.live_diagnosis import (
     live_diagnosis,
     live_diagnosis_lines,
     wait_for_verdict,
 )
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.json_output import plain_json, write_json
+from lumpbeam_ros.model.adopt import first_mode
+from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, load_beam_config
+from lumpbeam_ros.nodes.counts import COUNTS_DIR_ENV, read_counts
 from lumpbeam_ros.viz.markers import MARKERS_TOPIC
 
 SIMULATOR_MODULE = 'lumpbeam_ros.nodes.simulator_node'

@@ -4,9 +4,8 @@ import time
 
 import pytest
 
-from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.pipeline import graph as graph_module
-from lumpbeam_ros.pipeline.graph import (
+from lumpbeam_ros.demo import graph as graph_module
+from lumpbeam_ros.demo.graph import (
     DOMAIN_IDS,
     ProcessGraph,
     node_command,
@@ -15,6 +14,7 @@ from lumpbeam_ros.pipeline.graph import (
     wait_for_graph,
     wait_for_quiet,
 )
+from lumpbeam_ros.errors import LumpbeamError
 
 
 def _python(code):

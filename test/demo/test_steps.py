@@ -5,8 +5,8 @@ import json
 import pytest
 
 from lumpbeam_ros.cli.main import main
+from lumpbeam_ros.demo import steps
 from lumpbeam_ros.model.parameters import load_beam_config
-from lumpbeam_ros.pipeline import demo
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 
 
@@ -20,16 +20,16 @@ def test_diagnose_step_matches_the_command(tmp_path, capsys):
         bag,
         beam,
         drop,
-        SynthOptions(duration_s=6.0, markers_rate_hz=0.0, effects=demo.HIDDEN_EFFECT),
+        SynthOptions(duration_s=6.0, markers_rate_hz=0.0, effects=steps.HIDDEN_EFFECT),
     )
-    run = demo.DemoRun(
-        options=demo.DemoOptions(out=tmp_path / 'out'),
+    run = steps.DemoRun(
+        options=steps.DemoOptions(out=tmp_path / 'out'),
         beam=beam,
         drop=drop,
         echo=lambda _line: None,
         normalized_bag=bag,
     )
-    demo.diagnose(run)
+    steps.diagnose(run)
     written = json.loads((tmp_path / 'out' / 'diagnosis.json').read_text())
     assert written == run.diagnosis
     assert any((tmp_path / 'out' / 'figures').glob('*.png'))
