@@ -16,7 +16,7 @@ export ROS_HOME := $(CURDIR)/.cache/ros
 export ROS_AUTOMATIC_DISCOVERY_RANGE ?= LOCALHOST
 export PYTHONDONTWRITEBYTECODE :=
 
-.PHONY: venv demo test test-slow lint bench clean
+.PHONY: venv demo test test-slow lint typecheck bench clean
 
 $(STAMP): setup.py setup.cfg package.xml requirements.txt requirements-dev.txt
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -31,6 +31,7 @@ demo: venv
 
 test: venv
 	$(BIN)/ruff check .
+	$(BIN)/mypy
 	$(BIN)/python -m pytest
 
 # The long validation matrices (marked slow): CI runs them after `make test`.
@@ -40,6 +41,10 @@ test-slow: venv
 lint: venv
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
+
+# Strict static types of the ROS-free core (the module list is in mypy.ini).
+typecheck: venv
+	$(BIN)/mypy
 
 bench: venv
 	$(BIN)/lumpbeam bench --json results/bench.json

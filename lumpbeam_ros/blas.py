@@ -22,4 +22,5 @@ def single_threaded_blas() -> AbstractContextManager[Any]:
     global _controller
     if _controller is None:
         _controller = ThreadpoolController()
-    return _controller.limit(limits=1, user_api='blas')
+    limit: AbstractContextManager[Any] = _controller.limit(limits=1, user_api='blas')
+    return limit

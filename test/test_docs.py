@@ -147,7 +147,7 @@ def json_keys() -> dict[str, set[str]]:
         'compare': dict_keys('compare/comparison.py', 'Comparison.as_dict'),
         'track': dict_keys('cli/track.py', 'run'),
         'bench': dict_keys('cli/bench.py', 'run') | field_names(BenchResult),
-        'demo': dict_keys('pipeline/demo.py', 'summarize'),
+        'demo': dict_keys('demo/steps.py', 'summarize'),
         'campaign': set(ID_COLUMNS),
     }
 

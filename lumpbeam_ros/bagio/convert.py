@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -244,7 +244,7 @@ def image_array(msg: Any) -> np.ndarray:
         )
     rows = data.reshape(height, step)[:, :row]
     if itemsize > 1:
-        order = '>' if msg.is_bigendian else '<'
+        order: Literal['>', '<'] = '>' if msg.is_bigendian else '<'
         samples = np.ascontiguousarray(rows).view(np.dtype(dtype).newbyteorder(order))
         rows = samples.astype(dtype, copy=False)
     return rows.reshape(height, width) if channels == 1 else rows.reshape(height, width, channels)

@@ -28,6 +28,7 @@ from __future__ import annotations
 import struct
 import zlib
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from io import BytesIO
 from pathlib import Path
@@ -69,7 +70,7 @@ MAX_LINES_PER_KIND = 20
 
 _RECORD_HEADER = struct.Struct('<BQ')
 _FOOTER_LENGTH = 8 + 8 + 4
-_READERS = {
+_READERS: dict[int, Callable[[ReadDataStream], McapRecord]] = {
     Opcode.ATTACHMENT: Attachment.read,
     Opcode.ATTACHMENT_INDEX: AttachmentIndex.read,
     Opcode.CHANNEL: Channel.read,
@@ -128,7 +129,8 @@ def _parse(opcode: int, body: bytes, where: str) -> McapRecord | None:
     stream = _ExactStream(BytesIO(body))
     try:
         if opcode == Opcode.MESSAGE:
-            return Message.read(stream, len(body))
+            message: Message = Message.read(stream, len(body))
+            return message
         reader = _READERS.get(opcode)
         return None if reader is None else reader(stream)
     except _PARSE_ERRORS as exc:
@@ -648,7 +650,7 @@ class _Examiner:
         if not all(seen.readable for seen in self.chunks.values()):
             return  # the counts miss an unreadable chunk's messages; that chunk is reported
         stats = self.statistics[0]
-        counted = {
+        counted: dict[str, int | None] = {
             'message_count': self.message_count,
             'schema_count': len(self.schemas),
             'channel_count': len(self.channels),
@@ -680,11 +682,12 @@ class _Examiner:
                 self.problem(
                     'index', f'MetadataIndex "{index.name}" at {index.offset} matches no Metadata'
                 )
-        for index in self.attachment_indexes:
-            if self.attachments.get(index.offset) != index.length:
+        for attachment_index in self.attachment_indexes:
+            if self.attachments.get(attachment_index.offset) != attachment_index.length:
                 self.problem(
                     'index',
-                    f'AttachmentIndex "{index.name}" at {index.offset} matches no Attachment',
+                    f'AttachmentIndex "{attachment_index.name}" at {attachment_index.offset} '
+                    'matches no Attachment',
                 )
 
 

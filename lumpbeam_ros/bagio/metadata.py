@@ -12,7 +12,7 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Final
 
 import yaml
 from rosbags.interfaces import Qos
@@ -20,7 +20,7 @@ from rosbags.rosbag2.metadata import dump_qos_v9
 
 from lumpbeam_ros.errors import BagError
 
-VERSION = 9
+VERSION: Final = 9
 FILENAME = 'metadata.yaml'
 
 

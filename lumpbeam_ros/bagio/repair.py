@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import yaml
+from rosbags.interfaces import Qos
 
 from lumpbeam_ros.bagio import metadata
 from lumpbeam_ros.bagio.qos import from_dict
@@ -46,7 +47,7 @@ def reindex(path: str | Path) -> int:
     data_file = files[0]
     counts: dict[str, int] = {}
     types: dict[str, str] = {}
-    qos: dict[str, list] = {}
+    qos: dict[str, list[Qos]] = {}
     start, end = 2**63 - 1, 0
     try:
         with data_file.open('rb') as stream:

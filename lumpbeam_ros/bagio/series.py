@@ -7,7 +7,7 @@ synthetic bags and is the receive time in recorded ones.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
@@ -65,7 +65,7 @@ def _single_frame(frames: set[str], bag: BagReader, topic: str) -> str:
     return next(iter(frames), '')
 
 
-def _sorted_columns(rows: list[tuple[float, ...]], width: int) -> list[np.ndarray]:
+def _sorted_columns(rows: Sequence[tuple[float, ...]], width: int) -> list[np.ndarray]:
     table = np.asarray(rows, dtype=np.float64).reshape(-1, width)
     table = table[np.argsort(table[:, 0], kind='stable')]
     return [table[:, i].copy() for i in range(width)]
@@ -97,8 +97,8 @@ def read_tip_poses(bag: Bag, topic: str = TIP_POSE, *, fast: bool = True) -> Tip
         ns, x, z, pitch, frame = convert.pose_values(msg)
         rows.append((convert.ns_to_seconds(ns), x, z, pitch))
         frames.add(frame)
-    t, x, z, pitch = _sorted_columns(rows, 4)
-    return TipSeries(t, x, z, pitch, frame_id=_single_frame(frames, reader, topic))
+    t, xs, zs, pitches = _sorted_columns(rows, 4)
+    return TipSeries(t, xs, zs, pitches, frame_id=_single_frame(frames, reader, topic))
 
 
 def _fast_scan(reader: BagReader, topic: str) -> tuple[list[int], list[bytes]] | None:
@@ -141,7 +141,7 @@ def read_floats(bag: Bag, topic: str) -> tuple[np.ndarray, np.ndarray]:
     reader.require(topic, 'std_msgs/msg/Float64')
     scanned = _fast_scan(reader, topic)
     values = None if scanned is None else fastscan.decode_float64(scanned[1])
-    if values is not None:
+    if scanned is not None and values is not None:
         ns = np.asarray(scanned[0], dtype=np.int64)
         order = np.argsort(ns, kind='stable')
         return ns[order] / convert.NS_PER_S, values[order]
@@ -175,8 +175,8 @@ def read_points(bag: Bag, topic: str = '/tracker/point') -> PointSeries:
         ns, x, y, z, frame = convert.point_values(msg)
         rows.append((convert.ns_to_seconds(ns), x, y, z))
         frames.add(frame)
-    t, x, y, z = _sorted_columns(rows, 4)
-    return PointSeries(t, x, y, z, _single_frame(frames, reader, topic))
+    t, xs, ys, zs = _sorted_columns(rows, 4)
+    return PointSeries(t, xs, ys, zs, _single_frame(frames, reader, topic))
 
 
 def iter_images(bag: Bag, topic: str = '/camera/image_raw') -> Iterator[ImageFrame]:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -82,7 +82,7 @@ class TipSeries:
             A series of the same type.
         """
         n = self.t.size
-        picked = {
+        picked: dict[str, Any] = {
             f.name: value[keep]
             for f in dataclasses.fields(self)
             if isinstance(value := getattr(self, f.name), np.ndarray) and value.shape[:1] == (n,)

@@ -305,7 +305,7 @@ def camera_node_command() -> list[str]:
 
 def identifier_command(publish_rate_hz: float) -> list[str]:
     """The identifier node as a process, on wall time, publishing at ``publish_rate_hz``."""
-    from lumpbeam_ros.pipeline.graph import node_command
+    from lumpbeam_ros.demo.graph import node_command
 
     return node_command(
         'lumpbeam_ros.nodes.identifier_node', '-p', f'publish_rate_hz:={publish_rate_hz}'

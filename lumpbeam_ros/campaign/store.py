@@ -12,6 +12,7 @@ import os
 import time
 from collections.abc import Iterable
 from pathlib import Path
+from typing import Any
 
 from lumpbeam_ros.campaign.task import ID_COLUMNS, SCHEMA_VERSION, Row
 from lumpbeam_ros.errors import LumpbeamError
@@ -77,7 +78,8 @@ class ResultsStore:
                 f'{path}: written by campaign table version {found}, this is version '
                 f'{SCHEMA_VERSION}; move it away (or choose another --out) to start afresh'
             )
-        return table.to_pylist()
+        rows: list[dict[str, Any]] = table.to_pylist()
+        return rows
 
     def is_done(self, path: str, key: str) -> bool:
         """Whether a bag has a row with the same key (path, content, settings) and no error."""

@@ -157,7 +157,13 @@ def summarize(rows: Iterable[Row], beam: BeamParameters) -> CampaignSummary:
     data = np.array([_column(ok, c) for c in columns]) if ok else np.zeros((len(columns), 0))
     usable = np.all(np.isfinite(data), axis=0) & (data[2] > 0) & (data[4] > 0) & (data[6] > 0)
     try:
-        beam_fit = fit_beam(*data[:, usable], beam.length_m, beam.gravity_mps2, beam.tip_mass_kg)
+        load, deflection, deflection_std, level, level_std, frequency, frequency_std = data[
+            :, usable
+        ]
+        beam_fit = fit_beam(
+            load, deflection, deflection_std, level, level_std, frequency, frequency_std,
+            beam.length_m, beam.gravity_mps2, beam.tip_mass_kg,
+        )  # fmt: skip
         error = ''
     except ValueError as exc:
         beam_fit, error = None, str(exc)

@@ -7,15 +7,15 @@ import sys
 from pathlib import Path
 
 from lumpbeam_ros.cli.output import write_json
-from lumpbeam_ros.ident.config import load_identifier_config
-from lumpbeam_ros.model.parameters import load_beam_config
-from lumpbeam_ros.pipeline.bag_analysis import (
+from lumpbeam_ros.ident.bag import (
     CONTRACT_KEYS,
     POSE_TOPIC,
     analyze_bag,
     read_window,
     result_json,
 )
+from lumpbeam_ros.ident.config import load_identifier_config
+from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.progress import Progress
 
 __all__ = ['CONTRACT_KEYS', 'Progress', 'read_window', 'result_json', 'run']

@@ -16,9 +16,9 @@ def run(args: argparse.Namespace) -> int:
     Raises:
         LumpbeamError: A bad option or a failed step (one line, see the logs it names).
     """
+    from lumpbeam_ros.demo.graph import DOMAIN_IDS
+    from lumpbeam_ros.demo.steps import DemoOptions, run_demo
     from lumpbeam_ros.errors import LumpbeamError
-    from lumpbeam_ros.pipeline.demo import DemoOptions, run_demo
-    from lumpbeam_ros.pipeline.graph import DOMAIN_IDS
 
     if args.domain_id is not None and args.domain_id not in DOMAIN_IDS:
         raise LumpbeamError(
@@ -27,7 +27,7 @@ def run(args: argparse.Namespace) -> int:
         )
     if args.out.exists() and not args.out.is_dir():
         raise LumpbeamError(f'--out {args.out} is a file, not a folder')
-    from lumpbeam_ros.pipeline.demo import HIDDEN_EFFECT
+    from lumpbeam_ros.demo.steps import HIDDEN_EFFECT
     from lumpbeam_ros.synthetic.drop_test import parse_effect
     from lumpbeam_ros.synthetic.images import parse_image_size
 

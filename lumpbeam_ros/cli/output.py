@@ -1,49 +1,13 @@
-"""Output shared by the subcommands: the ``--json`` file and argument types."""
+"""Output shared by the subcommands: the ``--json`` file (written by the core), argument types."""
 
 from __future__ import annotations
 
 import argparse
-import json
 import math
-from pathlib import Path
-from typing import Any
 
-from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.json_output import write_json
 
-
-def _plain(value: Any) -> Any:
-    # numpy is imported here: the argument types below serve `--help`, which must stay light.
-    import numpy as np
-
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return [_plain(v) for v in value.tolist()]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None  # JSON has no NaN or inf
-    return value
-
-
-def write_json(path: str | Path, result: dict[str, Any]) -> None:
-    """Writes a command's machine-readable result.
-
-    Args:
-        path: Output file; its folder is created when missing.
-        result: JSON-serializable data; numpy values are converted, NaN and inf become null.
-
-    Raises:
-        LumpbeamError: The file cannot be written.
-    """
-    path = Path(path)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps(_plain(result), indent=2) + '\n', encoding='utf-8')
-    except OSError as exc:
-        raise LumpbeamError(f'cannot write JSON to {path}: {exc.strerror or exc}') from None
+__all__ = ['non_negative_float', 'positive_float', 'write_json']
 
 
 def _bounded_float(text: str, allow_zero: bool) -> float:

@@ -22,8 +22,9 @@ from lumpbeam_ros.compare.align import AlignedStreams, AlignOptions, align_strea
 from lumpbeam_ros.compare.bag import ComparisonInput, read_comparison_input
 from lumpbeam_ros.compare.comparison import Comparison, compare_sensors
 from lumpbeam_ros.compare.refine import Alignment
-from lumpbeam_ros.compare.rigid import RigidTransform, fit_rigid
+from lumpbeam_ros.compare.rigid import fit_rigid
 from lumpbeam_ros.compare.streams import GapInterpolator, Track, clean_track
+from lumpbeam_ros.transforms import RigidTransform
 
 __all__ = [
     'AlignOptions',

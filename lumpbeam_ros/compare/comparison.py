@@ -50,7 +50,7 @@ class Comparison:
     @property
     def difference(self) -> np.ndarray:
         """Camera minus reference at each pair, ``(n, 3)``, m."""
-        return self.camera - self.reference
+        return np.asarray(self.camera - self.reference)
 
     @property
     def rms_difference_m(self) -> float:

@@ -127,7 +127,7 @@ def _masked_correlation(z: np.ndarray, values: np.ndarray, mask: np.ndarray) -> 
     dv = (values - mean_v[:, None]) * weights
     denominator = np.sqrt((dz * dz).sum(axis=1) * (dv * dv).sum(axis=1))
     with np.errstate(invalid='ignore', divide='ignore'):
-        out = (dz * dv).sum(axis=1) / denominator
+        out: np.ndarray = (dz * dv).sum(axis=1) / denominator
     out[(count < MIN_PAIRS) | ~(denominator > 0.0)] = np.nan
     return out
 

@@ -24,9 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from lumpbeam_ros.compare.rigid import RigidTransform, skew
+from lumpbeam_ros.compare.rigid import skew
 from lumpbeam_ros.compare.streams import GapInterpolator, Track
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.transforms import RigidTransform
 
 #: Fewest camera samples that must meet valid reference samples.
 MIN_PAIRS = 20

@@ -153,10 +153,10 @@ class GapInterpolator:
 
     def scalar(self, values: np.ndarray, query: np.ndarray) -> np.ndarray:
         """Interpolates a per-sample scalar of the track (e.g. a projection) at ``query``."""
-        return np.interp(query, self.track.t, values)
+        return np.asarray(np.interp(query, self.track.t, values))
 
     def velocity(self, query: np.ndarray, half_width_s: float) -> np.ndarray:
         """Central-difference velocity over ``+- half_width_s``, ``(n, 3)``, m/s."""
         ahead = self(query + half_width_s)
         behind = self(query - half_width_s)
-        return (ahead - behind) / (2.0 * half_width_s)
+        return np.asarray((ahead - behind) / (2.0 * half_width_s))

@@ -84,7 +84,9 @@ class Candidate:
         """
         if self.parameter is None:
             return np.asarray(nominal_x[:2], dtype=float)
-        return np.r_[nominal_x[:2], (self.start if strength is None else strength) / self.scale]
+        return np.asarray(
+            np.r_[nominal_x[:2], (self.start if strength is None else strength) / self.scale]
+        )
 
     def value(self, x: np.ndarray) -> float:
         """The effect's contract parameter (SI) at ``x``; NaN for the nominal model.

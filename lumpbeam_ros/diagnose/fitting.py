@@ -124,7 +124,7 @@ class FitProblem:
         counts = np.bincount(labels)
         means = np.bincount(labels, weights=residual) / np.maximum(counts, 1)
         means[0] = 0.0
-        return residual - means[labels]
+        return np.asarray(residual - means[labels])
 
     def fit(
         self,

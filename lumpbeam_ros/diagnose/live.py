@@ -320,11 +320,11 @@ class LiveBuffer:
         for release in self._releases():
             if release <= self._done_until:
                 continue
-            end = self._ring_down_end(release, latest)
-            if end is None:
+            ring_down_end = self._ring_down_end(release, latest)
+            if ring_down_end is None:
                 return None
-            self._done_until = end
-            return Stretch(release - s.pre_release_s, end, release)
+            self._done_until = ring_down_end
+            return Stretch(release - s.pre_release_s, ring_down_end, release)
         return None
 
     def _ring_down_end(self, release: float, latest: float) -> float | None:

@@ -117,6 +117,7 @@ def config_from_parameters(params: Mapping[str, Any], source: str | Path) -> Ide
     for f in fields(IdentifierConfig):
         key = PARAMETER_KEYS[f.name]
         default = getattr(defaults, f.name)
+        value: str | bool | int | float
         if isinstance(default, str):
             value = get_choice(params, key, source, NONLINEAR_CHOICES, default)
         elif isinstance(default, bool):

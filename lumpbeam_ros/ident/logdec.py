@@ -47,7 +47,9 @@ class LogDecrementResult:
     def envelope(self, t: np.ndarray) -> np.ndarray:
         """The decaying amplitude the decrement implies, through the first peak."""
         decay = self.log_decrement * self.damped_frequency_hz
-        return self.peak_amplitudes[0] * np.exp(-decay * (np.asarray(t) - self.peak_times[0]))
+        return np.asarray(
+            self.peak_amplitudes[0] * np.exp(-decay * (np.asarray(t) - self.peak_times[0]))
+        )
 
 
 class LogDecrement:

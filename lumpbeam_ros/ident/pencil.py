@@ -126,4 +126,4 @@ def _uniform_blocks(t: np.ndarray, y: np.ndarray, decimation: int) -> np.ndarray
         grid = np.arange(t[0], t[-1] + 0.5 * step, step)
         y = np.interp(grid, t, y)
     usable = (y.size // decimation) * decimation
-    return y[:usable].reshape(-1, decimation).mean(axis=1)
+    return np.asarray(y[:usable].reshape(-1, decimation).mean(axis=1))

@@ -152,11 +152,12 @@ def detect_release(window: PoseWindow, config: IdentifierConfig) -> Release:
 def _from_hint(scan: _Scan, drop: LoadChange, config: IdentifierConfig) -> Release:
     """The release a ``/tip_load`` drop announces, timed from the data."""
     low, high = drop.time_s - config.hint_late_s, drop.time_s + config.hint_early_s
-    mass = {'load_kg': drop.released_kg, 'load_after_kg': drop.after_kg}
     near = [s for s in scan.steps if s.rising and low <= scan.t[s.departure] <= high]
     if near:
         release = scan.release(near[-1], 'tip_load')
-        return replace(release, **mass) if release.found else release
+        if not release.found:
+            return release
+        return replace(release, load_kg=drop.released_kg, load_after_kg=drop.after_kg)
     quiet = scan.quiet_between(low, high)
     earlier = [s for s in scan.steps if s.rising and scan.t[s.departure] < low]
     if not quiet and earlier:
@@ -171,7 +172,8 @@ def _from_hint(scan: _Scan, drop: LoadChange, config: IdentifierConfig) -> Relea
                 f'/tip_load dropped at {drop.time_s:.3f} s: release time only from /tip_load, '
                 'no static level before it'
             ),
-            **mass,
+            load_kg=drop.released_kg,
+            load_after_kg=drop.after_kg,
         )
     found = scan.last_release()
     if found.found:
@@ -183,7 +185,8 @@ def _from_hint(scan: _Scan, drop: LoadChange, config: IdentifierConfig) -> Relea
                 f'/tip_load dropped at {drop.time_s:.3f} s, {gap:+.3f} s from the release the '
                 f'tip shows at {found.time_s:.3f} s'
             ),
-            **mass,
+            load_kg=drop.released_kg,
+            load_after_kg=drop.after_kg,
         )
     return _unanswered(drop, found.message, config, float(scan.t[-1]))
 

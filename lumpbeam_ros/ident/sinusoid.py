@@ -123,7 +123,10 @@ class DampedSinusoidParams:
     def mode(self, index: int = 0) -> ModeEstimate:
         """The figures of one mode (0 is the first fitted, normally the beam's first mode)."""
         s = self.mode_slice(index)
-        return ModeEstimate.from_parameters(*self.x[s], self.covariance.matrix[s, s])
+        cos_amp, sin_amp, decay_rate, damped_omega = self.x[s]
+        return ModeEstimate.from_parameters(
+            cos_amp, sin_amp, decay_rate, damped_omega, self.covariance.matrix[s, s]
+        )
 
     def predict(self, t: np.ndarray) -> np.ndarray:
         """Evaluates the fitted model at stamps ``t``."""
@@ -283,7 +286,7 @@ def _gauss_newton(
 def _sweep(sigma: float, tau: np.ndarray) -> np.ndarray:
     """``(1 - e^{-2 sigma tau}) / (2 sigma)``: the phase a unit frequency shift adds."""
     if abs(sigma) * float(np.max(np.abs(tau), initial=0.0)) < 1e-8:
-        return tau - sigma * tau * tau
+        return np.asarray(tau - sigma * tau * tau)
     return -np.expm1(-2.0 * sigma * tau) / (2.0 * sigma)
 
 
@@ -292,8 +295,8 @@ def _sweep_rate(
 ) -> np.ndarray:
     """d sweep / d sigma = (tau e^{-2 sigma tau} - sweep) / sigma."""
     if abs(sigma) * float(np.max(np.abs(tau), initial=0.0)) < 1e-8:
-        return -tau * tau
-    return (tau * square - sweep) / sigma
+        return np.asarray(-tau * tau)
+    return np.asarray((tau * square - sweep) / sigma)
 
 
 def _pole_vector(

@@ -119,12 +119,12 @@ class LumpedChain:
     @property
     def inertia_coupling(self) -> np.ndarray:
         """A_ij = sum_p m_p l_i^p l_j^p."""
-        return (self.levers * self.masses[:, None]).T @ self.levers
+        return np.asarray((self.levers * self.masses[:, None]).T @ self.levers)
 
     @property
     def gravity_moment(self) -> np.ndarray:
         """G_i = sum_p m_p l_i^p: first moment of the masses beyond each joint."""
-        return self.masses @ self.levers
+        return np.asarray(self.masses @ self.levers)
 
     def gravity_forces(self, phi: np.ndarray) -> np.ndarray:
         """``g G cos(phi + tilt)``: the generalized forces of gravity, any batch shape."""
@@ -142,17 +142,19 @@ class LumpedChain:
     def stiffness_matrix(self) -> np.ndarray:
         """K = D^T diag(k) D."""
         d = _difference_matrix(self.n)
-        return d.T @ (self.stiffness[:, None] * d)
+        return np.asarray(d.T @ (self.stiffness[:, None] * d))
 
     @property
     def damping_matrix(self) -> np.ndarray:
         """C = D^T diag(c) D."""
         d = _difference_matrix(self.n)
-        return d.T @ (self.damping[:, None] * d)
+        return np.asarray(d.T @ (self.damping[:, None] * d))
 
     def mass_matrix(self, phi: np.ndarray) -> np.ndarray:
         """M(phi) of B.16 for one configuration (n,)."""
-        return self.inertia_coupling * np.cos(phi[:, None] - phi[None, :]) + np.diag(self.inertia)
+        return np.asarray(
+            self.inertia_coupling * np.cos(phi[:, None] - phi[None, :]) + np.diag(self.inertia)
+        )
 
     def tip_pose(self, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Pose of the free end in beam_base (B.17 chained to the end of segment n).
@@ -230,7 +232,7 @@ class LumpedChain:
         c, s = np.cos(phi), np.sin(phi)
         w2 = phi_dot**2
         coriolis = s * ((c * w2) @ a) - c * ((s * w2) @ a)
-        return (
+        return np.asarray(
             -coriolis
             + self.gravity_forces(phi)
             - phi @ self.stiffness_matrix
@@ -242,7 +244,9 @@ class LumpedChain:
         """``M(phi) phi''`` for a batch, without forming the matrices."""
         a = self.inertia_coupling
         c, s = np.cos(phi), np.sin(phi)
-        return c * ((c * phi_ddot) @ a) + s * ((s * phi_ddot) @ a) + self.inertia * phi_ddot
+        return np.asarray(
+            c * ((c * phi_ddot) @ a) + s * ((s * phi_ddot) @ a) + self.inertia * phi_ddot
+        )
 
     def acceleration(self, phi: np.ndarray, phi_dot: np.ndarray) -> np.ndarray:
         """Forward dynamics ``phi'' = M(phi)^-1 Q`` for one configuration (n,)."""
@@ -254,4 +258,4 @@ class LumpedChain:
         spring = 0.5 * (phi * (phi @ self.stiffness_matrix)).sum(axis=-1)
         spring = spring + 0.25 * self.cubic_stiffness * phi[..., 0] ** 4
         heights = -self.gravity * (self.gravity_moment * np.sin(phi + self.tilt)).sum(axis=-1)
-        return kinetic + spring + heights
+        return np.asarray(kinetic + spring + heights)

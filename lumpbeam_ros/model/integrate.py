@@ -127,7 +127,7 @@ class ModalSolver:
         drive[1:] = (h_phi1 - h_phi2) * u[:-1] + h_phi2 * u[1:]
         if self.chain.coulomb_torque > 0.0:
             return self._propagate_with_friction(drive, e, h_phi1)
-        z = np.empty_like(u)
+        z: np.ndarray = np.empty_like(u)
         for m in range(self._lam.size):
             z[:, m] = lfilter([1.0], [1.0, -e[m]], drive[:, m])
         return z

@@ -343,7 +343,7 @@ def load_beam_config(path: str | Path | None = None) -> tuple[BeamParameters, Dr
     return beam_from_parameters(params, path), drop_test_from_parameters(params, path)
 
 
-def beam_to_parameters(beam: BeamParameters, drop: DropTestConfig | None = None) -> dict:
+def beam_to_parameters(beam: BeamParameters, drop: DropTestConfig | None = None) -> dict[str, Any]:
     """Returns the nested ``ros__parameters`` mapping that reads back as ``beam``."""
     tree: dict[str, Any] = {
         'beam': {

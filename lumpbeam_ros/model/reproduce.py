@@ -14,7 +14,7 @@ from importlib import resources
 from lumpbeam_ros.model import rules
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.modes import chain_modes
-from lumpbeam_ros.model.parameters import BeamParameters
+from lumpbeam_ros.model.parameters import BeamParameters, TipPlacement
 from lumpbeam_ros.model.statics import static_tip_deflection
 
 #: The tables' end load, kg (section B.3.1).
@@ -72,7 +72,7 @@ def deflection_table(beam: BeamParameters, max_segments: int = 10) -> list[Table
     rows = []
     bare = replace(beam, tip_mass_kg=0.0, tip_inertia_kgm2=0.0)
     for n in range(1, max_segments + 1):
-        placement = 'segment_com' if n == 1 else 'free_end'
+        placement: TipPlacement = 'segment_com' if n == 1 else 'free_end'
         b = replace(bare, n_segments=n, tip_placement=placement)
         uniform = static_tip_deflection(b)
         loaded = static_tip_deflection(b, TABLE_LOAD_KG)

@@ -63,6 +63,7 @@ class PredictionStream:
         self.step = step
         self._beam = beam
         self._rate_hz = 0.0
+        self._time: float  # set by reset(), which ends this constructor
         self.rate_hz = rate_hz
         self._events: list[tuple[float, float]] = []
         self.reset(t0, load_kg)

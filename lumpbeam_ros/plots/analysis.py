@@ -15,6 +15,7 @@ matplotlib.use('Agg')  # before pyplot: files only, no display
 
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
 
 from lumpbeam_ros.errors import LumpbeamError  # noqa: E402
 from lumpbeam_ros.ident.result import Estimate, Identification  # noqa: E402
@@ -28,7 +29,7 @@ def _envelope(result: Identification, t: np.ndarray) -> np.ndarray:
     """Amplitude of the fitted first mode about the decay's level (B.20's envelope)."""
     figures = result.estimates
     sigma = figures.damping_ratio.value * 2.0 * math.pi * figures.natural_frequency_hz.value
-    return result.quality.amplitude_m * np.exp(-sigma * (t - t[0]))
+    return np.asarray(result.quality.amplitude_m * np.exp(-sigma * (t - t[0])))
 
 
 def plot_trajectory(window: PoseWindow, result: Identification, path: Path) -> None:
@@ -171,7 +172,7 @@ def write_analysis_plots(window: PoseWindow, result: Identification, folder: Pat
     return paths
 
 
-def _save(fig: plt.Figure, path: Path) -> None:
+def _save(fig: Figure, path: Path) -> None:
     try:
         fig.tight_layout()
         fig.savefig(path, dpi=110)

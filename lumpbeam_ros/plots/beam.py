@@ -52,9 +52,8 @@ def snapshot_indices(stamps: np.ndarray, times: Sequence[float] | None, count: i
     Returns:
         Distinct indices into ``stamps``, in time order.
     """
-    if times is None:
-        times = np.linspace(stamps[0], stamps[-1], count)
-    return sorted({int(np.argmin(np.abs(stamps - t))) for t in times})
+    wanted = np.linspace(stamps[0], stamps[-1], count) if times is None else times
+    return sorted({int(np.argmin(np.abs(stamps - t))) for t in wanted})
 
 
 def plot_beam_snapshots(
@@ -123,9 +122,9 @@ def plot_beam_snapshots(
         shape_axis.set_title('line strip through the joints; x measured tip, + predicted tip, '
                              'square: the hanging load', fontsize=9)  # fmt: skip
         for namespace, label in ((NS_MEASURED, 'measured tip'), (NS_PREDICTED, 'predicted tip')):
-            t, z = _tip_series(arrays, namespace)
-            if t.size:
-                time_axis.plot(t, z * 1e3, lw=0.8, label=label)
+            tip_t, tip_z = _tip_series(arrays, namespace)
+            if tip_t.size:
+                time_axis.plot(tip_t, tip_z * 1e3, lw=0.8, label=label)
         for color, index in zip(colors, chosen, strict=True):
             time_axis.axvline(stamps[index], color=color, lw=0.8, ls=':')
         if release_time_s is not None:

@@ -33,7 +33,7 @@ class Residual:
     @property
     def residual(self) -> np.ndarray:
         """Measured minus predicted, m."""
-        return self.measured - self.predicted
+        return np.asarray(self.measured - self.predicted)
 
     def rms(self, start: float = -np.inf, end: float = np.inf) -> float:
         """RMS of the residual over ``start <= t < end``, m (NaN when no sample)."""

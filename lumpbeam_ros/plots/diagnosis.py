@@ -82,7 +82,7 @@ def _refined(t: np.ndarray, z: np.ndarray, peak_t: np.ndarray) -> np.ndarray:
     left, mid, right = z[i - 1], z[i], z[i + 1]
     curvature = left - 2.0 * mid + right
     step = np.where(curvature != 0.0, 0.5 * (left - right) / np.where(curvature, curvature, 1), 0)
-    return t[i] + np.clip(step, -1.0, 1.0) * (t[i + 1] - t[i - 1]) / 2.0
+    return np.asarray(t[i] + np.clip(step, -1.0, 1.0) * (t[i + 1] - t[i - 1]) / 2.0)
 
 
 def _swing(

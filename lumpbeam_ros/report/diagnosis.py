@@ -6,7 +6,7 @@ import tempfile
 from pathlib import Path
 
 from lumpbeam_ros.diagnose.workflow import Diagnosis
-from lumpbeam_ros.report.html import HtmlReport
+from lumpbeam_ros.report.html import Cell, HtmlReport
 
 GAP_COLUMNS = ('rms_m', 'max_m', 'frequency_error', 'damping_error')
 
@@ -24,7 +24,10 @@ def add_diagnosis(page: HtmlReport, diagnosis: Diagnosis) -> None:
     page.heading(f'Missing effect: {d.missing_effect}')
     page.paragraph(d.decision.reason)
     if d.effect_parameters:
-        page.table(['effect parameter', 'value'], list(map(list, d.effect_parameters.items())))
+        page.table(
+            ['effect parameter', 'value'],
+            [[name, value] for name, value in d.effect_parameters.items()],
+        )
     page.paragraph(
         f'Measurement noise: z {d.noise_z_m * 1e6:.2f} um, pitch '
         f'{d.noise_pitch_rad * 1e6:.2f} urad; candidates fitted up to {d.train_end_s:.3f} s '
@@ -32,7 +35,7 @@ def add_diagnosis(page: HtmlReport, diagnosis: Diagnosis) -> None:
         note=True,
     )
     page.heading('The gap between model and measurement')
-    rows = []
+    rows: list[list[Cell]] = []
     for label, gap in (
         ('configured beam (as given)', d.gap_configured),
         ('before: nominal, refit', d.gap_before),

@@ -178,6 +178,7 @@ def write_drop_test_bag(
             f'duration {options.duration_s} s ends before the release at {drop.release_time_s} s'
         )
     measured, truth = simulate_experiment(beam, drop, options)
+    assert truth.q is not None  # the truth keeps its joint angles
     rng = np.random.default_rng(options.seed)
     noise = options.noise_m * rng.standard_normal((3, len(measured)))
     noise[2] *= PITCH_NOISE_PER_M

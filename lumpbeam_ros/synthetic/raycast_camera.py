@@ -122,7 +122,7 @@ class Optics:
 def _axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
     """Rodrigues' formula: the rotation by ``angle`` about the unit vector ``axis``."""
     k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-    return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
+    return np.asarray(np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k))
 
 
 def _homogeneous(xyz: tuple[float, float, float], rpy: tuple[float, float, float]) -> np.ndarray:
@@ -270,7 +270,7 @@ class RaycastCamera:
         base_tip = np.eye(4)
         base_tip[:3, :3] = _axis_rotation(np.array([0.0, 1.0, 0.0]), pitch)
         base_tip[:3, 3] = [x, 0.0, z]
-        return _rigid_inverse(base_tip @ self._tip_camera) @ self._base_board
+        return np.asarray(_rigid_inverse(base_tip @ self._tip_camera) @ self._base_board)
 
     def _ray_to_squares(self, tip_pose: np.ndarray) -> np.ndarray:
         """3x3 map from a ray ``(x, y, 1)`` to homogeneous square coordinates.
@@ -368,7 +368,7 @@ class RaycastCamera:
     def _edge_distance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Distance to the nearest edge of the pattern, in squares."""
         sc, m = self.scene, self.scene.margin_squares
-        d = np.minimum(np.abs(a - np.rint(a)), np.abs(b - np.rint(b)))
+        d: np.ndarray = np.minimum(np.abs(a - np.rint(a)), np.abs(b - np.rint(b)))
         if m != round(m):
             # The sheet's edges are off the grid of square edges.
             for edge_a in (-m, sc.squares_x + m):

@@ -14,11 +14,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from lumpbeam_ros.bagio import BagWriter
-from lumpbeam_ros.compare.rigid import RigidTransform
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.interface import TRACKER_POINT
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.model.simulate import drop_test_events, simulate_loads
+from lumpbeam_ros.transforms import RigidTransform
 
 TOPIC = TRACKER_POINT
 

@@ -235,7 +235,12 @@ def score(
     if not scored:
         raise LumpbeamError('accuracy: no frame with a pose to score')
     error = np.array([results[i].pose for i in scored]) - truths[scored]
-    sigma = np.sqrt(np.array([np.diag(results[i].covariance) for i in scored]))
+    no_covariance = np.full(3, np.nan)  # counts as outside its band
+    sigma = np.sqrt(
+        np.array(
+            [no_covariance if (c := results[i].covariance) is None else np.diag(c) for i in scored]
+        )
+    )
     inside = np.abs(error) <= sigma
     return AccuracyReport(
         width=int(width),

@@ -36,7 +36,9 @@ from lumpbeam_ros.errors import ConfigError, LumpbeamError
 from lumpbeam_ros.vision.camera_model import CameraInfo
 
 
-def _matrix(doc: dict[str, Any], key: str, shape: tuple[int, int] | None, source: Path):
+def _matrix(
+    doc: dict[str, Any], key: str, shape: tuple[int, int] | None, source: Path
+) -> np.ndarray:
     node = doc.get(key)
     if not isinstance(node, dict) or not {'rows', 'cols', 'data'} <= set(node):
         raise ConfigError(source, key, 'must be a mapping with rows, cols and data')

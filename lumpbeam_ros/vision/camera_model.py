@@ -14,7 +14,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
-import cv2
 import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
@@ -25,10 +24,6 @@ EQUIDISTANT = 'equidistant'
 
 #: Supported distortion models and their number of coefficients.
 DISTORTION_MODELS = {PLUMB_BOB: 5, RATIONAL_POLYNOMIAL: 8, EQUIDISTANT: 4}
-
-
-#: OpenCV's fixed-point undistortion run to convergence (Newton only polishes what is left).
-_OPENCV_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-15)
 
 
 @dataclass(frozen=True)
@@ -175,7 +170,7 @@ class CameraInfo:
             theta_d = theta * (1.0 + t2 * (k1 + t2 * (k2 + t2 * (k3 + t2 * k4))))
             # theta_d / r -> 1 on the optical axis.
             scale = np.divide(theta_d, r, out=np.ones_like(r), where=r > 1e-12)
-            return xy * scale[:, None]
+            return np.asarray(xy * scale[:, None])
         k1, k2, p1, p2, k3 = self.d[:5]
         radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
         if self.distortion_model == RATIONAL_POLYNOMIAL:
@@ -207,12 +202,17 @@ class CameraInfo:
         # OpenCV returns None, not an empty array, for no points (a frame with no corner seen).
         if not self.has_distortion or target.size == 0:
             return target.copy()
+        # OpenCV only here: reading a rig's configuration and projecting need none.
+        import cv2
+
+        # OpenCV's fixed-point iteration run to convergence (Newton only polishes the rest).
+        criteria = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-15)
         pts = np.ascontiguousarray(target).reshape(-1, 1, 2)
         eye = np.eye(3)
         if self.distortion_model == EQUIDISTANT:
-            xy = cv2.fisheye.undistortPoints(pts, eye, self.d, criteria=_OPENCV_CRITERIA)
+            xy = cv2.fisheye.undistortPoints(pts, eye, self.d, criteria=criteria)
         else:
-            xy = cv2.undistortPoints(pts, eye, self.d, None, None, None, _OPENCV_CRITERIA)
+            xy = cv2.undistortPoints(pts, eye, self.d, None, None, None, criteria)
         xy = xy.reshape(-1, 2)
         if not np.all(np.isfinite(xy)):
             xy = target.copy()
@@ -249,7 +249,9 @@ class CameraInfo:
 
     def to_pixels(self, xy: np.ndarray) -> np.ndarray:
         """Applies K to normalized coordinates (N x 2)."""
-        return xy * np.diag(self.k)[:2] + self.k[:2, 2] + np.outer(xy[:, 1], [self.k[0, 1], 0])
+        return np.asarray(
+            xy * np.diag(self.k)[:2] + self.k[:2, 2] + np.outer(xy[:, 1], [self.k[0, 1], 0])
+        )
 
     def to_normalized(self, pixels: np.ndarray) -> np.ndarray:
         """Applies K's inverse to pixels (N x 2)."""

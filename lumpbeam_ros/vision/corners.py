@@ -74,7 +74,7 @@ def corner_contrast(image: np.ndarray, corners: np.ndarray, offset: int) -> np.n
     x = np.clip(centre[:, 0, None] + offset * np.array([1, -1, 1, -1]), 0, w - 1)
     y = np.clip(centre[:, 1, None] + offset * np.array([1, -1, -1, 1]), 0, h - 1)
     v = image[y, x].astype(np.float64)
-    return np.abs(v[:, 0] + v[:, 1] - v[:, 2] - v[:, 3]) / 2.0
+    return np.asarray(np.abs(v[:, 0] + v[:, 1] - v[:, 2] - v[:, 3]) / 2.0)
 
 
 def homography_residual(object_xy: np.ndarray, pixels: np.ndarray) -> float:

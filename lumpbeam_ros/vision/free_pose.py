@@ -131,7 +131,7 @@ class FreeModel:
     def project(self, pose: np.ndarray) -> np.ndarray:
         """Returns the ideal (undistorted) pixel positions of the corners (N x 2)."""
         p = self.camera_points(pose)
-        return p[:, :2] / p[:, 2:3] * self._f + self._c
+        return np.asarray(p[:, :2] / p[:, 2:3] * self._f + self._c)
 
     def jacobian(self, pose: np.ndarray) -> np.ndarray:
         """d(pixels)/d(pose) by central differences (N x 2 x 6)."""

@@ -23,7 +23,7 @@ def rotation_rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
     Returns:
         A 3x3 rotation matrix.
     """
-    return rotation_z(yaw) @ rotation_y(pitch) @ rotation_x(roll)
+    return np.asarray(rotation_z(yaw) @ rotation_y(pitch) @ rotation_x(roll))
 
 
 def rotation_x(angle: float) -> np.ndarray:
@@ -57,7 +57,9 @@ class Transform:
     translation: np.ndarray
 
     @staticmethod
-    def from_xyz_rpy(xyz: tuple[float, float, float], rpy: tuple[float, float, float]):
+    def from_xyz_rpy(
+        xyz: tuple[float, float, float], rpy: tuple[float, float, float]
+    ) -> Transform:
         """Builds a transform from a position and roll-pitch-yaw angles (URDF convention).
 
         Args:
@@ -81,7 +83,7 @@ class Transform:
 
     def apply(self, points: np.ndarray) -> np.ndarray:
         """Maps child-frame points (N x 3) into the parent frame."""
-        return points @ self.rotation.T + self.translation
+        return np.asarray(points @ self.rotation.T + self.translation)
 
 
 def tip_transform(x: float, z: float, pitch: float) -> Transform:

@@ -244,7 +244,7 @@ class _Run:
         self._next_markers_ns = -1
 
     def track(
-        self, label: str, stamp_ns: int, pixels: object, encoding: str, log_time_ns: int
+        self, label: str, stamp_ns: int, pixels: np.ndarray, encoding: str, log_time_ns: int
     ) -> None:
         """Tracks one decoded frame and writes its pose.
 
@@ -266,6 +266,7 @@ class _Run:
         self._tick()
 
     def _write_markers(self, stamp_ns: int, result: TrackResult) -> None:
+        assert result.pose is not None  # markers are drawn for tracked frames only
         x, z, _ = (float(v) for v in result.pose)  # the planar part, also of a 6-DoF fit
         scene = BeamScene(0.0, measured=TipPoint(x, z), board=self._board)
         stamp = convert.ns_to_seconds(stamp_ns)
@@ -317,6 +318,7 @@ def pose_message(stamp_ns: int, result: TrackResult) -> object:
         return convert.pose_stamped_6dof(
             stamp_ns, tuple(p[:3]), rpy_quaternion(*p[3:]), BASE_FRAME
         )
+    assert result.pose is not None  # called for tracked frames only
     x, z, pitch = (float(v) for v in result.pose)
     return convert.pose_stamped(stamp_ns, x, z, pitch, BASE_FRAME)
 

@@ -67,12 +67,12 @@ class PlaneModel:
         d = self._points - np.array([x, 0.0, z])
         # R_y(pitch)^T applied to the offsets from the tip, written out for speed.
         tip = np.column_stack([c * d[:, 0] - s * d[:, 2], d[:, 1], s * d[:, 0] + c * d[:, 2]])
-        return tip @ self._r_ct.T + self._t_ct
+        return np.asarray(tip @ self._r_ct.T + self._t_ct)
 
     def project(self, pose: np.ndarray) -> np.ndarray:
         """Returns the ideal (undistorted) pixel positions of the corners (N x 2)."""
         p = self.camera_points(pose)
-        return p[:, :2] / p[:, 2:3] * self._f + self._c
+        return np.asarray(p[:, :2] / p[:, 2:3] * self._f + self._c)
 
     def project_with_jacobian(self, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Returns the projected corners (N x 2) and d(pixels)/d(pose) (N x 2 x 3)."""

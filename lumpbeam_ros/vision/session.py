@@ -118,7 +118,7 @@ class TrackingSession:
         self._tracker = TipTracker(info, self.config, self.pose_model)
         return True
 
-    def process(self, pixels: object, stamp: float, encoding: str = 'mono8') -> TrackResult:
+    def process(self, pixels: np.ndarray, stamp: float, encoding: str = 'mono8') -> TrackResult:
         """Tracks one frame and counts it.
 
         Args:

@@ -75,7 +75,7 @@ class SyntheticCamera:
         camera_board = camera_board_transform(self.config.rig, pose)
         r, t = camera_board.rotation, camera_board.translation
         plane = np.column_stack([r[:, 0], r[:, 1], t])
-        return self.camera_info.k @ plane @ self._tex_to_board
+        return np.asarray(self.camera_info.k @ plane @ self._tex_to_board)
 
     def _outline_px(self, poses: np.ndarray) -> np.ndarray:
         """Returns the image positions of the sheet's corners for every pose (4M x 2)."""
@@ -86,7 +86,7 @@ class SyntheticCamera:
             if np.any(cam[:, 2] <= 0):
                 raise LumpbeamError('synthetic camera: the board is behind the camera')
             pts.append(cam[:, :2] / cam[:, 2:3] * np.diag(self.camera_info.k)[:2])
-        return np.concatenate(pts) + self.camera_info.k[:2, 2]
+        return np.asarray(np.concatenate(pts) + self.camera_info.k[:2, 2])
 
     def motion_samples(self, start: np.ndarray, end: np.ndarray) -> int:
         """Sub-poses needed so no corner moves more than ``motion_step_px`` between two.
@@ -121,7 +121,7 @@ class SyntheticCamera:
         poses = np.atleast_2d(np.asarray(poses, dtype=float))
         st = self._settings
         w, h = self.camera_info.width, self.camera_info.height
-        image = np.full((h, w), st.wall_dn, dtype=np.float32)
+        image: np.ndarray = np.full((h, w), st.wall_dn, dtype=np.float32)
         outline = self._outline_px(poses)
         pad = 3 + int(np.ceil(4 * st.defocus_sigma_px))
         x0 = max(int(np.floor(outline[:, 0].min())) - pad, 0)
@@ -148,9 +148,11 @@ class SyntheticCamera:
             image += rng.standard_normal(image.shape, dtype=np.float32) * np.float32(
                 st.noise_sigma_dn
             )
-        return np.clip(np.rint(image), 0, 255).astype(np.uint8)
+        return np.asarray(np.clip(np.rint(image), 0, 255), dtype=np.uint8)
 
-    def _render_roi(self, poses: np.ndarray, x0: int, y0: int, width: int, height: int):
+    def _render_roi(
+        self, poses: np.ndarray, x0: int, y0: int, width: int, height: int
+    ) -> np.ndarray:
         s = self._settings.supersample
         # Ideal pixel (u, v) -> supersampled pixel s (u - x0 + 0.5) - 0.5 of the region, so
         # that averaging s x s blocks puts each block's mean at the ideal pixel's centre.

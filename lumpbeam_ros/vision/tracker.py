@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from enum import Enum
+from typing import Any
 
 import cv2
 import numpy as np
@@ -24,7 +25,7 @@ import numpy as np
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.vision.calibration import RigCalibration, calibrate_rig
 from lumpbeam_ros.vision.camera_model import CameraInfo
-from lumpbeam_ros.vision.config import CameraConfig
+from lumpbeam_ros.vision.config import CameraConfig, RigGeometry
 from lumpbeam_ros.vision.corners import (
     corner_contrast,
     grid_is_regular,
@@ -113,7 +114,7 @@ class TrackResult:
         return self.status is TrackStatus.OK
 
 
-def _failure(stamp: float, status: TrackStatus, reason: str, **extra) -> TrackResult:
+def _failure(stamp: float, status: TrackStatus, reason: str, **extra: Any) -> TrackResult:
     return TrackResult(stamp, status, reason, **extra)
 
 
@@ -148,7 +149,7 @@ class TipTracker:
         self._pending: list[tuple[np.ndarray, np.ndarray]] = []
         self.reset()
 
-    def _set_rig(self, rig) -> None:
+    def _set_rig(self, rig: RigGeometry) -> None:
         self._model = PlaneModel(rig, self.camera_info)
         self._free = FreeModel(rig, self.camera_info)
         centre = rig.base_board.translation
@@ -436,7 +437,7 @@ class TipTracker:
             self._pending.append((ideal, fit.pose))
             if len(self._pending) >= self.settings.calibration_frames:
                 self._calibrate()
-            elif len(self._pending) == 1:
+            elif len(self._pending) == 1 and isinstance(fit, PlaneFit):
                 fit = self._calibrate_depth(ideal, fit)
         pose, covariance, pose6, covariance6 = fit.pose, fit.covariance, None, None
         if self.pose_model == 'free':

@@ -86,7 +86,9 @@ class ValidationCase:
         )
 
 
-def _rpy_mount(base: tuple[float, ...], tilt_deg: tuple[float, float]) -> tuple[float, ...]:
+def _rpy_mount(
+    base: tuple[float, float, float], tilt_deg: tuple[float, float]
+) -> tuple[float, float, float]:
     # Roll about the tip's x tilts the optical axis up/down; yaw about z turns it sideways.
     return (base[0] + math.radians(tilt_deg[0]), base[1], base[2] + math.radians(tilt_deg[1]))
 
@@ -107,7 +109,8 @@ def case_setup(case: ValidationCase) -> tuple[CameraInfo, CameraConfig, RaycastC
         case.model,
     )  # fmt: skip
     mount_xyz, mount_rpy = (0.0, 0.05, 0.0), (-math.pi / 2, 0.0, 0.0)
-    board_xyz = tuple(float(v) for v in base.rig.base_board.translation)
+    board_x, board_y, board_z = (float(v) for v in base.rig.base_board.translation)
+    board_xyz = (board_x, board_y, board_z)
     mount_rpy = _rpy_mount(mount_rpy, case.mount_tilt_deg)
     # Pitch about beam_base y is the board's normal: an in-plane rotation.
     board_rpy = (-math.pi / 2, math.radians(case.board_rotation_deg), 0.0)
@@ -127,7 +130,7 @@ def case_setup(case: ValidationCase) -> tuple[CameraInfo, CameraConfig, RaycastC
     )  # fmt: skip
     scene = Scene(
         board.squares_x, board.squares_y, board.square_size_m, board.margin_squares,
-        mount_xyz, mount_rpy, board_xyz, board_rpy,  # type: ignore[arg-type]
+        mount_xyz, mount_rpy, board_xyz, board_rpy,
     )  # fmt: skip
     optics = Optics(
         defocus_px=case.defocus_px, gradient=case.gradient, flicker=case.flicker,

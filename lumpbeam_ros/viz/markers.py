@@ -169,7 +169,7 @@ def joint_positions(segment_length_m: float, phi: np.ndarray) -> np.ndarray:
 
 def load_cube_side_m(load_kg: float) -> float:
     """Edge of the steel cube that weighs ``load_kg``, m."""
-    return (load_kg / STEEL_DENSITY_KG_M3) ** (1.0 / 3.0)
+    return float((load_kg / STEEL_DENSITY_KG_M3) ** (1.0 / 3.0))
 
 
 def board_placement(config: CameraConfig) -> BoardPlacement:
@@ -193,7 +193,9 @@ def board_placement(config: CameraConfig) -> BoardPlacement:
     )
 
 
-def _tip_marker(namespace: str, tip: TipPoint, color: tuple, lifetime_s: float) -> MarkerSpec:
+def _tip_marker(
+    namespace: str, tip: TipPoint, color: tuple[float, float, float, float], lifetime_s: float
+) -> MarkerSpec:
     return MarkerSpec(
         namespace,
         0,

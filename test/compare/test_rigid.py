@@ -3,13 +3,13 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from lumpbeam_ros.compare.rigid import (
-    RigidTransform,
     check_rotation_observable,
     fit_rigid,
     point_spread,
     skew,
 )
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.transforms import RigidTransform
 
 RNG = np.random.default_rng(5)
 

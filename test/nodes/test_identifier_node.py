@@ -17,6 +17,7 @@ from lumpbeam_ros.bagio import read_tip_poses
 from lumpbeam_ros.bagio.convert import pitch_to_quaternion
 from lumpbeam_ros.cli.analyze import read_window
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ident.bag import analyze_bag
 from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.identify import identify
 from lumpbeam_ros.interface import IDENTIFIER_STATUS as STATUS_NAME
@@ -26,7 +27,6 @@ from lumpbeam_ros.model.modes import chain_modes
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.model.statics import static_tip_deflection
 from lumpbeam_ros.nodes.identifier_node import IdentifierNode
-from lumpbeam_ros.pipeline.bag_analysis import analyze_bag
 from lumpbeam_ros.resources import config_path
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 

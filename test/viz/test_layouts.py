@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from lumpbeam_ros.bagio import BagReader, BagWriter
-from lumpbeam_ros.pipeline import demo
+from lumpbeam_ros.demo import steps
 from lumpbeam_ros.resources import config_path
 from lumpbeam_ros.viz.layouts import (
     check_uses,
@@ -31,9 +31,11 @@ PLANNED = set(re.findall(r'`(/[\w/]+)` \(planned\)', (ROOT / 'doc' / 'interfaces
 def demo_bag(tmp_path_factory):
     """The demo's sim-time recording of a short run: synthesize, replay, normalize."""
     out = tmp_path_factory.mktemp('demo')
-    options = demo.DemoOptions(out=out, duration_s=3.5, image_size=None, effects={})
-    steps = [(n, f) for n, f in demo.default_steps() if n in ('synthesize', 'replay', 'normalize')]
-    run = demo.run_demo(options, steps, echo=lambda _line: None)
+    options = steps.DemoOptions(out=out, duration_s=3.5, image_size=None, effects={})
+    wanted = [
+        (n, f) for n, f in steps.default_steps() if n in ('synthesize', 'replay', 'normalize')
+    ]
+    run = steps.run_demo(options, wanted, echo=lambda _line: None)
     return run.normalized_bag
 
 

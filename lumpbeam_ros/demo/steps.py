@@ -13,8 +13,8 @@
 4. ``normalize``: the recording with every message logged at its sim time.
 5. ``analyze``: offline identification of the recorded ``/tip_pose`` and ``/tip_load``, and
    the prediction residual.
-6. ``diagnose`` (when ``lumpbeam diagnose`` is installed): the model-discrepancy workflow on
-   the recording.
+6. ``diagnose``: the model-discrepancy workflow on the recording, in this process (as
+   ``lumpbeam diagnose`` runs it: the same JSON and figures).
 7. ``figures`` and ``summary``: measured against predicted (Figs. B.8-B.10), the table.
 
 Each step is a function of the :class:`DemoRun` it fills in; :func:`default_steps` lists them,
@@ -24,7 +24,6 @@ so a step can be added or swapped without touching the others.
 from __future__ import annotations
 
 import importlib.util
-import json
 import math
 import shutil
 import time
@@ -34,6 +33,25 @@ from pathlib import Path
 from typing import Any
 
 from lumpbeam_ros.bagio import BagReader, read_tip_poses
+from lumpbeam_ros.demo.analysis import (
+    RecordingAnalysis,
+    analyze_recording,
+    live_value,
+    normalize_recording,
+    prediction_lag,
+)
+from lumpbeam_ros.demo.graph import (
+    ProcessGraph,
+    node_command,
+    python_command,
+    wait_for_graph,
+    wait_for_quiet,
+)
+from lumpbeam_ros.demo.live_diagnosis import (
+    live_diagnosis,
+    live_diagnosis_lines,
+    wait_for_verdict,
+)
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.interface import (
     BEAM_MARKERS,
@@ -56,28 +74,10 @@ from lumpbeam_ros.interface import (
     TIP_POSE,
     TIP_POSE_PREDICTED,
 )
+from lumpbeam_ros.json_output import plain_json, write_json
 from lumpbeam_ros.model.adopt import first_mode
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, load_beam_config
 from lumpbeam_ros.nodes.counts import COUNTS_DIR_ENV, read_counts
-from lumpbeam_ros.pipeline.analysis import (
-    RecordingAnalysis,
-    analyze_recording,
-    live_value,
-    normalize_recording,
-    prediction_lag,
-)
-from lumpbeam_ros.pipeline.graph import (
-    ProcessGraph,
-    node_command,
-    python_command,
-    wait_for_graph,
-    wait_for_quiet,
-)
-from lumpbeam_ros.pipeline.live_diagnosis import (
-    live_diagnosis,
-    live_diagnosis_lines,
-    wait_for_verdict,
-)
 from lumpbeam_ros.viz.markers import MARKERS_TOPIC
 
 SIMULATOR_MODULE = 'lumpbeam_ros.nodes.simulator_node'
@@ -90,7 +90,6 @@ DIAGNOSIS_NODE_MODULE = 'lumpbeam_ros.nodes.diagnosis_node'
 LIVE_DECAY_S = 2.3
 #: Longest wait after the replay for the live diagnosis (tens of seconds on a busy machine).
 VERDICT_WAIT_S = 120.0
-DIAGNOSE_MODULE = 'lumpbeam_ros.cli.diagnose'
 CLI_MODULE = 'lumpbeam_ros.cli.main'
 IMAGE_TOPIC = IMAGE
 CAMERA_INFO_TOPIC = CAMERA_INFO
@@ -194,7 +193,7 @@ class DemoRun:
         image_counts: Camera frames offered by the player, received and tracked by the camera
             node (empty without the camera).
         analysis: The offline analysis.
-        diagnosis: ``lumpbeam diagnose``'s JSON result, when it ran.
+        diagnosis: The diagnosis as ``lumpbeam diagnose`` writes it (JSON), when it ran.
         figures: Written figures.
         summary: The machine-readable summary (also ``summary.json``).
         step_seconds: Wall time of each step, s.
@@ -433,25 +432,18 @@ def analyze(run: DemoRun) -> None:
 
 
 def diagnose(run: DemoRun) -> None:
-    """Runs ``lumpbeam diagnose`` on the recording (a child process, its JSON kept)."""
-    import subprocess
+    """Diagnoses the recording as ``lumpbeam diagnose`` does; its JSON and figures are kept."""
+    from lumpbeam_ros.diagnose.record import read_record
+    from lumpbeam_ros.diagnose.workflow import diagnose as diagnose_record
+    from lumpbeam_ros.plots.diagnosis import plot_diagnosis
 
-    out_json = run.out / 'diagnosis.json'
-    command = python_command(
-        CLI_MODULE,
-        'diagnose',
-        str(run.normalized_bag),
-        '--json',
-        str(out_json),
-        '--plots',
-        str(run.out / 'figures'),
-    )
-    log = run.log_dir / 'diagnose.log'
-    with log.open('wb') as handle:
-        code = subprocess.run(command, stdout=handle, stderr=subprocess.STDOUT, check=False)
-    if code.returncode != 0:
-        raise LumpbeamError(f'lumpbeam diagnose failed with code {code.returncode} (log: {log})')
-    run.diagnosis = json.loads(out_json.read_text(encoding='utf-8'))
+    record = read_record(run.normalized_bag)
+    for note in record.notes:
+        run.echo(f'  warning: {note}')
+    result = diagnose_record(record, run.beam)
+    run.diagnosis = plain_json(result.as_dict())
+    write_json(run.out / 'diagnosis.json', run.diagnosis)
+    plot_diagnosis(result, run.out / 'figures')
 
 
 def figures(run: DemoRun) -> None:
@@ -563,8 +555,6 @@ def summarize(run: DemoRun) -> None:
         run.summary['live_diagnosis'] = live
     for line in summary_lines(run.summary):
         run.echo(line)
-    from lumpbeam_ros.cli.output import write_json
-
     write_json(run.out / 'summary.json', run.summary)
 
 
@@ -629,18 +619,17 @@ def diagnosis_lines(diagnosis: dict[str, Any]) -> list[str]:
 
 
 def default_steps() -> list[Step]:
-    """The demo's steps, in order (``diagnose`` only when ``lumpbeam diagnose`` exists)."""
-    steps: list[Step] = [
+    """The demo's steps, in order."""
+    return [
         ('synthesize', synthesize),
         ('replay', replay),
         ('count', count),
         ('normalize', normalize),
         ('analyze', analyze),
+        ('diagnose', diagnose),
+        ('figures', figures),
+        ('summary', summarize),
     ]
-    if module_available(DIAGNOSE_MODULE):
-        steps.append(('diagnose', diagnose))
-    steps += [('figures', figures), ('summary', summarize)]
-    return steps
 
 
 def run_demo(

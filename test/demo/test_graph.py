@@ -4,9 +4,8 @@ import time
 
 import pytest
 
-from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.pipeline import graph as graph_module
-from lumpbeam_ros.pipeline.graph import (
+from lumpbeam_ros.demo import graph as graph_module
+from lumpbeam_ros.demo.graph import (
     DOMAIN_IDS,
     ProcessGraph,
     node_command,
@@ -15,6 +14,7 @@ from lumpbeam_ros.pipeline.graph import (
     wait_for_graph,
     wait_for_quiet,
 )
+from lumpbeam_ros.errors import LumpbeamError
 
 
 def _python(code):
@@ -137,9 +137,10 @@ def test_wait_for_graph_sees_a_node_child(tmp_path):
         # stop it before it says it is ready.
         log = tmp_path / 'simulator.log'
         deadline = time.monotonic() + 30.0
-        while 'simulator ready' not in log.read_text() and time.monotonic() < deadline:
+        while 'simulation started' not in log.read_text() and time.monotonic() < deadline:
             time.sleep(0.1)
-        # It keeps publishing on wall time: never quiet, the wait ends at its timeout.
+        # It keeps publishing on wall time from then on: never quiet, the wait ends at its
+        # timeout.
         heard = wait_for_quiet(
             graph, {'/tip_pose_predicted': 'geometry_msgs/msg/PoseStamped'}, 0.5, 5.0
         )

@@ -17,8 +17,8 @@ import numpy as np
 
 from lumpbeam_ros.bagio import BagReader
 from lumpbeam_ros.bagio.series import read_diagnostics
+from lumpbeam_ros.demo.graph import ProcessGraph
 from lumpbeam_ros.interface import DIAGNOSIS_STATUS, MODEL_DISCREPANCY
-from lumpbeam_ros.pipeline.graph import ProcessGraph
 from lumpbeam_ros.plots.demo import Residual
 
 TOPIC = MODEL_DISCREPANCY

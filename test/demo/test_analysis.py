@@ -2,15 +2,15 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.bagio import BagWriter, convert, read_load_events
-from lumpbeam_ros.errors import BagError
-from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
-from lumpbeam_ros.model.simulate import simulate_drop_test
-from lumpbeam_ros.pipeline.analysis import (
+from lumpbeam_ros.demo.analysis import (
     analyze_recording,
     clock_time,
     last_live_status,
     normalize_recording,
 )
+from lumpbeam_ros.errors import BagError
+from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
+from lumpbeam_ros.model.simulate import simulate_drop_test
 
 WALL = 1_700_000_000.0  # the recorder logs in wall time; the poses carry sim time
 BEAM = BeamParameters()
