@@ -18,10 +18,11 @@ export PYTHONDONTWRITEBYTECODE :=
 
 .PHONY: venv demo test test-slow lint bench clean
 
+# One pip run: the venv's own pip installs these wheels as well as a newer one would, so it
+# is not upgraded first (a download and a reinstall saved on every fresh clone).
 $(STAMP): setup.py setup.cfg package.xml requirements.txt requirements-dev.txt
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -r requirements-dev.txt
+	$(BIN)/python -m pip install -q --disable-pip-version-check -r requirements-dev.txt
 	@touch $@
 
 venv: $(STAMP)
@@ -29,13 +30,20 @@ venv: $(STAMP)
 demo: venv
 	$(BIN)/lumpbeam demo --out results
 
+# The suite mostly waits (ROS discovery, child processes), so it runs in parallel workers
+# (pytest-xdist), one per core and at most 4. Each ROS test claims a domain no other worker
+# holds (test/harness.py); a module whose tests share one costly fixture is one xdist_group,
+# so only one worker builds it. PYTEST_WORKERS=0 runs everything in this process.
+PYTEST_WORKERS ?= auto
+PYTEST_PARALLEL := -n $(PYTEST_WORKERS) --maxprocesses=4 --dist loadgroup
+
 test: venv
 	$(BIN)/ruff check .
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest $(PYTEST_PARALLEL)
 
 # The long validation matrices (marked slow): CI runs them after `make test`.
 test-slow: venv
-	$(BIN)/python -m pytest -m slow
+	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -m slow
 
 lint: venv
 	$(BIN)/ruff check .
