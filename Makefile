@@ -32,10 +32,10 @@ demo: venv
 
 # The suite mostly waits (ROS discovery, child processes), so it runs in parallel workers
 # (pytest-xdist), one per core and at most 4. Each ROS test claims a domain no other worker
-# holds (test/harness.py); a module whose tests share one costly fixture is one xdist_group,
-# so only one worker builds it. PYTEST_WORKERS=0 runs everything in this process.
+# holds (test/harness.py). A test module goes to one worker whole (loadscope), so a costly
+# module fixture is built once. PYTEST_WORKERS=0 runs everything in this process.
 PYTEST_WORKERS ?= auto
-PYTEST_PARALLEL := -n $(PYTEST_WORKERS) --maxprocesses=4 --dist loadgroup
+PYTEST_PARALLEL := -n $(PYTEST_WORKERS) --maxprocesses=4 --dist loadscope
 
 test: venv
 	$(BIN)/ruff check .

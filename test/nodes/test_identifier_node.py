@@ -285,7 +285,7 @@ def test_main_takes_the_params_file_and_rejects_a_bad_one(ros_graph, tmp_path):
     good = [*command, '--params-file', str(config_path('identifier.yaml'))]
     process = subprocess.Popen([*good, '-p', 'publish_rate_hz:=10.0'], env=env)
     try:
-        assert ros_graph.spin_until(lambda: len(params) >= 2, 15.0)
+        assert ros_graph.spin_until(lambda: len(params) >= 2, 60.0)
     finally:
         process.terminate()
         process.wait(10)
