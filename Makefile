@@ -43,9 +43,12 @@ test: venv
 	$(BIN)/ruff check .
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL)
 
-# The long validation matrices (marked slow): CI runs them after `make test`.
+# The long validation matrices (marked slow): CI runs them after `make test`. The computing
+# ones run in parallel; the live graphs among them (marked ros) then run alone, on a machine
+# no other worker keeps busy (best-effort camera frames, replays at their rate).
 test-slow: venv
-	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -m slow
+	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -m 'slow and not ros'
+	$(BIN)/python -m pytest -m 'slow and ros'
 
 lint: venv
 	$(BIN)/ruff check .

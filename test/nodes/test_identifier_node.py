@@ -183,6 +183,7 @@ def test_replayed_drop_test_gives_ok_estimates(ros_graph, drop_record, arrival):
 
 
 @pytest.mark.slow
+@pytest.mark.ros
 @pytest.mark.parametrize('rate', list(RATES))
 @pytest.mark.parametrize('arrival', list(ARRIVALS))
 def test_release_matrix_of_arrivals_and_rates(ros_graph, drop_record, arrival, rate):
