@@ -1,4 +1,4 @@
 """Shared fixtures: the launch-free ROS graph of :mod:`harness`, ``mcap doctor``."""
 
-from harness import ros_graph  # noqa: F401  (registers the fixture for every test)
+from harness import ros_domain_id, ros_graph  # noqa: F401  (registers the fixtures for every test)
 from mcap_doctor import mcap_doctor  # noqa: F401  (registers the fixture for every test)

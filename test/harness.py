@@ -1,8 +1,9 @@
 """Launch-free fixtures for tests that run real ROS 2 nodes in the test process.
 
-Every test gets its own ``rclpy`` Context on its own ROS domain, so tests never see each
-other's topics, even when pytest runs several processes at once, and no ``launch`` or
-daemon is needed. Discovery stays on this machine (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``).
+Every test gets its own ``rclpy`` Context on its own ROS domain, claimed for the test's
+duration (:mod:`lumpbeam_ros.ros_domain`), so tests never see each other's topics, even when
+pytest-xdist runs them in several workers at once, and no ``launch`` or daemon is needed.
+Discovery stays on this machine (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``).
 
 Use it from any test (``test/conftest.py`` registers the fixture)::
 
@@ -17,12 +18,12 @@ Use it from any test (``test/conftest.py`` registers the fixture)::
 
 The camera, identifier and simulator node tests reuse it. A node under test must accept a
 ``context`` (``rclpy.node.Node(name, context=...)``). ``ros_graph.domain_id`` is also what a
-node started as a subprocess needs (``env={'ROS_DOMAIN_ID': ...}``, see :func:`ros_env`).
+node started as a subprocess needs (``env={'ROS_DOMAIN_ID': ...}``, see :func:`ros_env`); a
+test without a graph that needs a domain of its own takes the ``ros_domain_id`` fixture.
 """
 
 from __future__ import annotations
 
-import itertools
 import os
 import time
 from collections.abc import Callable, Iterator
@@ -36,15 +37,16 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, qos_profile_sensor_data
 
+from lumpbeam_ros.ros_domain import PRIVATE_DOMAIN_IDS, DomainClaim, claim_domain_id
+
 # Fast DDS maps domain ids to UDP ports; 0..101 and 215..232 are valid on Linux for any
 # number of participants. Domain 0 is left to a developer's own ROS graph.
-_DOMAINS = [*range(1, 102), *range(215, 233)]
-_counter = itertools.count()
+TEST_DOMAIN_IDS = [*PRIVATE_DOMAIN_IDS, *range(215, 233)]
 
 
-def next_domain_id() -> int:
-    """Returns a domain id unique to this process and call (pid-based, cycling)."""
-    return _DOMAINS[(os.getpid() * 7 + next(_counter)) % len(_DOMAINS)]
+def claim_test_domain() -> DomainClaim:
+    """Claims a domain of :data:`TEST_DOMAIN_IDS` that no other process holds."""
+    return claim_domain_id(TEST_DOMAIN_IDS)
 
 
 def ros_env(domain_id: int, root: Path | None = None) -> dict[str, str]:
@@ -164,8 +166,16 @@ def ros_graph(monkeypatch: pytest.MonkeyPatch) -> Iterator[RosGraph]:
     log_dir = Path.cwd() / '.cache' / 'ros' / 'log'
     log_dir.mkdir(parents=True, exist_ok=True)
     monkeypatch.setenv('ROS_LOG_DIR', str(log_dir))
-    graph = RosGraph(next_domain_id())
-    try:
-        yield graph
-    finally:
-        graph.shutdown()
+    with claim_test_domain() as claim:
+        graph = RosGraph(claim.domain_id)
+        try:
+            yield graph
+        finally:
+            graph.shutdown()
+
+
+@pytest.fixture
+def ros_domain_id() -> Iterator[int]:
+    """A domain id held for one test, for ROS code the test does not give a context to."""
+    with claim_test_domain() as claim:
+        yield claim.domain_id

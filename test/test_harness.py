@@ -2,7 +2,7 @@ import os
 import subprocess
 import sys
 
-from harness import next_domain_id, ros_env
+from harness import claim_test_domain, ros_env
 from std_msgs.msg import Float64
 
 
@@ -17,7 +17,10 @@ def test_round_trip_through_a_private_graph(ros_graph):
 
 
 def test_domains_are_distinct_and_valid():
-    ids = [next_domain_id() for _ in range(50)]
+    claims = [claim_test_domain() for _ in range(50)]
+    ids = [c.domain_id for c in claims]
+    for claim in claims:
+        claim.release()
     assert len(set(ids)) == 50
     assert all(1 <= i <= 101 or 215 <= i <= 232 for i in ids)
 
@@ -32,10 +35,10 @@ def test_a_subprocess_on_another_domain_is_not_seen(ros_graph, tmp_path):
         'for _ in range(15):\n'
         '    pub.publish(Float64(data=1.0)); time.sleep(0.05)\n'
     )
-    other = ros_graph.domain_id % 100 + 1
-    env = ros_env(other, tmp_path)
-    proc = subprocess.Popen([sys.executable, '-c', script], env=env)
-    ros_graph.spin_until(lambda: proc.poll() is not None, timeout=10.0)
+    with claim_test_domain() as other:  # held, so no other test's graph is on it
+        env = ros_env(other.domain_id, tmp_path)
+        proc = subprocess.Popen([sys.executable, '-c', script], env=env)
+        ros_graph.spin_until(lambda: proc.poll() is not None, timeout=60.0)
     assert proc.returncode == 0
     assert got == []
     assert os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE') == 'LOCALHOST'

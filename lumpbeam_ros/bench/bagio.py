@@ -14,7 +14,6 @@
 
 from __future__ import annotations
 
-import os
 import shutil
 import tempfile
 import time
@@ -26,6 +25,7 @@ from lumpbeam_ros.bagio import BagReader, BagWriter, convert
 from lumpbeam_ros.bagio.typestore import serialize
 from lumpbeam_ros.bench.result import BenchResult
 from lumpbeam_ros.interface import BASE_FRAME, IMAGE, IMAGE_TYPE, POSE_STAMPED, TIP_POSE
+from lumpbeam_ros.ros_domain import claim_domain_id
 
 FPS = 180.0
 SIDE = 1024
@@ -115,8 +115,9 @@ def _play_benchmark(quick: bool) -> BenchResult:
     t = np.arange(0.0, seconds, 1.0 / FPS)
     tmp = Path(tempfile.mkdtemp(prefix='lumpbeam-bench-'))
     context = Context()
-    # A private domain: the benchmark must not publish into a user's graph.
-    rclpy.init(context=context, domain_id=100 + os.getpid() % 2)
+    # A private domain: the benchmark must not publish into a user's graph or another run's.
+    claim = claim_domain_id()
+    rclpy.init(context=context, domain_id=claim.domain_id)
     try:
         with BagWriter(tmp / 'poses') as bag:
             for ti in t:
@@ -126,6 +127,7 @@ def _play_benchmark(quick: bool) -> BenchResult:
         player.destroy_node()
     finally:
         rclpy.shutdown(context=context)
+        claim.release()
         shutil.rmtree(tmp, ignore_errors=True)
     baseline = _sleep_until_lateness(t)
     p99 = stats.lateness_percentile_ms(99)

@@ -38,13 +38,11 @@ from lumpbeam_ros.interface import (
     TIP_POSE,
 )
 from lumpbeam_ros.resources import large_frames_profile
+from lumpbeam_ros.ros_domain import claim_domain_id
 
 #: Longest wait for the consumer processes to start and be discovered, s (a node importing
 #: OpenCV and scipy on a busy machine takes a while).
 STARTUP_TIMEOUT_S = 60.0
-#: Domains the bench uses (Fast DDS ports are valid for any participant count; 0 is left to
-#: a developer's own graph, the test harness cycles through the same range).
-_DOMAINS = (*range(1, 102), *range(215, 233))
 
 
 @dataclass(frozen=True)
@@ -219,7 +217,8 @@ def measure(
 
     from lumpbeam_ros.nodes.endpoints import subscription
 
-    domain = _DOMAINS[(os.getpid() * 13 + int(time.time())) % len(_DOMAINS)]
+    claim = claim_domain_id()  # held until every process of the run is gone
+    domain = claim.domain_id
     env = _env(domain, large_frames)
     context = Context()
     rclpy.init(context=context, domain_id=domain)
@@ -289,6 +288,7 @@ def measure(
         executor.shutdown()
         node.destroy_node()
         rclpy.shutdown(context=context)
+        claim.release()
     return StreamFigures(
         int(result['published']),
         len(latencies),

@@ -459,7 +459,7 @@ def add_demo(subparsers: Subparsers) -> argparse.ArgumentParser:
     parser.add_argument(
         '--adopt', action='store_true', help='the simulator adopts the live identified values'
     )
-    parser.add_argument('--domain-id', type=int, help='ROS domain (default: a random one)')
+    parser.add_argument('--domain-id', type=int, help='ROS domain (default: a free one)')
     parser.add_argument('--config', type=Path, help='beam parameter file')
     parser.add_argument('--json', type=Path, help='also write the summary here')
     parser.add_argument(

@@ -10,7 +10,6 @@ demo never talks to, or hears, another ROS graph on the machine.
 from __future__ import annotations
 
 import os
-import random
 import signal
 import subprocess
 import sys
@@ -23,21 +22,16 @@ from typing import IO
 
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.resources import large_frames_profile
+from lumpbeam_ros.ros_domain import PRIVATE_DOMAIN_IDS, claim_domain_id
 
-# Fast DDS maps domain ids to UDP ports; 1..101 are valid on Linux for any number of
-# participants. 0 is left to the user's own graph.
-DOMAIN_IDS = range(1, 102)
+#: The domains a graph may use (see :mod:`lumpbeam_ros.ros_domain`).
+DOMAIN_IDS = PRIVATE_DOMAIN_IDS
 #: How long an interrupted child may take to stop before it is killed, s.
 STOP_GRACE_S = 10.0
 #: Longest a probe waits to discover a publisher before taking it as gone, s.
 DISCOVERY_ALLOWANCE_S = 10.0
 #: Lines of a failed child's log quoted in the error.
 LOG_TAIL_LINES = 5
-
-
-def pick_domain_id() -> int:
-    """Returns a domain id from :data:`DOMAIN_IDS`, different between runs and processes."""
-    return random.Random(os.getpid() ^ time.time_ns()).choice(DOMAIN_IDS)
 
 
 def python_command(module: str, *args: str) -> list[str]:
@@ -89,7 +83,8 @@ class ProcessGraph:
 
     Args:
         log_dir: Folder for the children's logs (created).
-        domain_id: ROS domain; a free-looking one from :func:`pick_domain_id` when ``None``.
+        domain_id: ROS domain; when ``None``, one that no other lumpbeam process holds,
+            claimed until :meth:`close` (:func:`~lumpbeam_ros.ros_domain.claim_domain_id`).
         ros_home: ``ROS_HOME`` (and ``ROS_LOG_DIR`` under it) of the children; ``log_dir``'s
             ``ros`` subfolder when ``None``.
     """
@@ -97,7 +92,8 @@ class ProcessGraph:
     def __init__(self, log_dir: Path, domain_id: int | None = None, ros_home: Path | None = None):
         self.log_dir = Path(log_dir)
         self.log_dir.mkdir(parents=True, exist_ok=True)
-        self.domain_id = pick_domain_id() if domain_id is None else int(domain_id)
+        self._claim = claim_domain_id(DOMAIN_IDS) if domain_id is None else None
+        self.domain_id = self._claim.domain_id if self._claim else int(domain_id)
         home = ros_home or self.log_dir / 'ros'
         self.env = dict(os.environ)
         self.env.update(
@@ -223,6 +219,8 @@ class ProcessGraph:
                 child.process.wait()
         for child in self.children.values():
             child._log.close()
+        if self._claim is not None:
+            self._claim.release()
 
     @staticmethod
     def _exit_code(child: Child) -> int:

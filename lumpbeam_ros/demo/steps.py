@@ -155,7 +155,7 @@ class DemoOptions:
         duration_s: Length of the synthetic record, s (the load drops at 2 s).
         seed: Seed of the pose noise.
         adopt_identified: Let the simulator adopt the identifier's live estimates.
-        domain_id: ROS domain of the graph; a random private one when ``None``.
+        domain_id: ROS domain of the graph; when ``None``, one no other lumpbeam process holds.
         beam_config: Beam parameter file (the package's paper_beam.yaml when ``None``).
         ready_timeout_s: Longest wait for the nodes to join the graph, s.
         image_size: Width and height of the synthetic camera's frames; ``None`` plays the

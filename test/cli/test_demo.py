@@ -104,6 +104,7 @@ def test_summary_table_reads_back_from_json():
 # Best-effort camera frames: how many a machine tracks depends on its load (the bench measures
 # it); the suite on a quiet machine (make test-slow, in CI) runs the whole camera path.
 @pytest.mark.slow
+@pytest.mark.ros
 def test_demo_tracks_images_and_names_the_hidden_latency(tmp_path, capsys):
     # The default demo: camera frames through the camera node, and a 15 ms camera latency
     # hidden in the data for the diagnosis step.

@@ -111,10 +111,8 @@ def test_bad_invocations_print_one_line(tmp_path, short_bag, capsys, argv, match
     assert match in err and '\n' not in err
 
 
-def test_play_command_end_to_end(short_bag, capsys, monkeypatch):
-    from harness import next_domain_id
-
-    monkeypatch.setenv('ROS_DOMAIN_ID', str(next_domain_id()))
+def test_play_command_end_to_end(short_bag, capsys, monkeypatch, ros_domain_id):
+    monkeypatch.setenv('ROS_DOMAIN_ID', str(ros_domain_id))
     assert main(['play', str(short_bag), '--rate', '5', '--delay', '0.1']) == 0
     out = capsys.readouterr().out
     assert 'played' in out and '64 messages' in out

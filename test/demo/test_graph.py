@@ -9,12 +9,12 @@ from lumpbeam_ros.demo.graph import (
     DOMAIN_IDS,
     ProcessGraph,
     node_command,
-    pick_domain_id,
     python_command,
     wait_for_graph,
     wait_for_quiet,
 )
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ros_domain import claim_domain_id
 
 
 def _python(code):
@@ -122,7 +122,7 @@ def test_wait_for_graph_names_what_is_missing(tmp_path):
 
 
 def test_wait_for_graph_sees_a_node_child(tmp_path):
-    with ProcessGraph(tmp_path, domain_id=pick_domain_id()) as graph:
+    with ProcessGraph(tmp_path) as graph:
         graph.start(
             'simulator', node_command('lumpbeam_ros.nodes.simulator_node', '-p', 'rate_hz:=50.0')
         )
@@ -151,7 +151,7 @@ def test_wait_for_graph_sees_a_node_child(tmp_path):
 
 def test_wait_for_quiet_returns_on_a_topic_without_publisher(tmp_path, monkeypatch):
     monkeypatch.setattr(graph_module, 'DISCOVERY_ALLOWANCE_S', 0.2)
-    with ProcessGraph(tmp_path, domain_id=pick_domain_id()) as graph:
+    with ProcessGraph(tmp_path) as graph:
         heard = wait_for_quiet(graph, {'/nobody': 'std_msgs/msg/Float64'}, 0.2, 60.0)
     assert heard == {'/nobody': 0}
 
@@ -161,5 +161,15 @@ def test_commands_and_domain_ids():
     command = node_command('pkg.node', '-p', 'x:=1')
     assert command[:2] == [sys.executable, '-c'] and 'from pkg.node import main' in command[2]
     assert command[3:] == ['--ros-args', '-p', 'x:=1']
-    assert all(pick_domain_id() in DOMAIN_IDS for _ in range(50))
     assert 0 not in DOMAIN_IDS and graph_module.STOP_GRACE_S > 0
+
+
+def test_graphs_open_together_hold_different_domains_until_closed(tmp_path):
+    with ProcessGraph(tmp_path / 'a') as first, ProcessGraph(tmp_path / 'b') as second:
+        assert first.domain_id != second.domain_id
+        assert {first.domain_id, second.domain_id} <= set(DOMAIN_IDS)
+        held = first.domain_id
+    with claim_domain_id([held]) as claim:  # closing the graph freed its domain
+        assert claim.domain_id == held
+    with ProcessGraph(tmp_path / 'c', domain_id=held) as given:
+        assert given.domain_id == held

@@ -186,6 +186,7 @@ def test_replayed_drop_test_gives_ok_estimates(ros_graph, drop_record, arrival):
 
 
 @pytest.mark.slow
+@pytest.mark.ros
 @pytest.mark.parametrize('rate', list(RATES))
 @pytest.mark.parametrize('arrival', list(ARRIVALS))
 def test_release_matrix_of_arrivals_and_rates(ros_graph, drop_record, arrival, rate):
@@ -288,7 +289,7 @@ def test_main_takes_the_params_file_and_rejects_a_bad_one(ros_graph, tmp_path):
     good = [*command, '--params-file', str(config_path('identifier.yaml'))]
     process = subprocess.Popen([*good, '-p', 'publish_rate_hz:=10.0'], env=env)
     try:
-        assert ros_graph.spin_until(lambda: len(params) >= 2, 15.0)
+        assert ros_graph.spin_until(lambda: len(params) >= 2, 60.0)
     finally:
         process.terminate()
         process.wait(10)

@@ -66,25 +66,36 @@ def test_publishes_at_the_rate_from_the_loaded_equilibrium(ros_graph):
 
 
 def test_drop_oscillates_about_the_unloaded_level_at_the_first_mode(ros_graph):
-    got = ros_graph.collect('/tip_pose_predicted', PoseStamped, 500)
+    got = ros_graph.collect('/tip_pose_predicted', PoseStamped, 2000)
     node = _start(ros_graph)
     ros_graph.publish('/tip_load', Float64(data=4.5), LATCHED)  # the first reading: at rest
     assert ros_graph.spin_until(lambda: node.stream is not None and node.stream.load_kg == 4.5)
     ros_graph.spin_for(0.3)
+    # The load change is applied at the clock's time on arrival: after the last tick before
+    # it was sent and not after the tick that applied it (ticks come late on a busy machine).
+    earliest = node.stream.time
     ros_graph.publish('/tip_load', Float64(data=0.0), LATCHED)
-    assert ros_graph.spin_until(lambda: node.stream.load_kg == 0.0, 5.0)
-    release = node.stream.time  # the load change is applied at the clock's time on arrival
-    ros_graph.spin_for(2.5)
+    assert ros_graph.spin_until(lambda: node.stream.load_kg == 0.0, 30.0)
+    latest = node.stream.time
+    received_until = lambda: _columns(got[-1:])[0][0] if got else -math.inf  # noqa: E731
+    assert ros_graph.spin_until(lambda: received_until() > latest + 2.5, 60.0)
     t, z, _ = _columns(got)
+    # The arrival instant within those bounds that the batch simulation below agrees with.
+    candidates = [*np.arange(earliest, latest, 5e-3), latest]
+    loaded = t[t > earliest - 0.6]
+
+    def mismatch(when):
+        ref = simulate_loads(node.beam, loaded, [(when, 0.0)], 4.5)
+        return np.max(np.abs(ref.z - z[t > earliest - 0.6]))
+
+    release = min(candidates, key=mismatch)
     before, after = z[t < release - 0.01], z[t > release + 0.5]
     assert before[-1] == pytest.approx(-0.0694, abs=5e-4)
     assert 0.5 * (after.max() + after.min()) == pytest.approx(-0.029, abs=1.5e-3)
     crossings = t[t > release + 0.5][np.flatnonzero(np.diff(np.sign(after + 0.0286)) > 0)]
     assert 1 / np.mean(np.diff(crossings)) == pytest.approx(3.06, abs=0.04)
-    # The same stamps through the batch simulation, released within one tick of `release`.
-    loaded = t[t > release - 0.6]
-    ref = simulate_loads(node.beam, loaded, [(release, 0.0)], 4.5)
-    assert np.max(np.abs(ref.z - z[t > release - 0.6])) < 0.04 * 2 * np.pi * 3.06 * 0.025
+    # The same stamps through the batch simulation, released within 5 ms of the arrival.
+    assert mismatch(release) < 0.04 * 2 * np.pi * 3.06 * 0.025
 
 
 def test_follows_clock_under_sim_time_and_matches_the_batch_simulation(ros_graph):
