@@ -1,7 +1,7 @@
 """A rigid transform between two frames (a sensor's frame and ``beam_base``, doc/interfaces.md).
 
 Shared by the sensor comparison (:mod:`lumpbeam_ros.compare`), which fits one, and the
-synthetic reference tracker (:mod:`lumpbeam_ros.synthetic.tracker`), which places one.
+synthetic reference tracker (:mod:`lumpbeam_ros.synthetic.reference_sensor`), which places one.
 """
 
 from __future__ import annotations

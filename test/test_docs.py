@@ -18,13 +18,13 @@ from pathlib import Path
 
 import pytest
 
-from lumpbeam_ros.bench.result import BenchResult
+from lumpbeam_ros.bench.bench_result import BenchResult
 from lumpbeam_ros.campaign.task import ID_COLUMNS
 from lumpbeam_ros.cli.analyze import CONTRACT_KEYS
 from lumpbeam_ros.cli.main import COMMANDS, build_parser
 from lumpbeam_ros.diagnose.gap import Gap
 from lumpbeam_ros.diagnose.signatures import Signatures
-from lumpbeam_ros.ident.result import Identification, Status
+from lumpbeam_ros.ident.identification import Identification, Status
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS
 from lumpbeam_ros.model.reproduce import Comparison, TableRow
 

@@ -34,9 +34,9 @@ WITHOUT_TEST_MODULE = {
     'vision/offline.py',
     'vision/session.py',
     'vision/sources/frame.py',
-    'viz/live.py',
+    'viz/foxglove_server.py',
     'viz/markers.py',
-    'viz/messages.py',
+    'viz/marker_messages.py',
 }
 
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from lumpbeam_ros.bagio import BagReader, BagWriter, convert
 from lumpbeam_ros.bagio.typestore import serialize
-from lumpbeam_ros.bench.result import BenchResult
+from lumpbeam_ros.bench.bench_result import BenchResult
 from lumpbeam_ros.interface import BASE_FRAME, IMAGE, IMAGE_TYPE, POSE_STAMPED, TIP_POSE
 from lumpbeam_ros.ros_domain import claim_domain_id
 

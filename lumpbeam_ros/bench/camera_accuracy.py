@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from lumpbeam_ros.bench.result import BenchResult
+from lumpbeam_ros.bench.bench_result import BenchResult
 from lumpbeam_ros.vision.accuracy import drop_test_trajectory
 from lumpbeam_ros.vision.validation import (
     Z_RMS_LIMIT_UM,

@@ -17,13 +17,13 @@ import tempfile
 import time
 from pathlib import Path
 
-from lumpbeam_ros.bench.result import BenchResult
+from lumpbeam_ros.bench.bench_result import BenchResult
 from lumpbeam_ros.campaign.engine import run_campaign, run_serial
 from lumpbeam_ros.campaign.store import ResultsStore
 from lumpbeam_ros.campaign.task import CampaignSettings, warm_up
-from lumpbeam_ros.ident.config import load_identifier_config
+from lumpbeam_ros.ident.settings import load_identifier_config
 from lumpbeam_ros.model.parameters import DropTestConfig, load_beam_config
-from lumpbeam_ros.synthetic.campaign import write_campaign
+from lumpbeam_ros.synthetic.campaign_bags import write_campaign
 from lumpbeam_ros.synthetic.drop_test import SynthOptions
 
 LOADS = (0.5, 1.0, 2.0, 5.0, 10.0)

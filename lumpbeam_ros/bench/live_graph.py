@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 
 from lumpbeam_ros.bench import camera_stream
-from lumpbeam_ros.bench.result import BenchResult
+from lumpbeam_ros.bench.bench_result import BenchResult
 
 #: How often the identifier publishes during the bench, Hz (more samples than the default).
 PUBLISH_RATE_HZ = 10.0

@@ -6,7 +6,7 @@ import importlib
 import importlib.util
 from collections.abc import Iterable
 
-from lumpbeam_ros.bench.result import BenchResult
+from lumpbeam_ros.bench.bench_result import BenchResult
 
 #: Suite modules under :mod:`lumpbeam_ros.bench`.
 SUITES = (

@@ -19,7 +19,7 @@ import cv2
 import numpy as np
 
 from lumpbeam_ros.bench import camera_stream
-from lumpbeam_ros.bench.result import BenchResult
+from lumpbeam_ros.bench.bench_result import BenchResult
 from lumpbeam_ros.vision.accuracy import (
     drop_test_trajectory,
     measure_accuracy,

@@ -3,7 +3,7 @@
 The row holds the bag's path, key and metadata, then the JSON keys of ``lumpbeam analyze``
 and (with the diagnosis) ``lumpbeam diagnose`` flattened to columns (``gap_before.rms_m``;
 lists as JSON text), and ``error``: empty, or one line saying why the bag gave no result.
-The work is :func:`~lumpbeam_ros.ident.bag.analyze_bag` and
+The work is :func:`~lumpbeam_ros.ident.bag_analysis.analyze_bag` and
 :func:`~lumpbeam_ros.diagnose.workflow.diagnose`, exactly what the two commands call.
 """
 
@@ -20,7 +20,7 @@ from typing import Any
 
 from lumpbeam_ros.campaign.bags import bag_facts, fingerprint
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.model.parameters import BeamParameters
 
 #: Version of the table's layout; a results file of another version is not appended to.
@@ -130,7 +130,7 @@ def process_bag(bag: str, settings: CampaignSettings) -> Row:
         The row: identity and metadata, the results, and ``error`` (empty when the bag
         gave its results).
     """
-    from lumpbeam_ros.ident.bag import analyze_bag, result_json
+    from lumpbeam_ros.ident.bag_analysis import analyze_bag, result_json
 
     start = time.perf_counter()
     path = Path(bag)
@@ -167,4 +167,4 @@ def process_bag(bag: str, settings: CampaignSettings) -> Row:
 def warm_up() -> None:
     """Imports what :func:`process_bag` needs, so a worker's first bag is not timed with it."""
     import lumpbeam_ros.diagnose.workflow  # noqa: F401
-    import lumpbeam_ros.ident.bag  # noqa: F401
+    import lumpbeam_ros.ident.bag_analysis  # noqa: F401

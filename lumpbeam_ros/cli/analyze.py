@@ -7,14 +7,14 @@ import sys
 from pathlib import Path
 
 from lumpbeam_ros.cli.output import write_json
-from lumpbeam_ros.ident.bag import (
+from lumpbeam_ros.ident.bag_analysis import (
     CONTRACT_KEYS,
     POSE_TOPIC,
     analyze_bag,
     read_window,
     result_json,
 )
-from lumpbeam_ros.ident.config import load_identifier_config
+from lumpbeam_ros.ident.settings import load_identifier_config
 from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.progress import Progress
 

@@ -21,7 +21,7 @@ POSE_TOPIC = TIP_POSE
 REFERENCE_TOPIC = TRACKER_POINT
 CAMERA_INFO_TOPIC = CAMERA_INFO
 
-#: The simulated laser tracker's defaults (``synthetic.tracker.TrackerOptions``).
+#: The simulated laser tracker's defaults (``synthetic.tracker.ReferenceSensorOptions``).
 TRACKER_RATE_HZ = 1000.0
 TRACKER_NOISE_M = 15e-6
 TRACKER_CLOCK_OFFSET_S = 7.3e-3

@@ -13,7 +13,7 @@ def run(args: argparse.Namespace) -> int:
     from lumpbeam_ros.campaign.store import ResultsStore
     from lumpbeam_ros.campaign.summary import summarize, write_campaign_report
     from lumpbeam_ros.campaign.task import CampaignSettings
-    from lumpbeam_ros.ident.config import load_identifier_config
+    from lumpbeam_ros.ident.settings import load_identifier_config
     from lumpbeam_ros.model.parameters import load_beam_config
 
     bags = expand_bags(args.bags)

@@ -10,13 +10,13 @@ from scipy.spatial.transform import Rotation
 
 from lumpbeam_ros.cli.output import write_json
 from lumpbeam_ros.compare.align import AlignOptions
-from lumpbeam_ros.compare.bag import (
+from lumpbeam_ros.compare.bag_comparison import (
     LOAD_TOPIC,
     read_comparison_input,
 )
 from lumpbeam_ros.compare.comparison import Comparison, compare_sensors
-from lumpbeam_ros.ident.config import load_identifier_config
-from lumpbeam_ros.ident.result import Identification
+from lumpbeam_ros.ident.identification import Identification
+from lumpbeam_ros.ident.settings import load_identifier_config
 from lumpbeam_ros.model.parameters import load_beam_config
 
 

@@ -8,14 +8,14 @@ from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, load_beam_config
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, parse_effect, write_drop_test_bag
 from lumpbeam_ros.synthetic.images import ImageOptions, parse_image_size
-from lumpbeam_ros.synthetic.tracker import TrackerOptions
+from lumpbeam_ros.synthetic.reference_sensor import ReferenceSensorOptions
 
 
-def _tracker_options(args: argparse.Namespace) -> TrackerOptions | None:
+def _reference_sensor_options(args: argparse.Namespace) -> ReferenceSensorOptions | None:
     if not args.tracker:
         return None
     pose = args.tracker_pose
-    return TrackerOptions(
+    return ReferenceSensorOptions(
         rate_hz=args.tracker_rate,
         noise_m=args.tracker_noise,
         clock_offset_s=args.tracker_offset,
@@ -39,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
     )
     if args.loads is not None:
         return _write_campaign(args, beam, drop, options)
-    tracker = _tracker_options(args)
+    tracker = _reference_sensor_options(args)
     images = None
     if args.images:
         width, height = parse_image_size(args.image_size)
@@ -67,7 +67,7 @@ def _write_campaign(
     args: argparse.Namespace, beam: BeamParameters, drop: DropTestConfig, options: SynthOptions
 ) -> int:
     """``--loads``: a folder of drop-test bags, one per load and seed."""
-    from lumpbeam_ros.synthetic.campaign import parse_loads, write_campaign
+    from lumpbeam_ros.synthetic.campaign_bags import parse_loads, write_campaign
 
     if args.tracker or args.images:
         raise LumpbeamError('--loads writes pose-only bags: drop --tracker and --images')

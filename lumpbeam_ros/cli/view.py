@@ -24,7 +24,12 @@ def run(args: argparse.Namespace) -> int:
         LumpbeamError: The port is taken, the bag cannot be read or lacks a topic.
     """
     from lumpbeam_ros.bagio import BagReader
-    from lumpbeam_ros.viz.live import ChannelSink, open_bag_channels, replay_bag, start_server
+    from lumpbeam_ros.viz.foxglove_server import (
+        ChannelSink,
+        open_bag_channels,
+        replay_bag,
+        start_server,
+    )
 
     reader = BagReader(args.bag) if args.bag is not None else None  # bad bag: before binding
     stop = {'requested': False}

@@ -19,7 +19,7 @@ Use::
 """
 
 from lumpbeam_ros.compare.align import AlignedStreams, AlignOptions, align_streams
-from lumpbeam_ros.compare.bag import ComparisonInput, read_comparison_input
+from lumpbeam_ros.compare.bag_comparison import ComparisonInput, read_comparison_input
 from lumpbeam_ros.compare.comparison import Comparison, compare_sensors
 from lumpbeam_ros.compare.refine import Alignment
 from lumpbeam_ros.compare.rigid import fit_rigid

@@ -14,10 +14,10 @@ import numpy as np
 
 from lumpbeam_ros.compare.align import AlignedStreams, AlignOptions, align_streams
 from lumpbeam_ros.compare.streams import Track
-from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.identification import Identification
 from lumpbeam_ros.ident.identify import identify
-from lumpbeam_ros.ident.result import Identification
 from lumpbeam_ros.ident.samples import LoadReadings, clean_window
+from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.interface import BASE_FRAME
 from lumpbeam_ros.model.parameters import BeamParameters
 

@@ -33,13 +33,6 @@ from pathlib import Path
 from typing import Any
 
 from lumpbeam_ros.bagio import BagReader, read_tip_poses
-from lumpbeam_ros.demo.analysis import (
-    RecordingAnalysis,
-    analyze_recording,
-    live_value,
-    normalize_recording,
-    prediction_lag,
-)
 from lumpbeam_ros.demo.graph import (
     ProcessGraph,
     node_command,
@@ -51,6 +44,13 @@ from lumpbeam_ros.demo.live_diagnosis import (
     live_diagnosis,
     live_diagnosis_lines,
     wait_for_verdict,
+)
+from lumpbeam_ros.demo.recording import (
+    RecordingAnalysis,
+    analyze_recording,
+    live_value,
+    normalize_recording,
+    prediction_lag,
 )
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.interface import (

@@ -8,7 +8,7 @@ import numpy as np
 
 from lumpbeam_ros.diagnose.record import Record
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.modes import ModeEstimate
+from lumpbeam_ros.ident.mode_estimate import ModeEstimate
 from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParams
 from lumpbeam_ros.model.trajectory import TipTrajectory
 

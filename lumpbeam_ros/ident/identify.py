@@ -17,12 +17,7 @@ import numpy as np
 from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident import stiffness
-from lumpbeam_ros.ident.config import IdentifierConfig
-from lumpbeam_ros.ident.logdec import LogDecrement, LogDecrementResult, difference_noise_std
-from lumpbeam_ros.ident.modes import TWO_PI, ModeEstimate
-from lumpbeam_ros.ident.pencil import MatrixPencil
-from lumpbeam_ros.ident.release import Release, detect_release
-from lumpbeam_ros.ident.result import (
+from lumpbeam_ros.ident.identification import (
     UNKNOWN,
     AnalysedWindow,
     CrossCheckFigures,
@@ -34,7 +29,12 @@ from lumpbeam_ros.ident.result import (
     SampleTally,
     Status,
 )
+from lumpbeam_ros.ident.logdec import LogDecrement, LogDecrementResult, difference_noise_std
+from lumpbeam_ros.ident.mode_estimate import TWO_PI, ModeEstimate
+from lumpbeam_ros.ident.pencil import MatrixPencil
+from lumpbeam_ros.ident.release import Release, detect_release
 from lumpbeam_ros.ident.samples import PoseWindow
+from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParams, ModeGuess
 from lumpbeam_ros.model import rules
 from lumpbeam_ros.model.parameters import BeamParameters

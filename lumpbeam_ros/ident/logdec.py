@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.modes import TWO_PI, damping_ratio_from_decrement
+from lumpbeam_ros.ident.mode_estimate import TWO_PI, damping_ratio_from_decrement
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.modes import ModeEstimate
+from lumpbeam_ros.ident.mode_estimate import ModeEstimate
 
 
 @dataclass(frozen=True)

@@ -18,10 +18,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.covariance import mean_with_std
 from lumpbeam_ros.ident.onset import fit_onset
 from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow
+from lumpbeam_ros.ident.settings import IdentifierConfig
 
 # Load changes smaller than this (kg) are reading noise, not a drop.
 _LOAD_TOLERANCE_KG = 1e-6

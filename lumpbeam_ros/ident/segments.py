@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.release import detect_release
 from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow
+from lumpbeam_ros.ident.settings import IdentifierConfig
 
 
 def _loads_within(loads: LoadReadings, start: float, end: float) -> LoadReadings:

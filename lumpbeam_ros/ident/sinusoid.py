@@ -30,7 +30,7 @@ from scipy.optimize import least_squares
 
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.covariance import Covariance, sandwich_covariance
-from lumpbeam_ros.ident.modes import TWO_PI, ModeEstimate
+from lumpbeam_ros.ident.mode_estimate import TWO_PI, ModeEstimate
 
 #: A mode's starting point: (damped frequency in Hz, damping ratio).
 ModeGuess = tuple[float, float]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from lumpbeam_ros.ident.modes import TWO_PI
+from lumpbeam_ros.ident.mode_estimate import TWO_PI
 from lumpbeam_ros.model import rules
 
 NAN = float('nan')

@@ -67,7 +67,7 @@ from lumpbeam_ros.interface import (
 )
 from lumpbeam_ros.nodes.counts import write_counts
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
-from lumpbeam_ros.nodes.parameters import declare_parameters
+from lumpbeam_ros.nodes.ros_parameters import declare_parameters
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
 from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
 from lumpbeam_ros.vision.config import camera_config_from_parameters

@@ -68,7 +68,7 @@ from lumpbeam_ros.interface import (
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.nodes.counts import write_counts
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
-from lumpbeam_ros.nodes.parameters import declare_parameters
+from lumpbeam_ros.nodes.ros_parameters import declare_parameters
 from lumpbeam_ros.params.diagnosis_params import DIAGNOSIS_SCHEMA
 
 #: Seconds between repeated warnings about the same kind of bad input.

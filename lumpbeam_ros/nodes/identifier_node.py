@@ -37,16 +37,16 @@ from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio.convert import pose_values
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.config import PARAMETER_KEYS, IdentifierConfig, config_from_parameters
+from lumpbeam_ros.ident.identification import Identification, Status
 from lumpbeam_ros.ident.identify import FitState, identify_from
-from lumpbeam_ros.ident.result import Identification, Status
 from lumpbeam_ros.ident.samples import SampleCounts
+from lumpbeam_ros.ident.settings import PARAMETER_KEYS, IdentifierConfig, config_from_parameters
 from lumpbeam_ros.ident.window import SlidingWindow
 from lumpbeam_ros.interface import BASE_FRAME, BEAM_PARAMS, IDENTIFIER_STATUS, TIP_LOAD, TIP_POSE
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.nodes.counts import write_counts
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
-from lumpbeam_ros.nodes.parameters import declare_parameters
+from lumpbeam_ros.nodes.ros_parameters import declare_parameters
 from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA
 
 #: Seconds between repeated warnings about the same kind of bad input.

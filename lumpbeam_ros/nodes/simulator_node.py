@@ -56,9 +56,10 @@ from lumpbeam_ros.model.stream import PredictionStream
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.nodes.counts import write_counts
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
-from lumpbeam_ros.nodes.parameters import declare_parameters
+from lumpbeam_ros.nodes.ros_parameters import declare_parameters
 from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA, effect_parameter_name
 from lumpbeam_ros.vision.config import load_camera_config
+from lumpbeam_ros.viz.marker_messages import scene_cdr
 from lumpbeam_ros.viz.markers import (
     BeamScene,
     BoardPlacement,
@@ -66,7 +67,6 @@ from lumpbeam_ros.viz.markers import (
     board_placement,
     lifetime_for_rate,
 )
-from lumpbeam_ros.viz.messages import scene_cdr
 
 #: DiagnosticStatus.OK as a number (rclpy gives levels as one byte).
 OK_LEVEL = 0

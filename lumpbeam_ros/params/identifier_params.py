@@ -1,13 +1,13 @@
 """The identifier node's parameters (values in ``config/identifier.yaml``, documented there).
 
-The identification settings are :class:`~lumpbeam_ros.ident.config.IdentifierConfig`'s
-fields under their :data:`~lumpbeam_ros.ident.config.PARAMETER_KEYS`; a test holds the two
+The identification settings are :class:`~lumpbeam_ros.ident.settings.IdentifierConfig`'s
+fields under their :data:`~lumpbeam_ros.ident.settings.PARAMETER_KEYS`; a test holds the two
 and the file equal.
 """
 
 from __future__ import annotations
 
-from lumpbeam_ros.ident.config import NONLINEAR_CHOICES
+from lumpbeam_ros.ident.settings import NONLINEAR_CHOICES
 from lumpbeam_ros.interface import IDENTIFIER_NODE
 from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec
 

@@ -3,7 +3,7 @@
 One :class:`ParameterSchema` per node lists every parameter the node declares, as
 generate_parameter_library's YAML does for C++ nodes (``type``, ``default_value``,
 ``description``, ``read_only``, ``validation: {bounds<>, gt<>, one_of<>, fixed_size<>}``).
-From it the node adapter (:mod:`lumpbeam_ros.nodes.parameters`) builds the
+From it the node adapter (:mod:`lumpbeam_ros.nodes.ros_parameters`) builds the
 descriptors and the on-set check, and :mod:`lumpbeam_ros.params.reference`
 writes ``doc/parameters.md``. The schema is plain Python: no ROS import, so the command line
 and the tests use it as they are.

@@ -18,7 +18,7 @@ import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 from lumpbeam_ros.errors import LumpbeamError  # noqa: E402
-from lumpbeam_ros.ident.result import Estimate, Identification  # noqa: E402
+from lumpbeam_ros.ident.identification import Estimate, Identification  # noqa: E402
 from lumpbeam_ros.ident.samples import PoseWindow  # noqa: E402
 
 #: File names written into the plots folder.

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.viz.marker_messages import read_marker_arrays
 from lumpbeam_ros.viz.markers import (
     NS_BEAM,
     NS_LOAD,
@@ -23,7 +24,6 @@ from lumpbeam_ros.viz.markers import (
     Action,
     MarkerSpec,
 )
-from lumpbeam_ros.viz.messages import read_marker_arrays
 
 #: Snapshots drawn when no times are given.
 DEFAULT_SNAPSHOTS = 6

@@ -12,7 +12,7 @@ matplotlib.use('Agg')  # files only: no display
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from lumpbeam_ros.ident.bag import CONTRACT_KEYS, BagAnalysis, result_json  # noqa: E402
+from lumpbeam_ros.ident.bag_analysis import CONTRACT_KEYS, BagAnalysis, result_json  # noqa: E402
 from lumpbeam_ros.plots.analysis import write_analysis_plots  # noqa: E402
 from lumpbeam_ros.report.html import HtmlReport, as_cell, estimate_rows, figure_png  # noqa: E402
 

@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from lumpbeam_ros.compare.comparison import Comparison  # noqa: E402
-from lumpbeam_ros.ident.bag import CONTRACT_KEYS  # noqa: E402
+from lumpbeam_ros.ident.bag_analysis import CONTRACT_KEYS  # noqa: E402
 from lumpbeam_ros.plots.comparison import plot_comparison  # noqa: E402
 from lumpbeam_ros.report.html import HtmlReport, as_cell, figure_png  # noqa: E402
 

@@ -27,8 +27,13 @@ from lumpbeam_ros.model.parameters import (
 )
 from lumpbeam_ros.model.simulate import drop_test_events, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
-from lumpbeam_ros.synthetic.tracker import TrackerOptions, simulate_tracker, write_tracker_points
+from lumpbeam_ros.synthetic.reference_sensor import (
+    ReferenceSensorOptions,
+    simulate_reference_sensor,
+    write_reference_points,
+)
 from lumpbeam_ros.vision.config import load_camera_config
+from lumpbeam_ros.viz.marker_messages import write_scene
 from lumpbeam_ros.viz.markers import (
     BeamScene,
     TipPoint,
@@ -36,7 +41,6 @@ from lumpbeam_ros.viz.markers import (
     lifetime_for_rate,
     marker_sample_indices,
 )
-from lumpbeam_ros.viz.messages import write_scene
 
 if TYPE_CHECKING:
     from lumpbeam_ros.synthetic.images import ImageOptions
@@ -151,7 +155,7 @@ def write_drop_test_bag(
     drop: DropTestConfig,
     options: SynthOptions,
     *,
-    tracker: TrackerOptions | None = None,
+    tracker: ReferenceSensorOptions | None = None,
     images: ImageOptions | None = None,
 ) -> tuple[TipTrajectory, TipTrajectory]:
     """Simulates the drop test and writes it as a bag.
@@ -162,7 +166,7 @@ def write_drop_test_bag(
         drop: The load and its release time.
         options: What to vary.
         tracker: Also write ``/tracker/point`` from a simulated laser tracker
-            (:mod:`~lumpbeam_ros.synthetic.tracker`).
+            (:mod:`~lumpbeam_ros.synthetic.reference_sensor`).
         images: When given, also ``/camera/image_raw`` and ``/camera/camera_info``: the
             camera films the measured motion (hidden effects included, no pose noise), one
             frame per pose stamp (see :mod:`lumpbeam_ros.synthetic.images`).
@@ -185,7 +189,7 @@ def write_drop_test_bag(
     points = None
     if tracker is not None:
         hidden = with_effects(beam, options.effects)
-        points = simulate_tracker(hidden, drop, options.duration_s, tracker)
+        points = simulate_reference_sensor(hidden, drop, options.duration_s, tracker)
     written = 0
     camera = None
     if images is not None:
@@ -208,7 +212,7 @@ def write_drop_test_bag(
                 bag.write_float(TIP_LOAD, pending[0], pending[1])
                 pending = next(loads, None)
             if points is not None:
-                written = write_tracker_points(bag, points, written, stamp)
+                written = write_reference_points(bag, points, written, stamp)
             bag.write_pose(
                 TIP_POSE,
                 stamp,
@@ -229,5 +233,5 @@ def write_drop_test_bag(
             if camera is not None:
                 camera.write_next(bag)
         if points is not None:
-            write_tracker_points(bag, points, written, math.inf)
+            write_reference_points(bag, points, written, math.inf)
     return measured, truth

@@ -56,6 +56,7 @@ from lumpbeam_ros.vision.messages import (
 from lumpbeam_ros.vision.session import TrackingSession
 from lumpbeam_ros.vision.sources import FootageError, FootageFrame
 from lumpbeam_ros.vision.tracker import TrackResult
+from lumpbeam_ros.viz.marker_messages import write_scene
 from lumpbeam_ros.viz.markers import (
     MARKERS_TOPIC,
     BeamScene,
@@ -63,7 +64,6 @@ from lumpbeam_ros.viz.markers import (
     board_placement,
     lifetime_for_rate,
 )
-from lumpbeam_ros.viz.messages import write_scene
 
 POSE_TOPIC = TIP_POSE
 TRUTH_TOPIC = TIP_POSE_TRUTH

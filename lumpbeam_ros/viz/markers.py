@@ -2,7 +2,7 @@
 
 ROS-free: :func:`scene_markers` turns what is known at one instant (the model's segment
 angles, the measured and predicted tip, the load, the board) into :class:`MarkerSpec`
-descriptions in ``beam_base``, which :mod:`lumpbeam_ros.viz.messages` writes as a
+descriptions in ``beam_base``, which :mod:`lumpbeam_ros.viz.marker_messages` writes as a
 ``visualization_msgs/msg/MarkerArray``. Every marker has a namespace and an id that stay the
 same from one array to the next, so a viewer replaces the previous one instead of piling
 them up, and a lifetime, so a stream that stops leaves nothing stale on screen; a marker

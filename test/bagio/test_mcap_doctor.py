@@ -2,7 +2,7 @@
 
 The live kinds are checked where they are made: a recording in test/cli/test_record.py, the
 demo's recorded and sim-time bags in test/cli/test_demo.py, a sim-time copy in
-test/demo/test_analysis.py, a repaired bag in test/cli/test_repair.py.
+test/demo/test_recording.py, a repaired bag in test/cli/test_repair.py.
 """
 
 import pytest

@@ -5,7 +5,7 @@ from pathlib import Path
 import pytest
 
 from lumpbeam_ros.model.parameters import DropTestConfig, load_beam_config
-from lumpbeam_ros.synthetic.campaign import write_campaign
+from lumpbeam_ros.synthetic.campaign_bags import write_campaign
 from lumpbeam_ros.synthetic.drop_test import SynthOptions
 
 #: Loads of the shared campaign, kg, one seed each.

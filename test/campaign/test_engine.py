@@ -13,7 +13,7 @@ from lumpbeam_ros.campaign.engine import run_campaign, run_serial
 from lumpbeam_ros.campaign.store import ResultsStore
 from lumpbeam_ros.campaign.task import CampaignSettings
 from lumpbeam_ros.cli.main import main
-from lumpbeam_ros.ident.config import load_identifier_config
+from lumpbeam_ros.ident.settings import load_identifier_config
 from lumpbeam_ros.model.parameters import load_beam_config
 
 

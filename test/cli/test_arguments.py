@@ -4,11 +4,11 @@ import pytest
 
 from lumpbeam_ros.cli import arguments
 from lumpbeam_ros.cli.main import build_parser
-from lumpbeam_ros.compare import bag as compare_bag
-from lumpbeam_ros.synthetic.tracker import TrackerOptions
+from lumpbeam_ros.compare import bag_comparison as compare_bag
+from lumpbeam_ros.synthetic.reference_sensor import ReferenceSensorOptions
 from lumpbeam_ros.vision import offline
 
-TRACKER = TrackerOptions()
+TRACKER = ReferenceSensorOptions()
 
 
 @pytest.mark.parametrize(

@@ -120,7 +120,7 @@ def test_unknown_pose_model_is_exit_2(bag, tmp_path, capsys):
 
 
 def test_out_draws_the_tracked_tip_and_the_board(bag, tmp_path, capsys):
-    from lumpbeam_ros.viz.messages import read_marker_arrays
+    from lumpbeam_ros.viz.marker_messages import read_marker_arrays
 
     out = tmp_path / 'out'
     assert main(['track', str(bag), str(out)]) == 0

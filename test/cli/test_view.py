@@ -15,7 +15,7 @@ from lumpbeam_ros.bagio.typestore import deserialize
 from lumpbeam_ros.cli.main import main
 from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
-from lumpbeam_ros.viz.live import SUBPROTOCOL
+from lumpbeam_ros.viz.foxglove_server import SUBPROTOCOL
 
 websockets = pytest.importorskip('websockets')
 

@@ -10,7 +10,11 @@ from lumpbeam_ros.compare.streams import Track, clean_track
 from lumpbeam_ros.ident.samples import LoadReadings
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, simulate_experiment, with_effects
-from lumpbeam_ros.synthetic.tracker import TrackerOptions, TrackerSamples, simulate_tracker
+from lumpbeam_ros.synthetic.reference_sensor import (
+    ReferenceSamples,
+    ReferenceSensorOptions,
+    simulate_reference_sensor,
+)
 
 CAMERA_NOISE = 20e-6
 TRACKER_NOISE = 15e-6
@@ -22,19 +26,19 @@ class Pair:
     camera: Track
     reference: Track
     loads: LoadReadings
-    tracker: TrackerOptions
-    samples: TrackerSamples
+    tracker: ReferenceSensorOptions
+    samples: ReferenceSamples
 
 
 def make_pair(
-    tracker: TrackerOptions | None = None,
+    tracker: ReferenceSensorOptions | None = None,
     effects: dict[str, float] | None = None,
     camera_noise: float = CAMERA_NOISE,
     duration: float = DURATION,
     seed: int = 0,
 ) -> Pair:
     """Simulates both sensors; the camera stamps are true time (plus any latency effect)."""
-    tracker = tracker or TrackerOptions(seed=seed + 1)
+    tracker = tracker or ReferenceSensorOptions(seed=seed + 1)
     beam, drop = BeamParameters(), DropTestConfig()
     options = SynthOptions(duration_s=duration, noise_m=camera_noise, effects=effects or {})
     measured, _ = simulate_experiment(beam, drop, options)
@@ -44,7 +48,9 @@ def make_pair(
         [measured.x + noise[:, 0], np.zeros(len(measured)), measured.z + noise[:, 1]]
     )
     camera = clean_track(measured.t, points, 'beam_base', '/tip_pose', measured.pitch)
-    samples = simulate_tracker(with_effects(beam, options.effects), drop, duration, tracker)
+    samples = simulate_reference_sensor(
+        with_effects(beam, options.effects), drop, duration, tracker
+    )
     reference = clean_track(samples.stamps, samples.points, tracker.frame_id, '/tracker/point')
     loads = LoadReadings(np.array([0.0, drop.release_time_s]), np.array([drop.load_kg, 0.0]))
     return Pair(camera, reference, loads, tracker, samples)

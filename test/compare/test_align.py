@@ -5,16 +5,16 @@ from scipy.spatial.transform import Rotation
 from lumpbeam_ros.compare.align import AlignOptions, align_streams
 from lumpbeam_ros.compare.streams import clean_track
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.synthetic.tracker import TrackerOptions
+from lumpbeam_ros.synthetic.reference_sensor import ReferenceSensorOptions
 
 from .helpers import make_pair, with_reference
 
 TRACKERS = {
-    'default': TrackerOptions(),
-    'near, upside down': TrackerOptions(
+    'default': ReferenceSensorOptions(),
+    'near, upside down': ReferenceSensorOptions(
         position_m=(0.5, 1.5, -1.0), rotation_deg=(170.0, 30.0, -60.0), clock_offset_s=-0.0421
     ),
-    'far, noisier': TrackerOptions(
+    'far, noisier': ReferenceSensorOptions(
         position_m=(4.0, -6.0, 1.0), rotation_deg=(0.0, 0.0, 180.0), noise_m=30e-6
     ),
 }

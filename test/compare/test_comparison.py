@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.compare.comparison import compare_sensors
-from lumpbeam_ros.ident.result import Status
+from lumpbeam_ros.ident.identification import Status
 from lumpbeam_ros.model.parameters import BeamParameters
-from lumpbeam_ros.synthetic.tracker import TrackerOptions
+from lumpbeam_ros.synthetic.reference_sensor import ReferenceSensorOptions
 
 from .helpers import CAMERA_NOISE, TRACKER_NOISE, make_pair
 
@@ -71,8 +71,8 @@ def test_json_keys(comparison):
     ('tracker', 'effects', 'offset'),
     [
         # The camera late by 20 ms: its stamps run 20 ms behind the true time.
-        (TrackerOptions(), {'sensor_latency': 0.02}, 7.3e-3 - 0.02),
-        (TrackerOptions(clock_offset_s=0.0), {'coulomb_friction': 0.5}, 0.0),
+        (ReferenceSensorOptions(), {'sensor_latency': 0.02}, 7.3e-3 - 0.02),
+        (ReferenceSensorOptions(clock_offset_s=0.0), {'coulomb_friction': 0.5}, 0.0),
     ],
 )
 def test_camera_latency_shows_as_offset(tracker, effects, offset):
@@ -83,7 +83,7 @@ def test_camera_latency_shows_as_offset(tracker, effects, offset):
 
 
 def test_a_reflector_off_the_tip_shows_as_difference():
-    pair = make_pair(TrackerOptions(lever_m=0.05), duration=4.0)
+    pair = make_pair(ReferenceSensorOptions(lever_m=0.05), duration=4.0)
     comparison = compare_sensors(pair.camera, pair.reference, BeamParameters(), pair.loads)
     # 5 cm beyond the tip swings 5 cm x the pitch change (about 50 mrad) more than the tip.
     assert comparison.rms_difference_m > 5.0 * COMBINED

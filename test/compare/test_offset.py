@@ -5,14 +5,14 @@ from lumpbeam_ros.compare.offset import check_overlap, coarse_offset
 from lumpbeam_ros.compare.rigid import point_spread
 from lumpbeam_ros.compare.streams import GapInterpolator, clean_track
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.synthetic.tracker import TrackerOptions
+from lumpbeam_ros.synthetic.reference_sensor import ReferenceSensorOptions
 
 from .helpers import make_pair
 
 
 @pytest.mark.parametrize('offset', [-0.25, 0.0, 7.3e-3, 0.4])
 def test_cross_correlation_finds_the_offset(offset):
-    pair = make_pair(TrackerOptions(clock_offset_s=offset), duration=4.0)
+    pair = make_pair(ReferenceSensorOptions(clock_offset_s=offset), duration=4.0)
     spread = point_spread(pair.reference.points)
     coarse = coarse_offset(pair.camera, GapInterpolator(pair.reference), spread, 1.0)
     # A tenth of the 1 ms lag step: the parabola through the peak does the rest.

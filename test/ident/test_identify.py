@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.identification import Status
 from lumpbeam_ros.ident.identify import identify, identify_from
-from lumpbeam_ros.ident.result import Status
 from lumpbeam_ros.ident.samples import clean_loads, clean_window
+from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.ident.window import SlidingWindow
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.model.simulate import simulate_loads

@@ -5,7 +5,7 @@ import pytest
 
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.logdec import LogDecrement, difference_noise_std
-from lumpbeam_ros.ident.modes import damping_ratio_from_decrement
+from lumpbeam_ros.ident.mode_estimate import damping_ratio_from_decrement
 
 T = np.arange(0.0, 10.0, 1.0 / 180.0)
 

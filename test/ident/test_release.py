@@ -3,9 +3,9 @@ import math
 import numpy as np
 import pytest
 
-from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.release import detect_release, load_changes
 from lumpbeam_ros.ident.samples import clean_loads, clean_window
+from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.model.parameters import DropTestConfig
 
 from .conftest import HINT_ARRIVALS, replay_window

@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
 
-from lumpbeam_ros.ident.config import IdentifierConfig
 from lumpbeam_ros.ident.samples import clean_loads, clean_window
 from lumpbeam_ros.ident.segments import keep_release_segment
+from lumpbeam_ros.ident.settings import IdentifierConfig
 
 CONFIG = IdentifierConfig()
 

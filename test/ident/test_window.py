@@ -3,9 +3,9 @@ import math
 import numpy as np
 import pytest
 
-from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.identification import Status
 from lumpbeam_ros.ident.identify import identify
-from lumpbeam_ros.ident.result import Status
+from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.ident.window import SlidingWindow
 from lumpbeam_ros.model.parameters import BeamParameters
 

@@ -17,9 +17,9 @@ from lumpbeam_ros.bagio import read_tip_poses
 from lumpbeam_ros.bagio.convert import pitch_to_quaternion
 from lumpbeam_ros.cli.analyze import read_window
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.bag import analyze_bag
-from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.bag_analysis import analyze_bag
 from lumpbeam_ros.ident.identify import identify
+from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.interface import IDENTIFIER_STATUS as STATUS_NAME
 from lumpbeam_ros.model import rules
 from lumpbeam_ros.model.chain import LumpedChain

@@ -4,7 +4,7 @@ import math
 import pytest
 
 from lumpbeam_ros.errors import ConfigError
-from lumpbeam_ros.ident.config import PARAMETER_KEYS, IdentifierConfig, config_from_parameters
+from lumpbeam_ros.ident.settings import PARAMETER_KEYS, IdentifierConfig, config_from_parameters
 from lumpbeam_ros.paramfile import read_parameter_file
 from lumpbeam_ros.params import schema as schema_module
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS

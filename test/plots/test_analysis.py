@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ident.identification import Identification, Status
 from lumpbeam_ros.ident.identify import identify
-from lumpbeam_ros.ident.result import Identification, Status
 from lumpbeam_ros.ident.samples import clean_loads, clean_window
 from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.plots.analysis import FILES, _envelope, write_analysis_plots

@@ -20,11 +20,11 @@ from lumpbeam_ros.bagio import BagReader, BagWriter, convert, read_diagnostics, 
 from lumpbeam_ros.bagio.series import read_load_events
 from lumpbeam_ros.bagio.tipseries import TipSeries
 from lumpbeam_ros.errors import BagError
-from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.identification import Identification
 from lumpbeam_ros.ident.identify import identify
-from lumpbeam_ros.ident.result import Identification
 from lumpbeam_ros.ident.samples import clean_loads, clean_window
 from lumpbeam_ros.ident.segments import keep_release_segment
+from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.interface import (
     BEAM_PARAMS,
     CLOCK,
@@ -41,8 +41,8 @@ from lumpbeam_ros.interface import (
 )
 from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.plots.demo import Residual, prediction_residual
+from lumpbeam_ros.viz.marker_messages import MARKER_ARRAY_TYPE
 from lumpbeam_ros.viz.markers import MARKERS_TOPIC
-from lumpbeam_ros.viz.messages import MARKER_ARRAY_TYPE
 
 #: Pose topics a normalized recording keeps.
 POSE_TOPICS = (TIP_POSE, TIP_POSE_PREDICTED, TIP_POSE_TRUTH)

@@ -11,7 +11,7 @@ from rclpy.parameter_client import AsyncParameterClient
 from lumpbeam_ros.errors import ConfigError
 from lumpbeam_ros.nodes.camera_node import CameraNode
 from lumpbeam_ros.nodes.identifier_node import IdentifierNode
-from lumpbeam_ros.nodes.parameters import declare_parameters, describe, undeclared_in_schema
+from lumpbeam_ros.nodes.ros_parameters import declare_parameters, describe, undeclared_in_schema
 from lumpbeam_ros.nodes.simulator_node import SimulatorNode
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA
 from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA

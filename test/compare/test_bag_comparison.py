@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.bagio import BagWriter
-from lumpbeam_ros.compare.bag import read_comparison_input
+from lumpbeam_ros.compare.bag_comparison import read_comparison_input
 from lumpbeam_ros.errors import BagError
 
 

@@ -3,7 +3,7 @@ import pytest
 from lumpbeam_ros.bagio import read_load_events
 from lumpbeam_ros.cli.main import main
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.synthetic.campaign import parse_loads
+from lumpbeam_ros.synthetic.campaign_bags import parse_loads
 
 
 def test_loads_parse():

@@ -14,11 +14,11 @@ from typing import Any
 
 from lumpbeam_ros.bagio import BagReader, read_load_events, read_tip_poses
 from lumpbeam_ros.errors import BagError, LumpbeamError
-from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.identification import Identification
 from lumpbeam_ros.ident.identify import FitState, identify_from
-from lumpbeam_ros.ident.result import Identification
 from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow, clean_loads, clean_window
 from lumpbeam_ros.ident.segments import keep_release_segment
+from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.interface import BASE_FRAME, TIP_LOAD, TIP_POSE
 from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.progress import Progress

@@ -24,7 +24,7 @@ TOPIC = TRACKER_POINT
 
 
 @dataclass(frozen=True)
-class TrackerOptions:
+class ReferenceSensorOptions:
     """The synthetic tracker.
 
     Attributes:
@@ -71,7 +71,7 @@ class TrackerOptions:
 
 
 @dataclass(frozen=True)
-class TrackerSamples:
+class ReferenceSamples:
     """What the tracker publishes.
 
     Attributes:
@@ -90,9 +90,9 @@ class TrackerSamples:
         return int(self.stamps.size)
 
 
-def simulate_tracker(
-    beam: BeamParameters, drop: DropTestConfig, duration_s: float, options: TrackerOptions
-) -> TrackerSamples:
+def simulate_reference_sensor(
+    beam: BeamParameters, drop: DropTestConfig, duration_s: float, options: ReferenceSensorOptions
+) -> ReferenceSamples:
     """Simulates the tracker over a drop test.
 
     Args:
@@ -117,11 +117,11 @@ def simulate_tracker(
     rng = np.random.default_rng(options.seed)
     in_tracker = options.transform.inverse().apply(true_points)
     noisy = in_tracker + options.noise_m * rng.standard_normal(in_tracker.shape)
-    return TrackerSamples(t + options.clock_offset_s, noisy, true_points, options.frame_id)
+    return ReferenceSamples(t + options.clock_offset_s, noisy, true_points, options.frame_id)
 
 
-def write_tracker_points(
-    bag: BagWriter, samples: TrackerSamples, start: int, until_s: float
+def write_reference_points(
+    bag: BagWriter, samples: ReferenceSamples, start: int, until_s: float
 ) -> int:
     """Writes the samples from index ``start`` whose stamps are ``<= until_s``.
 

@@ -4,8 +4,8 @@ import pytest
 
 from lumpbeam_ros.bagio import BagWriter
 from lumpbeam_ros.errors import BagError, LumpbeamError
-from lumpbeam_ros.ident.bag import CONTRACT_KEYS, analyze_bag, read_window, result_json
-from lumpbeam_ros.ident.config import IdentifierConfig
+from lumpbeam_ros.ident.bag_analysis import CONTRACT_KEYS, analyze_bag, read_window, result_json
+from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.model.adopt import first_mode
 from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag

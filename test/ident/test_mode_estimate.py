@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from lumpbeam_ros.ident.modes import ModeEstimate, damping_ratio_from_decrement
+from lumpbeam_ros.ident.mode_estimate import ModeEstimate, damping_ratio_from_decrement
 
 FIELDS = (
     'damped_frequency_hz',

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.bagio import BagWriter, convert, read_load_events
-from lumpbeam_ros.demo.analysis import (
+from lumpbeam_ros.demo.recording import (
     analyze_recording,
     clock_time,
     last_live_status,

@@ -9,15 +9,18 @@ from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.model.simulate import simulate_loads
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
-from lumpbeam_ros.synthetic.tracker import TrackerOptions, simulate_tracker
+from lumpbeam_ros.synthetic.reference_sensor import (
+    ReferenceSensorOptions,
+    simulate_reference_sensor,
+)
 
 DROP = DropTestConfig()
 
 
 @pytest.mark.parametrize('offset', [7.3e-3, -0.05])
 def test_stamps_are_true_time_plus_offset(offset):
-    options = TrackerOptions(clock_offset_s=offset, noise_m=0.0)
-    samples = simulate_tracker(BeamParameters(), DROP, 3.0, options)
+    options = ReferenceSensorOptions(clock_offset_s=offset, noise_m=0.0)
+    samples = simulate_reference_sensor(BeamParameters(), DROP, 3.0, options)
     assert samples.stamps[0] >= 0.0
     assert np.allclose(np.diff(samples.stamps), 1e-3)
     true_t = samples.stamps - offset
@@ -28,8 +31,8 @@ def test_stamps_are_true_time_plus_offset(offset):
 
 
 def test_noise_and_frame():
-    options = TrackerOptions()
-    samples = simulate_tracker(BeamParameters(), DROP, 3.0, options)
+    options = ReferenceSensorOptions()
+    samples = simulate_reference_sensor(BeamParameters(), DROP, 3.0, options)
     in_tracker = options.transform.inverse().apply(samples.true_points)
     assert np.std(samples.points - in_tracker) == pytest.approx(15e-6, rel=0.05)
     # The tracker stands 3.2 m from the tip, below its level.
@@ -41,14 +44,20 @@ def test_noise_and_frame():
 def test_latency_is_the_camera_s_not_the_tracker_s():
     late = BeamParameters().effects.with_effect('sensor_latency', 0.02)
     beam = BeamParameters()
-    a = simulate_tracker(replace(beam, effects=late), DROP, 3.0, TrackerOptions(noise_m=0.0))
-    b = simulate_tracker(beam, DROP, 3.0, TrackerOptions(noise_m=0.0))
+    a = simulate_reference_sensor(
+        replace(beam, effects=late), DROP, 3.0, ReferenceSensorOptions(noise_m=0.0)
+    )
+    b = simulate_reference_sensor(beam, DROP, 3.0, ReferenceSensorOptions(noise_m=0.0))
     assert np.array_equal(a.points, b.points)
 
 
 def test_lever_moves_the_reflector_along_the_tangent():
-    plain = simulate_tracker(BeamParameters(), DROP, 3.0, TrackerOptions(noise_m=0.0))
-    lever = simulate_tracker(BeamParameters(), DROP, 3.0, TrackerOptions(noise_m=0.0, lever_m=0.1))
+    plain = simulate_reference_sensor(
+        BeamParameters(), DROP, 3.0, ReferenceSensorOptions(noise_m=0.0)
+    )
+    lever = simulate_reference_sensor(
+        BeamParameters(), DROP, 3.0, ReferenceSensorOptions(noise_m=0.0, lever_m=0.1)
+    )
     step = lever.true_points - plain.true_points
     assert np.allclose(np.linalg.norm(step, axis=1), 0.1)
     loaded = plain.stamps - 7.3e-3 < DROP.release_time_s
@@ -58,7 +67,7 @@ def test_lever_moves_the_reflector_along_the_tangent():
 def test_bag_holds_the_points_in_time_order(tmp_path):
     options = SynthOptions(duration_s=3.0)
     write_drop_test_bag(
-        tmp_path / 'bag', BeamParameters(), DROP, options, tracker=TrackerOptions()
+        tmp_path / 'bag', BeamParameters(), DROP, options, tracker=ReferenceSensorOptions()
     )
     points = read_points(tmp_path / 'bag')
     assert points.frame_id == 'tracker'
@@ -103,4 +112,4 @@ def test_synth_cli_rejects_bad_tracker_options(tmp_path, capsys, argv):
 )
 def test_bad_tracker_options(kwargs):
     with pytest.raises(LumpbeamError):
-        TrackerOptions(**kwargs)
+        ReferenceSensorOptions(**kwargs)

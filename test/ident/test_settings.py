@@ -3,7 +3,7 @@ import re
 import pytest
 
 from lumpbeam_ros.errors import ConfigError
-from lumpbeam_ros.ident.config import (
+from lumpbeam_ros.ident.settings import (
     PARAMETER_KEYS,
     IdentifierConfig,
     config_from_parameters,

@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from lumpbeam_ros.cli.analyze import CONTRACT_KEYS
-from lumpbeam_ros.ident.result import (
+from lumpbeam_ros.ident.identification import (
     Estimate,
     Estimates,
     Identification,
