@@ -46,7 +46,6 @@ import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
 from rclpy.context import Context
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import CameraInfo as CameraInfoMsg
@@ -65,8 +64,8 @@ from lumpbeam_ros.interface import (
     TIP_POSE,
     TIP_POSE_COVARIANCE,
 )
-from lumpbeam_ros.nodes.counts import write_counts
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
+from lumpbeam_ros.nodes.lifecycle import run_node
 from lumpbeam_ros.nodes.ros_parameters import declare_parameters
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
 from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
@@ -346,42 +345,36 @@ def main(args: Sequence[str] | None = None) -> int:
     Returns:
         0, or 2 for a configuration or bag error (one line on stderr).
     """
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = CameraNode()
-        if node.in_process:
+    return run_node(
+        CAMERA_NODE,
+        CameraNode,
+        lambda node: {
+            TIP_POSE: node.session.stats.poses_out,
+            TIP_POSE_COVARIANCE: node.session.stats.poses_out,
+        },
+        args,
+        run=_run,
+        received=lambda node: {IMAGE: node.session.stats.frames_in},
+    )
 
-            def should_stop() -> bool:
-                rclpy.spin_once(node, timeout_sec=0.0)  # timers: /diagnostics keeps coming
-                return not rclpy.ok()
 
-            if node.bag_path:
-                node.run_bag(should_stop)
-            else:
-                node.run_footage(should_stop)
-            s = node.session.stats
-            name = node.bag_path or node.footage_path or f'video device {node.video_device}'
-            print(f'camera_node: {name}: {s.frames_in} frames, {s.poses_out} poses')
-        else:
-            rclpy.spin(node)
-    except LumpbeamError as exc:
-        print(f'camera_node: error: {exc}', file=sys.stderr)
-        return 2
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            stats = node.session.stats
-            write_counts(
-                CAMERA_NODE,
-                {TIP_POSE: stats.poses_out, TIP_POSE_COVARIANCE: stats.poses_out},
-                {IMAGE: stats.frames_in},
-            )
-            node.destroy_node()
-        if rclpy.ok():
-            rclpy.shutdown()
-    return 0
+def _run(node: CameraNode) -> None:
+    """Spins a live node; a node given a bag or footage reads it through, then says so."""
+    if not node.in_process:
+        rclpy.spin(node)
+        return
+
+    def should_stop() -> bool:
+        rclpy.spin_once(node, timeout_sec=0.0)  # timers: /diagnostics keeps coming
+        return not rclpy.ok()
+
+    if node.bag_path:
+        node.run_bag(should_stop)
+    else:
+        node.run_footage(should_stop)
+    s = node.session.stats
+    name = node.bag_path or node.footage_path or f'video device {node.video_device}'
+    print(f'camera_node: {name}: {s.frames_in} frames, {s.poses_out} poses')
 
 
 if __name__ == '__main__':

@@ -33,12 +33,10 @@ from collections.abc import Mapping, Sequence
 from multiprocessing.pool import AsyncResult, Pool, ThreadPool
 from typing import Any
 
-import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
 from rclpy.clock import Clock, ClockType
 from rclpy.context import Context
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
@@ -66,8 +64,8 @@ from lumpbeam_ros.interface import (
     TIP_POSE_PREDICTED,
 )
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
-from lumpbeam_ros.nodes.counts import write_counts
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
+from lumpbeam_ros.nodes.lifecycle import run_node
 from lumpbeam_ros.nodes.ros_parameters import declare_parameters
 from lumpbeam_ros.params.diagnosis_params import DIAGNOSIS_SCHEMA
 
@@ -386,22 +384,12 @@ def main(args: Sequence[str] | None = None) -> int:
     Returns:
         0, or 2 when the configuration is invalid (one line on stderr).
     """
-    rclpy.init(args=args)
-    try:
-        node = DiagnosisNode()
-    except LumpbeamError as exc:
-        print(f'diagnosis_node: {exc}', file=sys.stderr)
-        rclpy.try_shutdown()
-        return 2
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        write_counts(DIAGNOSIS_SCHEMA.node, {MODEL_DISCREPANCY: node.published})
-        node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return run_node(
+        DIAGNOSIS_SCHEMA.node,
+        DiagnosisNode,
+        lambda node: {MODEL_DISCREPANCY: node.published},
+        args,
+    )
 
 
 if __name__ == '__main__':

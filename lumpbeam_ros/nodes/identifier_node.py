@@ -26,11 +26,9 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
-import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
 from rclpy.context import Context
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64
@@ -44,8 +42,8 @@ from lumpbeam_ros.ident.settings import PARAMETER_KEYS, IdentifierConfig, config
 from lumpbeam_ros.ident.window import SlidingWindow
 from lumpbeam_ros.interface import BASE_FRAME, BEAM_PARAMS, IDENTIFIER_STATUS, TIP_LOAD, TIP_POSE
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
-from lumpbeam_ros.nodes.counts import write_counts
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
+from lumpbeam_ros.nodes.lifecycle import run_node
 from lumpbeam_ros.nodes.ros_parameters import declare_parameters
 from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA
 
@@ -185,8 +183,8 @@ class IdentifierNode(Node):
         return msg
 
 
-def main(args: list[str] | None = None) -> int:
-    """Runs the node until Ctrl-C.
+def main(args: Sequence[str] | None = None) -> int:
+    """Runs the node until Ctrl-C (console script ``identifier_node``).
 
     Args:
         args: Command-line arguments (default ``sys.argv``), incl. ``--ros-args``.
@@ -194,22 +192,9 @@ def main(args: list[str] | None = None) -> int:
     Returns:
         0, or 2 when the configuration is invalid (one line on stderr).
     """
-    rclpy.init(args=args)
-    try:
-        node = IdentifierNode()
-    except LumpbeamError as exc:
-        print(f'identifier_node: {exc}', file=sys.stderr)
-        rclpy.try_shutdown()
-        return 2
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        write_counts(IDENTIFIER_SCHEMA.node, {BEAM_PARAMS: node.updates})
-        node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return run_node(
+        IDENTIFIER_SCHEMA.node, IdentifierNode, lambda node: {BEAM_PARAMS: node.updates}, args
+    )
 
 
 if __name__ == '__main__':

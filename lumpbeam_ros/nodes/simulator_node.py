@@ -26,13 +26,10 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseStamped
 from rclpy.clock import Clock, ClockType
 from rclpy.context import Context
-from rclpy.exceptions import ParameterException
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64
@@ -54,8 +51,8 @@ from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters, loa
 from lumpbeam_ros.model.statics import static_tip_deflection
 from lumpbeam_ros.model.stream import PredictionStream
 from lumpbeam_ros.model.trajectory import TipTrajectory
-from lumpbeam_ros.nodes.counts import write_counts
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
+from lumpbeam_ros.nodes.lifecycle import run_node
 from lumpbeam_ros.nodes.ros_parameters import declare_parameters
 from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA, effect_parameter_name
 from lumpbeam_ros.vision.config import load_camera_config
@@ -438,25 +435,12 @@ def main(args: Sequence[str] | None = None) -> int:
     Returns:
         0 after a clean stop, 2 for a bad parameter or beam file.
     """
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = SimulatorNode()
-        rclpy.spin(node)
-    except (LumpbeamError, ParameterException) as exc:
-        print(f'simulator_node: error: {exc}', file=sys.stderr)
-        return 2
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            write_counts(
-                SIMULATOR_SCHEMA.node,
-                {TIP_POSE_PREDICTED: node.published, BEAM_MARKERS: node.markers_published},
-            )
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    return run_node(
+        SIMULATOR_SCHEMA.node,
+        SimulatorNode,
+        lambda node: {TIP_POSE_PREDICTED: node.published, BEAM_MARKERS: node.markers_published},
+        args,
+    )
 
 
 if __name__ == '__main__':

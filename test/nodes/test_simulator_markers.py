@@ -41,8 +41,14 @@ def test_markers_draw_the_model_at_their_own_rate(ros_graph):
     node = _start(ros_graph, initial_load_kg=4.5, markers_rate_hz=20.0)
     assert ros_graph.spin_until(lambda: len(arrays) >= 3, 30.0)
     ros_graph.spin_for(1.0)
-    # 20 Hz, not the poses' 180 Hz (a loaded machine ticks in bursts: fewer, never more).
-    assert len(arrays) < len(poses) / 4
+    # 20 Hz in model time, not the poses' 180 Hz: a loaded machine fires the timer late and
+    # in bursts (fewer arrays, the odd close pair), so the typical spacing is what is checked.
+    stamps = [
+        a.markers[0].header.stamp.sec + a.markers[0].header.stamp.nanosec * 1e-9 for a in arrays
+    ]
+    assert np.median(np.diff(stamps)) >= 0.75 / 20.0
+    pose_stamps = [p.header.stamp.sec + p.header.stamp.nanosec * 1e-9 for p in poses]
+    assert np.median(np.diff(pose_stamps)) == pytest.approx(1.0 / 180.0, rel=0.01)
     markers = _by_ns(arrays[-1])
     assert set(markers) == {'beam', 'tip_predicted', 'load', 'board'}  # no /tip_pose yet
     beam = markers['beam']
