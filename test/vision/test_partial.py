@@ -216,11 +216,16 @@ def test_the_staged_blur_search_decides_as_the_full_one(config, blur, noise):
     full, staged = misfits
     np.testing.assert_array_equal(decisions[0], decisions[1])
     # Why they agree: a misfit kept from the first blur is never better than the best one,
-    # is within the limit's floor, and leaves the median below where it raises the limit.
+    # is within the limit's floor, and leaves the median below where it raises the limit
+    # or every misfit within the floor.
     assert np.all(staged >= full - 1e-12)
     differ = staged > full + 1e-12
     assert np.all(staged[differ] <= MAX_SADDLE_MISFIT)
-    assert not np.any(differ) or np.median(staged) <= MAX_SADDLE_MISFIT / MISFIT_MEDIANS
+    assert (
+        not np.any(differ)
+        or np.median(staged) <= MAX_SADDLE_MISFIT / MISFIT_MEDIANS
+        or np.all(staged <= MAX_SADDLE_MISFIT)
+    )
     assert 0 < np.count_nonzero(decisions[0]) < 48
 
 
