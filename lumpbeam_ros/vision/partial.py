@@ -118,10 +118,41 @@ def grid_axes(grid: np.ndarray, pattern_size: tuple[int, int]) -> tuple[np.ndarr
         ``(along_x, along_y)``, each N x 2, by central differences (one-sided at the border).
     """
     cols, rows = pattern_size
-    g = grid.reshape(rows, cols, 2)
-    along_x = np.gradient(g, axis=1) if cols > 1 else np.zeros_like(g)
-    along_y = np.gradient(g, axis=0) if rows > 1 else np.zeros_like(g)
-    return along_x.reshape(-1, 2), along_y.reshape(-1, 2)
+    g = np.asarray(grid, dtype=float).reshape(rows, cols, 2)
+    return _differences(g, 1).reshape(-1, 2), _differences(g, 0).reshape(-1, 2)
+
+
+def _differences(g: np.ndarray, axis: int) -> np.ndarray:
+    """``np.gradient`` of a rows x cols x 2 grid along ``axis``, for every frame.
+
+    Central differences inside, one-sided at the ends, without ``np.gradient``'s generality.
+    """
+    out = np.zeros_like(g)
+    if g.shape[axis] < 2:
+        return out
+    if axis == 0:
+        out[1:-1] = (g[2:] - g[:-2]) / 2.0
+        out[0] = g[1] - g[0]
+        out[-1] = g[-1] - g[-2]
+    else:
+        out[:, 1:-1] = (g[:, 2:] - g[:, :-2]) / 2.0
+        out[:, 0] = g[:, 1] - g[:, 0]
+        out[:, -1] = g[:, -1] - g[:, -2]
+    return out
+
+
+def sorted_median(values: np.ndarray) -> float:
+    """``np.median`` of a 1-D array by one sort: some 5 times faster for a board's corners.
+
+    Args:
+        values: Finite or infinite numbers (no NaN), at least one.
+
+    Returns:
+        The middle value, or the mean of the two middle ones.
+    """
+    ordered = np.sort(values, axis=None)
+    n = ordered.size
+    return float((ordered[(n - 1) // 2] + ordered[n // 2]) / 2.0)
 
 
 #: Samples of ``erf`` per unit of its argument in :data:`_ERF_TABLE`: the nearest entry is
@@ -311,18 +342,24 @@ def checked_saddle_fit(
     search(rough)
     # With every misfit within the limit's floor, the limit passes them all whatever the
     # median: the other corners' best misfits cannot change a decision.
-    if np.median(misfit) > MAX_SADDLE_MISFIT / MISFIT_MEDIANS and np.any(
-        misfit > MAX_SADDLE_MISFIT
+    if np.any(misfit > MAX_SADDLE_MISFIT) and (
+        sorted_median(misfit) > MAX_SADDLE_MISFIT / MISFIT_MEDIANS
     ):
         search(~rough)
     return amplitude, misfit
 
 
+@functools.lru_cache(maxsize=8)
 def corner_parity(pattern_size: tuple[int, int]) -> np.ndarray:
-    """+1 or -1 per corner: the sign of its saddle relative to corner 0 (they alternate)."""
+    """+1 or -1 per corner: the sign of its saddle relative to corner 0 (they alternate).
+
+    The array is shared between calls (read-only).
+    """
     cols, rows = pattern_size
     r, c = np.divmod(np.arange(cols * rows), cols)
-    return np.where((r + c) % 2 == 0, 1.0, -1.0)
+    parity = np.where((r + c) % 2 == 0, 1.0, -1.0)
+    parity.flags.writeable = False
+    return parity
 
 
 def reject_outliers(
@@ -351,7 +388,7 @@ def reject_outliers(
         mapped = src @ h[:, :2].T + h[:, 2]
         residual = np.linalg.norm(mapped[:, :2] / mapped[:, 2:3] - dst, axis=1)
         worst = int(np.argmax(residual))
-        limit = max(OUTLIER_MEDIANS * float(np.median(residual)), OUTLIER_FLOOR_PX)
+        limit = max(OUTLIER_MEDIANS * sorted_median(residual), OUTLIER_FLOOR_PX)
         if residual[worst] <= limit:
             break
         mask[index[worst]] = False
@@ -425,8 +462,8 @@ def select_corners(
     signed = amplitude * corner_parity(pattern_size)[found]
     # The board's colour order (dark or light square at corner 0) from the majority.
     if polarity is None:
-        polarity = 1.0 if np.median(signed) >= 0 else -1.0
-    limit = min(max(MAX_SADDLE_MISFIT, MISFIT_MEDIANS * float(np.median(misfit))), MISFIT_CEILING)
+        polarity = 1.0 if sorted_median(signed) >= 0 else -1.0
+    limit = min(max(MAX_SADDLE_MISFIT, MISFIT_MEDIANS * sorted_median(misfit)), MISFIT_CEILING)
     good = (signed * polarity >= min_contrast_dn / 2.0) & (misfit <= limit)
     mask[np.flatnonzero(found)[good]] = True
     return CornerSelection(mask, int(np.count_nonzero(~found)), int(np.count_nonzero(~good)), 0)

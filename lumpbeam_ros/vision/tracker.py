@@ -46,6 +46,7 @@ from lumpbeam_ros.vision.partial import (
     labelling_is_unambiguous,
     reject_outliers,
     select_corners,
+    sorted_median,
 )
 from lumpbeam_ros.vision.pose import (
     PlaneFit,
@@ -343,7 +344,7 @@ class TipTracker:
         if shortage:
             # With no corner at all where the board should be, it is not a partial view.
             return None, f'{shortage} ({selection.describe()})' if mask.any() else ''
-        error = float(np.median(np.linalg.norm(corners[mask] - guess[mask], axis=1)))
+        error = sorted_median(np.linalg.norm(corners[mask] - guess[mask], axis=1))
         if not labelling_is_unambiguous(int(mask.sum()), pattern) and not (
             self._prediction_error <= self._half_window / 2
         ):
