@@ -17,6 +17,14 @@ from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import RigGeometry
 from lumpbeam_ros.vision.geometry import Transform, tip_pose_from_transform, tip_transform
 
+#: Gauss-Newton stops after a step below this, m or rad. The tip moves parallel to the image
+#: plane (constant depth) and the pitch turns the image about the optical axis, so the
+#: model's curvature is about 1 per m or rad and the step after one of 0.5 mm is some 0.2 um:
+#: on the 2048 x 2048 drop test (bench) the poses moved by at most 0.2 um in x, 0.004 um in
+#: z and 0.006 urad in pitch against a 10 um stop, with one step per frame instead of two.
+#: The linearized residual and the last Jacobian serve for the covariance.
+_STEP_TOLERANCE = 5e-4
+
 
 @dataclass(frozen=True)
 class PlaneFit:
@@ -52,6 +60,8 @@ class PlaneModel:
         cam_tip = rig.tip_camera.inverse()
         self._r_ct = cam_tip.rotation
         self._t_ct = cam_tip.translation
+        # The points' y (across the bending plane) is untouched by the tip's motion.
+        self._offset_ct = np.outer(self._points[:, 1], self._r_ct[:, 1]) + self._t_ct
         self._f = np.diag(camera_info.k)[:2].copy()
         self._c = camera_info.k[:2, 2].copy()
 
@@ -78,20 +88,25 @@ class PlaneModel:
         """Returns the projected corners (N x 2) and d(pixels)/d(pose) (N x 2 x 3)."""
         x, z, pitch = pose
         c, s = np.cos(pitch), np.sin(pitch)
-        d = self._points - np.array([x, 0.0, z])
-        tip = np.column_stack([c * d[:, 0] - s * d[:, 2], d[:, 1], s * d[:, 0] + c * d[:, 2]])
-        p = tip @ self._r_ct.T + self._t_ct
-        # Derivatives of the tip-frame point with respect to x, z and pitch.
-        d_tip = np.empty((d.shape[0], 3, 3))
-        d_tip[:, :, 0] = [-c, 0.0, -s]
-        d_tip[:, :, 1] = [s, 0.0, -c]
-        d_tip[:, :, 2] = np.column_stack(
-            [-s * d[:, 0] - c * d[:, 2], np.zeros(d.shape[0]), c * d[:, 0] - s * d[:, 2]]
-        )
-        d_cam = np.einsum('ij,njk->nik', self._r_ct, d_tip)
+        d0 = self._points[:, 0] - x
+        d2 = self._points[:, 2] - z
+        r = self._r_ct
+        # The tip-frame point (c d0 - s d2, d1, s d0 + c d2) turned into the camera frame,
+        # column by column: this runs in every Gauss-Newton step of every frame.
+        rotated_0 = c * d0 - s * d2
+        rotated_2 = s * d0 + c * d2
+        p = np.outer(rotated_0, r[:, 0]) + np.outer(rotated_2, r[:, 2]) + self._offset_ct
+        # Camera-frame derivatives with respect to x, z (the same for every corner) and
+        # pitch (d/dpitch of the tip-frame point is (-rotated_2, 0, rotated_0)).
+        d_x = -c * r[:, 0] - s * r[:, 2]
+        d_z = s * r[:, 0] - c * r[:, 2]
+        d_pitch = np.outer(rotated_0, r[:, 2]) - np.outer(rotated_2, r[:, 0])
         inv_z = 1.0 / p[:, 2]
         uv = p[:, :2] * inv_z[:, None]
-        jac = (d_cam[:, :2, :] - uv[:, :, None] * d_cam[:, 2:3, :]) * inv_z[:, None, None]
+        jac = np.empty((p.shape[0], 2, 3))
+        jac[:, :, 0] = (d_x[:2] - uv * d_x[2]) * inv_z[:, None]
+        jac[:, :, 1] = (d_z[:2] - uv * d_z[2]) * inv_z[:, None]
+        jac[:, :, 2] = (d_pitch[:, :2] - uv * d_pitch[:, 2:3]) * inv_z[:, None]
         return uv * self._f + self._c, jac * self._f[None, :, None]
 
     def fit(self, pixels: np.ndarray, initial: np.ndarray, max_iterations: int = 10) -> PlaneFit:
@@ -121,11 +136,7 @@ class PlaneModel:
             jtj = j.T @ j
             step = np.linalg.solve(jtj, -(j.T @ r))
             pose += step
-            # The tip moves parallel to the image plane (constant depth) and the pitch turns
-            # the image about the optical axis, so the model's curvature is about 1 per m or
-            # rad: after a step below 10 um (or urad) the next would be below 1e-10, far
-            # under the 1 um noise, and the last Jacobian serves for the covariance.
-            if np.max(np.abs(step)) < 1e-5:
+            if np.max(np.abs(step)) < _STEP_TOLERANCE:
                 converged = True
                 break
         residual = (r + j @ step).reshape(-1, 2)

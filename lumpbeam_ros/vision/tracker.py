@@ -41,11 +41,13 @@ from lumpbeam_ros.vision.free_pose import (
     planar_part,
 )
 from lumpbeam_ros.vision.partial import (
+    OUTLIER_FLOOR_PX,
     board_polarity,
     coverage_problem,
     labelling_is_unambiguous,
     reject_outliers,
     select_corners,
+    sorted_median,
 )
 from lumpbeam_ros.vision.pose import (
     PlaneFit,
@@ -147,6 +149,7 @@ class TipTracker:
         self._calibration: RigCalibration | None = None
         self._set_rig(config.rig)
         self._pending: list[tuple[np.ndarray, np.ndarray]] = []
+        self._whole_board_coverage: str | None = None
         self.reset()
 
     def _set_rig(self, rig: RigGeometry) -> None:
@@ -333,16 +336,16 @@ class TipTracker:
         )  # fmt: skip
         ideal = np.full_like(corners, np.nan)
         ideal[selection.mask] = self.camera_info.undistort_pixels(corners[selection.mask])
-        mask = reject_outliers(self._object_xy, ideal, selection.mask, self.settings.min_corners)
-        selection = replace(selection, mask=mask, outliers=selection.count - int(mask.sum()))
-        shortage = coverage_problem(
-            self._object_xy, mask, self.settings.min_corners,
-            self.settings.min_corner_spread, self._board.square_size_m,
-        )  # fmt: skip
+        fit = self._fit_within_outlier_floor(ideal, selection.mask, pose_guess)
+        mask = selection.mask
+        if fit is None:
+            mask = reject_outliers(self._object_xy, ideal, mask, self.settings.min_corners)
+            selection = replace(selection, mask=mask, outliers=selection.count - int(mask.sum()))
+        shortage = self._coverage_problem(mask)
         if shortage:
             # With no corner at all where the board should be, it is not a partial view.
             return None, f'{shortage} ({selection.describe()})' if mask.any() else ''
-        error = float(np.median(np.linalg.norm(corners[mask] - guess[mask], axis=1)))
+        error = sorted_median(np.linalg.norm(corners[mask] - guess[mask], axis=1))
         if not labelling_is_unambiguous(int(mask.sum()), pattern) and not (
             self._prediction_error <= self._half_window / 2
         ):
@@ -353,12 +356,53 @@ class TipTracker:
             )
         ideal[~mask] = np.nan
         corners = np.where(mask[:, None], corners, np.nan)
-        fit, _ = self._fit(ideal, pose_guess)
+        if fit is None:
+            fit, _ = self._fit(ideal, pose_guess)
         if fit is None:
             return None, ''
         result = self._accept(stamp, corners, ideal, fit, detected=False)
         self._prediction_error = error
         return result, ''
+
+    def _fit_within_outlier_floor(
+        self, ideal: np.ndarray, mask: np.ndarray, pose_guess: np.ndarray
+    ) -> PlaneFit | FreeFit | None:
+        """The fit of the selected corners when none of them can be an outlier, else ``None``.
+
+        Once the rig is calibrated, the pose model is a homography with fewer degrees of
+        freedom than :func:`reject_outliers`' own, so when it passes every corner within
+        :data:`OUTLIER_FLOOR_PX` (a clean frame) no corner can miss the homography by more
+        than that floor, and the homography loop is left out. Otherwise (an occluder, a
+        corner caught off, or no calibration yet) the caller runs the loop as usual.
+
+        Args:
+            ideal: Undistorted corners (N x 2; NaN outside ``mask``).
+            mask: The corners the saddle check kept.
+            pose_guess: The predicted pose.
+
+        Returns:
+            The fit, or ``None`` when the homography loop must decide.
+        """
+        if not self._is_calibrated() or np.count_nonzero(mask) < max(self.settings.min_corners, 5):
+            return None
+        fit, _ = self._fit(np.where(mask[:, None], ideal, np.nan), pose_guess)
+        if fit is None or not fit.max_px <= OUTLIER_FLOOR_PX:
+            return None
+        return fit
+
+    def _coverage_problem(self, mask: np.ndarray) -> str:
+        """:func:`coverage_problem` of the used corners (that of the whole board kept)."""
+        if not mask.all():
+            return self._coverage_of(mask)
+        if self._whole_board_coverage is None:
+            self._whole_board_coverage = self._coverage_of(mask)
+        return self._whole_board_coverage
+
+    def _coverage_of(self, mask: np.ndarray) -> str:
+        return coverage_problem(
+            self._object_xy, mask, self.settings.min_corners,
+            self.settings.min_corner_spread, self._board.square_size_m,
+        )  # fmt: skip
 
     def _track(self, gray: np.ndarray, stamp: float) -> TrackResult:
         prediction = self._predict(stamp)
