@@ -195,7 +195,7 @@ def _erf_of_affine(
     index += (slope_y * _ERF_SAMPLES) * oy
     index += intercept * _ERF_SAMPLES + (reach + 0.5)
     np.clip(index, 0.0, 2.0 * reach, out=index)
-    return _ERF_TABLE.take(index.astype(np.intp))
+    return np.asarray(_ERF_TABLE.take(index.astype(np.intp)))
 
 
 @functools.lru_cache(maxsize=8)
