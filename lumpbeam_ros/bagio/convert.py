@@ -19,6 +19,7 @@ import numpy as np
 from lumpbeam_ros.bagio.typestore import message_class
 from lumpbeam_ros.errors import BagError
 from lumpbeam_ros.interface import (
+    CAMERA_FRAME,
     CAMERA_INFO_TYPE,
     CLOCK_TYPE,
     COMPRESSED_IMAGE_TYPE,
@@ -290,7 +291,7 @@ class CameraInfoData:
     k: np.ndarray
     d: np.ndarray = field(default_factory=lambda: np.zeros(5))
     distortion_model: str = 'plumb_bob'
-    frame_id: str = 'camera'
+    frame_id: str = CAMERA_FRAME
     r: np.ndarray = field(default_factory=lambda: np.eye(3))
     p: np.ndarray | None = None
 

@@ -17,7 +17,14 @@ from lumpbeam_ros.bagio import convert, fastscan
 from lumpbeam_ros.bagio.reader import BagReader, open_bag
 from lumpbeam_ros.bagio.tipseries import TipSeries
 from lumpbeam_ros.errors import BagError
-from lumpbeam_ros.interface import TIP_LOAD, TIP_POSE
+from lumpbeam_ros.interface import (
+    BEAM_PARAMS,
+    CAMERA_INFO,
+    IMAGE,
+    TIP_LOAD,
+    TIP_POSE,
+    TRACKER_POINT,
+)
 
 Bag = str | Path | BagReader
 
@@ -163,7 +170,7 @@ def read_load_events(bag: Bag, topic: str = TIP_LOAD) -> LoadSeries:
     return LoadSeries(t, kg)
 
 
-def read_points(bag: Bag, topic: str = '/tracker/point') -> PointSeries:
+def read_points(bag: Bag, topic: str = TRACKER_POINT) -> PointSeries:
     """Reads a ``geometry_msgs/PointStamped`` topic, sorted by stamp.
 
     Raises:
@@ -179,7 +186,7 @@ def read_points(bag: Bag, topic: str = '/tracker/point') -> PointSeries:
     return PointSeries(t, xs, ys, zs, _single_frame(frames, reader, topic))
 
 
-def iter_images(bag: Bag, topic: str = '/camera/image_raw') -> Iterator[ImageFrame]:
+def iter_images(bag: Bag, topic: str = IMAGE) -> Iterator[ImageFrame]:
     """Iterates over a ``sensor_msgs/Image`` topic in recording order.
 
     Yields:
@@ -193,7 +200,7 @@ def iter_images(bag: Bag, topic: str = '/camera/image_raw') -> Iterator[ImageFra
         yield ImageFrame(_stamp_s(msg), pixels, msg.encoding, msg.header.frame_id)
 
 
-def read_camera_info(bag: Bag, topic: str = '/camera/camera_info') -> convert.CameraInfoData:
+def read_camera_info(bag: Bag, topic: str = CAMERA_INFO) -> convert.CameraInfoData:
     """Returns the first ``sensor_msgs/CameraInfo`` of a topic.
 
     Raises:
@@ -206,7 +213,7 @@ def read_camera_info(bag: Bag, topic: str = '/camera/camera_info') -> convert.Ca
 
 
 def read_diagnostics(
-    bag: Bag, topic: str = '/beam_params'
+    bag: Bag, topic: str = BEAM_PARAMS
 ) -> list[tuple[float, list[convert.Status]]]:
     """Reads a ``diagnostic_msgs/DiagnosticArray`` topic as ``(stamp s, statuses)`` pairs.
 

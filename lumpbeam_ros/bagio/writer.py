@@ -40,7 +40,7 @@ from lumpbeam_ros.bagio import convert, metadata
 from lumpbeam_ros.bagio.qos import default_profile
 from lumpbeam_ros.bagio.typestore import serialize, type_description
 from lumpbeam_ros.errors import BagError
-from lumpbeam_ros.interface import BASE_FRAME, CLOCK
+from lumpbeam_ros.interface import BASE_FRAME, CAMERA_FRAME, CLOCK
 
 _log = logging.getLogger(__name__)
 
@@ -235,7 +235,7 @@ class BagWriter:
         topic: str,
         stamp: float,
         pixels: np.ndarray,
-        frame: str = 'camera',
+        frame: str = CAMERA_FRAME,
         encoding: str | None = None,
     ) -> None:
         """Writes a ``sensor_msgs/msg/Image``; see :func:`~lumpbeam_ros.bagio.convert.image`."""

@@ -24,7 +24,14 @@ import numpy as np
 from lumpbeam_ros.bagio import BagReader, BagWriter, convert
 from lumpbeam_ros.bagio.typestore import serialize
 from lumpbeam_ros.bench.bench_result import BenchResult
-from lumpbeam_ros.interface import BASE_FRAME, IMAGE, IMAGE_TYPE, POSE_STAMPED, TIP_POSE
+from lumpbeam_ros.interface import (
+    BASE_FRAME,
+    CAMERA_FRAME,
+    IMAGE,
+    IMAGE_TYPE,
+    POSE_STAMPED,
+    TIP_POSE,
+)
 from lumpbeam_ros.ros_domain import claim_domain_id
 
 FPS = 180.0
@@ -37,7 +44,7 @@ def _frames(count: int) -> tuple[list[bytes], list[bytes]]:
     images, poses = [], []
     for i in range(count):
         ns = round(i / FPS * 1e9)
-        images.append(serialize(convert.image(ns, pixels, 'camera')))
+        images.append(serialize(convert.image(ns, pixels, CAMERA_FRAME)))
         poses.append(serialize(convert.pose_stamped(ns, 2.3, -0.01, 0.01, BASE_FRAME)))
     return images, poses
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from lumpbeam_ros.bagio import BagWriter
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.interface import CAMERA_INFO, IMAGE
+from lumpbeam_ros.interface import CAMERA_FRAME, CAMERA_INFO, IMAGE
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.vision.messages import camera_info_to_data
@@ -24,7 +24,6 @@ from lumpbeam_ros.vision.synthetic import SyntheticCamera, SyntheticFrame
 IMAGE_TOPIC = IMAGE
 CAMERA_INFO_TOPIC = CAMERA_INFO
 #: ``header.frame_id`` of the images and the camera info.
-CAMERA_FRAME = 'camera'
 
 #: Smallest image side the camera configuration accepts, px.
 MIN_SIDE_PX = 64

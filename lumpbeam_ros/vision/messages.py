@@ -16,7 +16,12 @@ import numpy as np
 from lumpbeam_ros.bagio import CameraInfoData, convert
 from lumpbeam_ros.bagio.typestore import deserialize
 from lumpbeam_ros.errors import BagError
-from lumpbeam_ros.interface import CAMERA_INFO_TYPE, COMPRESSED_IMAGE_TYPE, IMAGE_TYPE
+from lumpbeam_ros.interface import (
+    CAMERA_FRAME,
+    CAMERA_INFO_TYPE,
+    COMPRESSED_IMAGE_TYPE,
+    IMAGE_TYPE,
+)
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.sources.pixels import decode_compressed, tracker_pixels
 
@@ -68,7 +73,7 @@ def camera_info_from_data(data: CameraInfoData) -> CameraInfo:
     )
 
 
-def camera_info_to_data(info: CameraInfo, frame_id: str = 'camera') -> CameraInfoData:
+def camera_info_to_data(info: CameraInfo, frame_id: str = CAMERA_FRAME) -> CameraInfoData:
     """Converts the camera model into bagio's record (for writing ``/camera/camera_info``).
 
     Args:
