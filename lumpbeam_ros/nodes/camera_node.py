@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -46,7 +46,6 @@ import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
 from rclpy.context import Context
-from rclpy.node import Node
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import CameraInfo as CameraInfoMsg
 from sensor_msgs.msg import Image
@@ -66,7 +65,7 @@ from lumpbeam_ros.interface import (
 )
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
-from lumpbeam_ros.nodes.ros_parameters import declare_parameters
+from lumpbeam_ros.nodes.ros_parameters import SchemaNode
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
 from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
 from lumpbeam_ros.vision.config import camera_config_from_parameters
@@ -92,7 +91,7 @@ def _stamp(msg: Any, stamp_ns: int) -> None:
     msg.sec, msg.nanosec = divmod(int(stamp_ns), NS_PER_S)
 
 
-class CameraNode(Node):
+class CameraNode(SchemaNode):
     """Tracks the tip in camera frames and publishes its pose.
 
     Args:
@@ -109,18 +108,12 @@ class CameraNode(Node):
     def __init__(
         self,
         context: Context | None = None,
-        parameter_overrides: Sequence[Parameter] | None = None,
+        parameter_overrides: Mapping[str, Any] | Sequence[Parameter] | None = None,
         namespace: str = '',
         cli_args: Sequence[str] | None = None,
     ):
-        super().__init__(
-            CAMERA_SCHEMA.node,
-            context=context,
-            namespace=namespace,
-            cli_args=list(cli_args) if cli_args is not None else None,
-            parameter_overrides=list(parameter_overrides or []),
-        )
-        values = declare_parameters(self, CAMERA_SCHEMA)
+        super().__init__(CAMERA_SCHEMA, context, parameter_overrides, namespace, cli_args)
+        values = self.parameter_values
         self.config = camera_config_from_parameters(
             {key: values[key] for key in CONFIG_KEYS}, f'{self.get_name()} parameters'
         )

@@ -37,7 +37,6 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
 from rclpy.clock import Clock, ClockType
 from rclpy.context import Context
-from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.task import Future as RclpyFuture
@@ -66,7 +65,7 @@ from lumpbeam_ros.interface import (
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
-from lumpbeam_ros.nodes.ros_parameters import declare_parameters
+from lumpbeam_ros.nodes.ros_parameters import SchemaNode
 from lumpbeam_ros.params.diagnosis_params import DIAGNOSIS_SCHEMA
 
 #: Seconds between repeated warnings about the same kind of bad input.
@@ -90,7 +89,7 @@ def _start_worker() -> None:
     import lumpbeam_ros.diagnose.workflow  # noqa: F401
 
 
-class DiagnosisNode(Node):
+class DiagnosisNode(SchemaNode):
     """Publishes ``/model_discrepancy`` from the measured and predicted tip and the load.
 
     Args:
@@ -106,19 +105,19 @@ class DiagnosisNode(Node):
     def __init__(
         self,
         context: Context | None = None,
-        parameter_overrides: Mapping[str, Any] | None = None,
+        parameter_overrides: Mapping[str, Any] | Sequence[Parameter] | None = None,
         namespace: str = '',
         cli_args: Sequence[str] | None = None,
     ):
-        overrides = [Parameter(k, value=v) for k, v in (parameter_overrides or {}).items()]
         super().__init__(
-            DIAGNOSIS_SCHEMA.node,
-            context=context,
-            namespace=namespace,
-            cli_args=list(cli_args) if cli_args is not None else None,
-            parameter_overrides=overrides,
+            DIAGNOSIS_SCHEMA,
+            context,
+            parameter_overrides,
+            namespace,
+            cli_args,
+            on_change=self._on_change,
         )
-        values = declare_parameters(self, DIAGNOSIS_SCHEMA, self._on_change)
+        values = self.parameter_values
         self.adopt = bool(values['adopt'])
         self.hardware_id = str(values['hardware_id'])
         self.beam: BeamParameters = load_beam_config(values['beam_config'] or None)[0]

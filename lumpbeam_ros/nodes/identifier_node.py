@@ -29,7 +29,6 @@ import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
 from rclpy.context import Context
-from rclpy.node import Node
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64
 
@@ -44,14 +43,14 @@ from lumpbeam_ros.interface import BASE_FRAME, BEAM_PARAMS, IDENTIFIER_STATUS, T
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
-from lumpbeam_ros.nodes.ros_parameters import declare_parameters
+from lumpbeam_ros.nodes.ros_parameters import SchemaNode
 from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA
 
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0
 
 
-class IdentifierNode(Node):
+class IdentifierNode(SchemaNode):
     """Publishes ``/beam_params`` from ``/tip_pose`` and ``/tip_load``.
 
     Args:
@@ -68,19 +67,12 @@ class IdentifierNode(Node):
     def __init__(
         self,
         context: Context | None = None,
-        parameter_overrides: Mapping[str, Any] | None = None,
+        parameter_overrides: Mapping[str, Any] | Sequence[Parameter] | None = None,
         namespace: str = '',
         cli_args: Sequence[str] | None = None,
     ):
-        overrides = [Parameter(k, value=v) for k, v in (parameter_overrides or {}).items()]
-        super().__init__(
-            IDENTIFIER_SCHEMA.node,
-            context=context,
-            namespace=namespace,
-            cli_args=list(cli_args) if cli_args is not None else None,
-            parameter_overrides=overrides,
-        )
-        values = declare_parameters(self, IDENTIFIER_SCHEMA)
+        super().__init__(IDENTIFIER_SCHEMA, context, parameter_overrides, namespace, cli_args)
+        values = self.parameter_values
         settings = {key: values[key] for key in PARAMETER_KEYS.values()}
         self.config: IdentifierConfig = config_from_parameters(
             settings, f'{self.get_name()} parameters'

@@ -14,7 +14,7 @@ A node calls it once, in ``__init__``::
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from rcl_interfaces.msg import (
@@ -24,6 +24,7 @@ from rcl_interfaces.msg import (
     ParameterType,
     SetParametersResult,
 )
+from rclpy.context import Context
 from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -157,3 +158,49 @@ def undeclared_in_schema(node: Node, schema: ParameterSchema) -> list[str]:
         and name not in RCLPY_PARAMETERS
         and not name.startswith(RCLPY_PREFIXES)
     )
+
+
+class SchemaNode(Node):
+    """A node named by its parameter schema, with every parameter of it declared.
+
+    The constructor every node of the package shares: the schema names the node, the
+    overrides and ``--ros-args`` (``--params-file``, ``-p``, remaps) are taken as rclpy takes
+    them, and :func:`declare_parameters` declares and checks the values.
+
+    Args:
+        schema: The node's parameters (and its name).
+        context: The rclpy context (default: the global one).
+        parameter_overrides: Values by name, or ``Parameter`` objects, on top of any
+            ``--params-file``.
+        namespace: The node's namespace (``'/beam_a'``); its topics resolve in it.
+        cli_args: Node-specific ``--ros-args`` (e.g. ``--params-file``, ``-r``).
+        on_change: See :func:`declare_parameters`.
+
+    Attributes:
+        parameter_values: The declared values, by name.
+
+    Raises:
+        ConfigError: A value is of the wrong type or out of range, naming the parameter.
+    """
+
+    def __init__(
+        self,
+        schema: ParameterSchema,
+        context: Context | None = None,
+        parameter_overrides: Mapping[str, Any] | Sequence[Parameter] | None = None,
+        namespace: str = '',
+        cli_args: Sequence[str] | None = None,
+        on_change: ChangeHook | None = None,
+    ):
+        if isinstance(parameter_overrides, Mapping):
+            overrides = [Parameter(k, value=v) for k, v in parameter_overrides.items()]
+        else:
+            overrides = list(parameter_overrides or [])
+        super().__init__(
+            schema.node,
+            context=context,
+            namespace=namespace,
+            cli_args=list(cli_args) if cli_args is not None else None,
+            parameter_overrides=overrides,
+        )
+        self.parameter_values = declare_parameters(self, schema, on_change)

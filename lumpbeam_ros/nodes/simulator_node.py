@@ -30,7 +30,6 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseStamped
 from rclpy.clock import Clock, ClockType
 from rclpy.context import Context
-from rclpy.node import Node
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64
 from visualization_msgs.msg import MarkerArray
@@ -53,7 +52,7 @@ from lumpbeam_ros.model.stream import PredictionStream
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
-from lumpbeam_ros.nodes.ros_parameters import declare_parameters
+from lumpbeam_ros.nodes.ros_parameters import SchemaNode
 from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA, effect_parameter_name
 from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.viz.marker_messages import scene_cdr
@@ -92,7 +91,7 @@ def load_board(path: str) -> BoardPlacement:
     return board_placement(load_camera_config(path or None))
 
 
-class SimulatorNode(Node):
+class SimulatorNode(SchemaNode):
     """Publishes the predicted tip pose of the lumped beam under the live tip load.
 
     Args:
@@ -109,18 +108,19 @@ class SimulatorNode(Node):
     def __init__(
         self,
         context: Context | None = None,
-        parameter_overrides: Sequence[Parameter] | None = None,
+        parameter_overrides: Mapping[str, Any] | Sequence[Parameter] | None = None,
         namespace: str = '',
         cli_args: Sequence[str] | None = None,
     ):
         super().__init__(
-            SIMULATOR_SCHEMA.node,
-            context=context,
-            namespace=namespace,
-            cli_args=list(cli_args) if cli_args is not None else None,
-            parameter_overrides=list(parameter_overrides or []),
+            SIMULATOR_SCHEMA,
+            context,
+            parameter_overrides,
+            namespace,
+            cli_args,
+            on_change=self._on_change,
         )
-        values = declare_parameters(self, SIMULATOR_SCHEMA, self._on_change)
+        values = self.parameter_values
         self._settings = values
         self._base_beam = load_beam(values['beam_config'])
         self._stream: PredictionStream | None = None
