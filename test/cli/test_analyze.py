@@ -49,9 +49,14 @@ def test_analyze_prints_writes_json_and_plots(drop_bag, tmp_path, capsys):
 
 
 def same_value(value, expected):
-    """Equal, floats to 1e-9 relative (another BLAS may round the fit differently)."""
+    """Equal, floats to 1e-6 relative.
+
+    The uncertainties and the amplitude shift are small differences of large sums: another
+    numpy, BLAS or CPU rounds them a few 1e-9 apart (seen on CI), while any real change in the
+    estimators moves them by far more than 1e-6.
+    """
     if isinstance(expected, float):
-        return value == pytest.approx(expected, rel=1e-9, abs=1e-300)
+        return value == pytest.approx(expected, rel=1e-6, abs=1e-300)
     return value == expected
 
 

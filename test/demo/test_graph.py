@@ -78,8 +78,12 @@ def test_interrupt_stops_with_sigint_and_kills_what_ignores_it(tmp_path, monkeyp
         "print('ready', flush=True)\n"
         'time.sleep(60)\n'
     )
+    # The polite child installs its handler as rclpy.init does for every node, so the test
+    # holds when pytest itself was started with SIGINT ignored (a background job of a
+    # non-interactive shell), which a plain Python child would inherit.
     polite = (
-        'import time\n'
+        'import signal, time\n'
+        'signal.signal(signal.SIGINT, signal.default_int_handler)\n'
         "print('ready', flush=True)\n"
         'try:\n'
         '    time.sleep(60)\n'

@@ -317,10 +317,12 @@ def test_beam_params_keep_the_keys_their_order_and_values(ros_graph, tmp_path):
     counts = ['samples_wrong_frame', 'samples_non_finite', 'samples_out_of_order', 'window_resets']
     expected = [*map(tuple, golden['beam_params']), *((key, '0') for key in counts)]
     assert [key for key, _ in pairs] == [key for key, _ in expected]
+    # 1e-6 relative, as analyze's golden test: the stds lose digits to cancellation that
+    # another numpy or CPU rounds differently.
     differ = [
         key
         for (key, value), (_, want) in zip(pairs, expected, strict=True)
-        if value != want and float(value) != pytest.approx(float(want), rel=1e-9, nan_ok=True)
+        if value != want and float(value) != pytest.approx(float(want), rel=1e-6, nan_ok=True)
     ]
     assert differ == []
     assert status.level == bytes([0]) and status.message == result.message
