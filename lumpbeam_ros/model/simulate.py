@@ -14,6 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
+from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.integrate import ChainState, ModalSolver, solve_reference
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
@@ -27,6 +28,10 @@ from lumpbeam_ros.model.trajectory import TipTrajectory
 DEFAULT_STEP_S = 1.0 / 180.0
 
 
+class SimulationDiverged(LumpbeamError):
+    """The modal solver cannot integrate a beam and the stiff fallback is off."""
+
+
 class BeamSimulation:
     """A beam advanced in time, with the tip load changeable between advances.
 
@@ -36,6 +41,9 @@ class BeamSimulation:
             static equilibrium for that load.
         t0: Start time, s.
         step: Internal grid spacing, s.
+        stiff_fallback: Integrate a stretch the modal solver cannot (extreme parameters) with
+            the Radau reference; ``False`` raises :class:`SimulationDiverged` instead (a fit
+            takes such parameters for a bad fit rather than wait minutes for Radau).
     """
 
     def __init__(
@@ -44,14 +52,19 @@ class BeamSimulation:
         load_kg: float = 0.0,
         t0: float = 0.0,
         step: float = DEFAULT_STEP_S,
+        stiff_fallback: bool = True,
     ):
         self.beam = beam
+        self.stiff_fallback = stiff_fallback
         self.step = step
         self.time = float(t0)
         self.load_kg = float(load_kg)
         self._solvers: dict[float, ModalSolver] = {}
         chain = self._solver(self.load_kg).chain
         self.state = ChainState(static_equilibrium(chain), np.zeros(beam.n_segments))
+        # At rest in the equilibrium of the load it carries: nothing to integrate until the
+        # load changes (a drop test's seconds before the release cost nothing).
+        self._at_rest = True
 
     def _solver(self, load_kg: float) -> ModalSolver:
         if load_kg not in self._solvers:
@@ -74,6 +87,7 @@ class BeamSimulation:
         """
         if not np.isfinite(load_kg) or load_kg < 0.0:
             raise ValueError(f'tip load must be a non-negative number of kg, got {load_kg!r}')
+        self._at_rest = self._at_rest and float(load_kg) == self.load_kg
         self.load_kg = float(load_kg)
 
     def advance(self, t_out: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -92,12 +106,18 @@ class BeamSimulation:
         if t_out.size == 0 or np.any(np.diff(t_out) < 0) or t_out[0] < self.time - 1e-12:
             raise ValueError('output times must be increasing and not before the current time')
         duration = float(t_out[-1] - self.time)
-        if duration <= 0.0:
+        if duration <= 0.0 or self._at_rest:
+            self.time = max(self.time, float(t_out[-1]))
             phi = np.repeat(self.state.phi[None, :], t_out.size, axis=0)
             return phi, np.repeat(self.state.phi_dot[None, :], t_out.size, axis=0)
         solver = self._solver(self.load_kg)
         solution = solver.solve(self.state, duration, self.step)
         if solution is None:
+            if not self.stiff_fallback:
+                raise SimulationDiverged(
+                    f'the modal solver did not converge over {duration:.3f} s: the beam is '
+                    'too far from its linearisation (extreme parameters)'
+                )
             steps = max(1, int(np.ceil(duration / self.step)))
             grid = np.linspace(0.0, duration, steps + 1)
             solution = solve_reference(solver.chain, self.state, grid)
@@ -118,6 +138,7 @@ def simulate_loads(
     load_events: Sequence[tuple[float, float]],
     initial_load_kg: float = 0.0,
     step: float = DEFAULT_STEP_S,
+    stiff_fallback: bool = True,
 ) -> TipTrajectory:
     """Simulates the tip under a schedule of load changes, starting at rest.
 
@@ -132,16 +153,20 @@ def simulate_loads(
         load_events: ``(time, load_kg)`` changes, in any order.
         initial_load_kg: The load before the first event; the beam starts at rest with it.
         step: Internal grid spacing, s.
+        stiff_fallback: See :class:`BeamSimulation`.
 
     Returns:
         The tip trajectory at ``t``, with the load at each sample.
+
+    Raises:
+        SimulationDiverged: The modal solver failed and ``stiff_fallback`` is off.
     """
     t = np.asarray(t, dtype=float)
     latency = beam.effects.latency_s
     physical_t = t - latency
     events = sorted((float(te), float(kg)) for te, kg in load_events)
     start = min(float(physical_t[0]), events[0][0] if events else np.inf)
-    simulation = BeamSimulation(beam, initial_load_kg, t0=start, step=step)
+    simulation = BeamSimulation(beam, initial_load_kg, start, step, stiff_fallback)
     n = beam.n_segments
     phi = np.empty((t.size, n))
     loads = np.empty(t.size)
