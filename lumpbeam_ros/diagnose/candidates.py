@@ -6,11 +6,14 @@ the effects: ``k_total_nm_per_rad`` (k_tE, B.12: the static drop and the frequen
 (positive by construction, order one whatever the unit).
 
 A candidate adds one *strength*: a quantity that is zero when the effect is off and grows
-with it, fitted linearly in units of ``scale``. For four effects it is the contract parameter
+with it, fitted linearly in units of ``scale``. For most effects it is the contract parameter
 itself; for ``base_compliance`` it is the mount's compliance relative to the clamp joint,
-``k_clamp / k_base`` (a rigid mount is 0, where ``k_base`` would be infinite). So the nominal
-model is the candidate at strength 0, a bound that the least squares reaches in a step or
-two when the data hold no such effect, instead of crawling along a log-parameter to -inf.
+``k_clamp / k_base`` (a rigid mount is 0, where ``k_base`` would be infinite), for
+``sensor_scale`` the scale's departure from 1. So the nominal model is the candidate at
+strength 0, a bound that the least squares reaches in a step or two when the data hold no
+such effect, instead of crawling along a log-parameter to -inf. Three effects have a sign
+(``cubic_stiffness`` hardens or softens, ``sensor_scale`` is above or below 1,
+``mount_tilt`` is down or up): their strength is searched on both sides of 0.
 
 Each strength has a search bound, beyond its plausible range: a best fit outside the
 plausible range (or pinned at the bound) is unphysical, and a diagnosis that needs it is
@@ -24,7 +27,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters
+from lumpbeam_ros.model.chain import LumpedChain
+from lumpbeam_ros.model.parameters import EFFECT_OFF, EFFECT_PARAMETERS, BeamParameters, Effects
+from lumpbeam_ros.model.statics import static_equilibrium
 
 NOMINAL = 'nominal'
 
@@ -47,6 +52,9 @@ class Candidate:
         reciprocal: The contract parameter is ``reference / strength`` (a compliance fitted
             for a stiffness), else the strength itself.
         reference: See ``reciprocal``.
+        signed: The strength may be negative (searched down to ``-search_max``).
+        offset: The contract parameter's "off" value, added to a non-reciprocal strength
+            (``sensor_scale``: 1).
     """
 
     name: str
@@ -57,6 +65,8 @@ class Candidate:
     start: float = 0.0
     reciprocal: bool = False
     reference: float = 1.0
+    signed: bool = False
+    offset: float = 0.0
 
     @property
     def n_parameters(self) -> int:
@@ -68,7 +78,7 @@ class Candidate:
         lo = [math.log(STIFFNESS_FACTORS[0]), math.log(DAMPING_FACTORS[0])]
         hi = [math.log(STIFFNESS_FACTORS[1]), math.log(DAMPING_FACTORS[1])]
         if self.parameter is not None:
-            lo.append(0.0)
+            lo.append(-self.search_max / self.scale if self.signed else 0.0)
             hi.append(self.search_max / self.scale)
         return np.asarray(lo), np.asarray(hi)
 
@@ -95,10 +105,19 @@ class Candidate:
         """
         if self.parameter is None:
             return float('nan')
-        strength = float(x[2]) * self.scale
+        return self.parameter_value(float(x[2]))
+
+    def parameter_value(self, x_strength: float) -> float:
+        """The contract parameter (SI) at a fitted strength ``x_strength`` (units of scale)."""
+        strength = x_strength * self.scale
         if not self.reciprocal:
-            return strength
+            return self.offset + strength
         return self.reference / strength if strength > 0.0 else math.inf
+
+    def strength_physical(self, x_strength: float) -> bool:
+        """Whether a fitted strength lies inside the plausible range, off the search bound."""
+        strength = abs(x_strength) * self.scale
+        return strength <= min(self.plausible_max, (1.0 - 1e-3) * self.search_max)
 
     def beam(self, nominal: BeamParameters, x: np.ndarray) -> BeamParameters:
         """The beam that ``x`` describes.
@@ -140,10 +159,7 @@ class Candidate:
         margin = 1e-3 * (hi[:2] - lo[:2])
         if np.any(x[:2] <= lo[:2] + margin) or np.any(x[:2] >= hi[:2] - margin):
             return False
-        if self.parameter is None:
-            return True
-        strength = float(x[2]) * self.scale
-        return strength <= min(self.plausible_max, (1.0 - 1e-3) * self.search_max)
+        return self.parameter is None or self.strength_physical(float(x[2]))
 
 
 def nominal_candidate() -> Candidate:
@@ -158,15 +174,19 @@ SEARCHED_EFFECTS = (
     'quadratic_drag',
     'added_mass',
     'sensor_latency',
+    'cubic_stiffness',
+    'sensor_scale',
+    'mount_tilt',
 )
+
+#: Effects whose strength has a sign.
+SIGNED_EFFECTS = frozenset({'cubic_stiffness', 'sensor_scale', 'mount_tilt'})
 
 
 def effect_candidates(nominal: BeamParameters) -> list[Candidate]:
     """The effects the diagnosis searches, with ranges scaled to the beam.
 
-    These are the first five of :data:`SEARCHED_EFFECTS`; the model also simulates
-    ``cubic_stiffness``, ``sensor_scale`` and ``mount_tilt``, which the search does not
-    name yet.
+    All eight effects of :data:`SEARCHED_EFFECTS`.
 
     Args:
         nominal: The nominal beam; its clamp stiffness, masses and length set the scales.
@@ -178,6 +198,9 @@ def effect_candidates(nominal: BeamParameters) -> list[Candidate]:
     k_clamp = float(nominal.joint_stiffness()[0])
     carried_kg = nominal.tip_mass_kg + nominal.mass_kg
     clamp_moment = nominal.gravity_mps2 * carried_kg * nominal.length_m
+    # A hardening of 1 % of the clamp's tangent stiffness at its unloaded rest angle.
+    rest = static_equilibrium(LumpedChain.from_beam(replace(nominal, effects=Effects())))
+    k3_unit = 0.01 * k_clamp / (3.0 * max(float(rest[0]) ** 2, 1e-12))
     # name: (scale, search_max, plausible_max, start)
     table = {
         # Compliance relative to the clamp joint; a mount 20 times softer than the beam's
@@ -191,6 +214,12 @@ def effect_candidates(nominal: BeamParameters) -> list[Candidate]:
         'added_mass': (1.0, 20.0 * carried_kg, 2.0 * carried_kg, 0.03),
         # Beyond a quarter of a second a camera pipeline is broken, not late.
         'sensor_latency': (0.01, 2.0, 0.25, 0.002),
+        # Half the clamp's stiffness gained or lost over the swing is not a mild nonlinearity.
+        'cubic_stiffness': (k3_unit, 500.0 * k3_unit, 50.0 * k3_unit, k3_unit),
+        # A camera 30 % off in depth is a wrong calibration, not a small scale error.
+        'sensor_scale': (0.01, 0.9, 0.3, 0.002),
+        # A clamp tilted more than 10 degrees is a different setup, not an unnoticed tilt.
+        'mount_tilt': (0.01, 1.2, 0.175, 0.002),
     }
     return [
         Candidate(
@@ -202,6 +231,8 @@ def effect_candidates(nominal: BeamParameters) -> list[Candidate]:
             start,
             reciprocal=name == 'base_compliance',
             reference=k_clamp,
+            signed=name in SIGNED_EFFECTS,
+            offset=EFFECT_OFF[name],
         )
         for name in SEARCHED_EFFECTS
         for scale, search_max, plausible, start in [table[name]]

@@ -16,20 +16,45 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 from scipy.optimize import least_squares
 
-from lumpbeam_ros.diagnose.candidates import Candidate
 from lumpbeam_ros.diagnose.record import Record
 from lumpbeam_ros.model.parameters import BeamParameters
-from lumpbeam_ros.model.simulate import simulate_loads
+from lumpbeam_ros.model.simulate import SimulationDivergedError, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
 #: Finite-difference step of the fitted parameters (relative, at least 2e-3 absolute): well
 #: above the simulator's round-off and its dry-friction switching, well below any
 #: parameter's uncertainty.
 DIFF_STEP = 2e-3
+
+#: Residual of every sample when a model cannot be simulated (extreme parameters): far
+#: worse than any fit, so the least squares steps back.
+DIVERGED_RESIDUAL = 1e3
+
+
+class Fittable(Protocol):
+    """What a fit needs of a model: a single candidate effect, or several at once."""
+
+    @property
+    def name(self) -> str:
+        """The model's name."""
+
+    @property
+    def n_parameters(self) -> int:
+        """Fitted parameters."""
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """Bounds of the fitted ``x``."""
+
+    def beam(self, nominal: BeamParameters, x: np.ndarray) -> BeamParameters:
+        """The beam that ``x`` describes."""
+
+    def physical(self, x: np.ndarray) -> bool:
+        """Whether ``x`` is plausible and off its bounds."""
 
 
 @dataclass(frozen=True)
@@ -46,7 +71,7 @@ class Fit:
         physical: Whether the fitted values are inside their plausible ranges.
     """
 
-    candidate: Candidate
+    candidate: Fittable
     x: np.ndarray
     beam: BeamParameters
     chi2: float
@@ -98,7 +123,31 @@ class FitProblem:
         """
         self.simulations += 1
         t = self.record.t[self.record.t <= end_s]
-        return simulate_loads(beam, t, self.record.load_events, self.record.initial_load_kg)
+        return simulate_loads(
+            beam, t, self.record.load_events, self.record.initial_load_kg, stiff_fallback=False
+        )
+
+    def model_residuals(
+        self, model: Fittable, x: np.ndarray, end_s: float = math.inf
+    ) -> np.ndarray:
+        """Residuals of a model at ``x`` on the samples up to ``end_s``.
+
+        A beam the modal solver cannot simulate (extreme parameters) gets
+        ``DIVERGED_RESIDUAL`` everywhere: a bad fit, not minutes of a stiff solver.
+
+        Args:
+            model: The model.
+            x: Its parameters.
+            end_s: Last time, s.
+
+        Returns:
+            The stacked residuals (:meth:`residuals`).
+        """
+        try:
+            return self.residuals(self.simulate(model.beam(self.nominal, x), end_s))
+        except SimulationDivergedError:
+            count = int(np.count_nonzero(self.record.t <= end_s))
+            return np.full(2 * count, DIVERGED_RESIDUAL)
 
     def residuals(self, trajectory: TipTrajectory, start_s: float = -math.inf) -> np.ndarray:
         """Noise-normalized residuals (model minus measurement), z then pitch.
@@ -128,7 +177,7 @@ class FitProblem:
 
     def fit(
         self,
-        candidate: Candidate,
+        candidate: Fittable,
         x0: np.ndarray,
         end_s: float = math.inf,
         max_evaluations: int = 60,
@@ -149,7 +198,7 @@ class FitProblem:
         start = self.simulations
 
         def fun(x: np.ndarray) -> np.ndarray:
-            return self.residuals(self.simulate(candidate.beam(self.nominal, x), end_s))
+            return self.model_residuals(candidate, x, end_s)
 
         result = least_squares(
             fun,

@@ -108,8 +108,91 @@ def information_criteria(
     )
 
 
+@dataclass(frozen=True)
+class RoundDecision:
+    """One round of forward selection: whether the best candidate joins the model.
+
+    Attributes:
+        keep: The best candidate is added.
+        best: The best-scoring candidate (added or not).
+        reason: One sentence for the human summary.
+        unphysical: The data insist on the best candidate, but only with an implausible
+            parameter: the answer is ``unexplained``.
+    """
+
+    keep: bool
+    best: str
+    reason: str
+    unphysical: bool = False
+
+
+def decide_round(base: Score, candidates: Sequence[Score]) -> RoundDecision:
+    """Whether the best candidate improves on the current model (rules 1 and 3).
+
+    The best (lowest BIC) must beat ``base`` and the runner-up each by ``SIGNIFICANT_BIC``,
+    and both of them on the held-out part; it must be physical.
+
+    Args:
+        base: The current model's score (the nominal model in the first round).
+        candidates: The current model plus one more effect, one score each.
+
+    Returns:
+        The round's decision.
+    """
+    ranked = sorted(candidates, key=lambda s: s.bic)
+    best = ranked[0]
+    runner = ranked[1] if len(ranked) > 1 else base
+    margin_base = base.bic - best.bic
+    margin_runner = runner.bic - best.bic
+    if margin_base < SIGNIFICANT_BIC:
+        return RoundDecision(
+            False,
+            best.name,
+            f'no effect improves on {base.name} significantly (best {best.name}, '
+            f'dBIC {margin_base:.1f})',
+        )
+    if margin_runner < SIGNIFICANT_BIC or best.holdout_chi2 >= runner.holdout_chi2:
+        return RoundDecision(
+            False,
+            best.name,
+            f'{best.name} and {runner.name} explain the data about equally '
+            f'(dBIC {margin_runner:.1f}, held-out chi2 {best.holdout_chi2:.2f} vs '
+            f'{runner.holdout_chi2:.2f})',
+        )
+    if best.holdout_chi2 >= base.holdout_chi2:
+        return RoundDecision(
+            False, best.name, f'{best.name} does not improve the held-out part of the record'
+        )
+    if not best.physical:
+        return RoundDecision(
+            False,
+            best.name,
+            f'the best candidate, {best.name}, needs an unphysical parameter {best.parameters}',
+            unphysical=True,
+        )
+    return RoundDecision(
+        True,
+        best.name,
+        f'{best.name} beats {base.name} by dBIC {margin_base:.0f} and the runner-up '
+        f'{runner.name} by {margin_runner:.0f}; held-out chi2/n {best.holdout_chi2:.2f}',
+    )
+
+
+def explains(score: Score) -> bool:
+    """Rule 2: reduced chi2 below ``EXPLAINED_CHI2`` on the whole record and held out."""
+    return max(score.record_chi2, score.holdout_chi2) < EXPLAINED_CHI2
+
+
+def unexplained_reason(score: Score) -> str:
+    """Why a model that does not explain the data (rule 2) makes the answer ``unexplained``."""
+    return (
+        f'the best model, {score.name}, leaves chi2/n {score.record_chi2:.2f} '
+        f'(held-out {score.holdout_chi2:.2f}): a gap no library effect explains'
+    )
+
+
 def decide(nominal: Score, candidates: Sequence[Score]) -> Decision:
-    """Names the missing effect, or ``none``, or ``unexplained`` (see the module docstring).
+    """Names one missing effect, or ``none``, or ``unexplained`` (see the module docstring).
 
     Args:
         nominal: The nominal model's score.
@@ -118,46 +201,12 @@ def decide(nominal: Score, candidates: Sequence[Score]) -> Decision:
     Returns:
         The decision.
     """
-    ranked = sorted(candidates, key=lambda s: s.bic)
-    best = ranked[0]
-    runner = ranked[1] if len(ranked) > 1 else nominal
-    nominal_fits = max(nominal.record_chi2, nominal.holdout_chi2) < EXPLAINED_CHI2
-    fallback = NONE if nominal_fits else UNEXPLAINED
-    margin_nominal = nominal.bic - best.bic
-    margin_runner = runner.bic - best.bic
-    if margin_nominal < SIGNIFICANT_BIC:
-        why = 'no effect improves on the nominal model significantly'
-        return Decision(
-            fallback, best.name, f'{why} (best {best.name}, dBIC {margin_nominal:.1f})'
-        )
-    if max(best.record_chi2, best.holdout_chi2) >= EXPLAINED_CHI2:
-        return Decision(
-            UNEXPLAINED,
-            best.name,
-            f'the best candidate, {best.name}, leaves chi2/n {best.record_chi2:.2f} '
-            f'(held-out {best.holdout_chi2:.2f}): a gap no library effect explains',
-        )
-    if margin_runner < SIGNIFICANT_BIC or best.holdout_chi2 >= runner.holdout_chi2:
-        return Decision(
-            fallback,
-            best.name,
-            f'{best.name} and {runner.name} explain the data about equally '
-            f'(dBIC {margin_runner:.1f}, held-out chi2 {best.holdout_chi2:.2f} vs '
-            f'{runner.holdout_chi2:.2f})',
-        )
-    if best.holdout_chi2 >= nominal.holdout_chi2:
-        return Decision(
-            fallback, best.name, f'{best.name} does not improve the held-out part of the record'
-        )
-    if not best.physical:
-        return Decision(
-            UNEXPLAINED,
-            best.name,
-            f'the best candidate, {best.name}, needs an unphysical parameter {best.parameters}',
-        )
-    return Decision(
-        best.name,
-        best.name,
-        f'{best.name} beats the nominal model by dBIC {margin_nominal:.0f} and the runner-up '
-        f'{runner.name} by {margin_runner:.0f}; held-out chi2/n {best.holdout_chi2:.2f}',
-    )
+    verdict = decide_round(nominal, candidates)
+    best = min(candidates, key=lambda s: s.bic)
+    if verdict.keep:
+        if not explains(best):
+            return Decision(UNEXPLAINED, best.name, unexplained_reason(best))
+        return Decision(best.name, best.name, verdict.reason)
+    if verdict.unphysical or not explains(nominal):
+        return Decision(UNEXPLAINED, best.name, verdict.reason)
+    return Decision(NONE, best.name, verdict.reason)

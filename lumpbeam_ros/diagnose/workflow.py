@@ -11,10 +11,13 @@
    beta); nothing else of the configuration is refit.
 3. Signatures of the nominal model's residual (:mod:`~lumpbeam_ros.diagnose.signatures`);
    the time shift at the load event starts the latency fit.
-4. Each effect fitted on the record up to ``train_fraction`` of the time after the event,
-   then checked on the rest (held out), and scored (:mod:`~lumpbeam_ros.diagnose.scoring`).
-5. The winner, if any, refit on the whole record; the gap before (nominal) and after
-   (augmented) measured on the whole record.
+4. Forward selection (:mod:`~lumpbeam_ros.diagnose.selection`): every effect fitted on the
+   record up to ``train_fraction`` of the time after the event, checked on the rest (held
+   out) and scored (:mod:`~lumpbeam_ros.diagnose.scoring`); the best joins the model when
+   the data insist on it, and a second effect is searched on top of it the same way (a
+   pair only on a decay of at least ``PAIR_MIN_DECAY_S``).
+5. The selected model, if any, refit on the whole record; the gap before (nominal) and
+   after (augmented) measured on the whole record.
 """
 
 from __future__ import annotations
@@ -25,17 +28,27 @@ from typing import Any
 import numpy as np
 
 from lumpbeam_ros.blas import single_threaded_blas
-from lumpbeam_ros.diagnose.candidates import effect_candidates, nominal_candidate
-from lumpbeam_ros.diagnose.fitting import Fit, FitProblem
+from lumpbeam_ros.diagnose.candidates import Candidate, effect_candidates, nominal_candidate
+from lumpbeam_ros.diagnose.fitting import FitProblem
 from lumpbeam_ros.diagnose.gap import SETTLE_S, Gap, decay_fit, measure_gap
 from lumpbeam_ros.diagnose.noise import decay_error_std, noise_std
 from lumpbeam_ros.diagnose.record import Record
 from lumpbeam_ros.diagnose.scoring import (
+    NONE,
+    UNEXPLAINED,
     Decision,
     Score,
-    decide,
-    inflation,
-    information_criteria,
+    explains,
+    unexplained_reason,
+)
+from lumpbeam_ros.diagnose.selection import (
+    MAX_EFFECTS,
+    PAIR_MIN_DECAY_S,
+    Evaluated,
+    Model,
+    Selection,
+    Selector,
+    select,
 )
 from lumpbeam_ros.diagnose.signatures import Signatures, signatures
 from lumpbeam_ros.errors import LumpbeamError
@@ -55,12 +68,36 @@ DEFAULT_C_TOTAL = 0.08
 
 
 @dataclass(frozen=True)
+class NamedEffect:
+    """One effect the diagnosis names.
+
+    Attributes:
+        name: The effect's name (doc/interfaces.md, 'Missing effects').
+        parameters: ``{parameter: value}``, SI, fitted on the whole record with the others.
+        gap_reduction: Share of the tip-z RMS gap (over the whole record) that adding it
+            removed, from the model before it to the model with it.
+    """
+
+    name: str
+    parameters: dict[str, float]
+    gap_reduction: float
+
+    def as_dict(self) -> dict[str, Any]:
+        """``{name, parameters, gap_reduction}``."""
+        return {
+            'name': self.name,
+            'parameters': dict(self.parameters),
+            'gap_reduction': self.gap_reduction,
+        }
+
+
+@dataclass(frozen=True)
 class Diagnosis:
     """What ``lumpbeam diagnose`` reports (doc/interfaces.md, 'Command line', ``diagnose`` keys).
 
     Attributes:
-        missing_effect: An effect name of doc/interfaces.md, ``'none'`` or ``'unexplained'``.
-        effect_parameters: The named effect's parameter (empty otherwise).
+        missing_effect: The first named effect, ``'none'`` or ``'unexplained'``.
+        effect_parameters: Every named effect's parameter (empty otherwise).
         gap_before: The nominal model (k_tE, beta refit) against the record.
         gap_after: The augmented model against the record (the nominal one when nothing
             is named).
@@ -78,6 +115,9 @@ class Diagnosis:
         before: Nominal simulation at the record's stamps.
         after: Augmented simulation at the record's stamps.
         simulations: Model simulations the diagnosis ran.
+        missing_effects: Every named effect, in the order chosen.
+        confidence: BIC posterior probability of the answer's path (product over rounds).
+        rounds: The selection's rounds (JSON form).
     """
 
     missing_effect: str
@@ -98,6 +138,9 @@ class Diagnosis:
     before: TipTrajectory
     after: TipTrajectory
     simulations: int
+    missing_effects: tuple[NamedEffect, ...] = ()
+    confidence: float = 1.0
+    rounds: tuple[dict[str, Any], ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON form: the contract keys, then ``details`` for humans and plots."""
@@ -110,8 +153,11 @@ class Diagnosis:
                 {'name': s.name, 'parameters': s.parameters, 'score': s.bic}
                 for s in self.candidates
             ],
+            'missing_effects': [e.as_dict() for e in self.missing_effects],
+            'confidence': self.confidence,
             'details': {
                 'reason': self.decision.reason,
+                'rounds': [dict(r) for r in self.rounds],
                 'gap_configured': self.gap_configured.as_dict(),
                 'score': 'BIC (lower is better) of the fit on the training part',
                 'nominal': _score_details(self.nominal),
@@ -199,23 +245,6 @@ def _static_seed(model: TipTrajectory, record: Record, problem: FitProblem) -> B
     return replace(beam, k_total_nm_per_rad=beam.k_total_nm_per_rad * factor)
 
 
-@dataclass(frozen=True)
-class _Evaluated:
-    fit: Fit
-    trajectory: TipTrajectory
-    residuals: np.ndarray  # z then pitch, whole record
-
-
-def _evaluate(problem: FitProblem, fit: Fit) -> _Evaluated:
-    trajectory = problem.simulate(fit.beam)
-    return _Evaluated(fit, trajectory, problem.residuals(trajectory))
-
-
-def _chi2(residuals: np.ndarray, mask: np.ndarray) -> float:
-    both = np.concatenate([mask, mask])
-    return float(np.mean(residuals[both] ** 2))
-
-
 def diagnose(
     record: Record, beam: BeamParameters, train_fraction: float = TRAIN_FRACTION
 ) -> Diagnosis:
@@ -257,69 +286,108 @@ def _diagnose(record: Record, beam: BeamParameters, train_fraction: float) -> Di
     measured_mode = measured_fit.mode(0)
 
     nominal_model = nominal_candidate()
-    nominal = _evaluate(problem, problem.fit(nominal_model, np.zeros(2), train_end))
-    sig = signatures(record, nominal.trajectory, measured_fit.offset)
+    nominal = problem.fit(nominal_model, np.zeros(2), train_end)
+    nominal_trajectory = problem.simulate(nominal.beam)
+    sig = signatures(record, nominal_trajectory, measured_fit.offset)
 
-    evaluated = [nominal]
-    for candidate in effect_candidates(problem.nominal):
-        strength = None
+    def start_strength(candidate: Candidate) -> float | None:
         if candidate.name == 'sensor_latency' and sig.time_shift_s > candidate.start:
-            strength = sig.time_shift_s  # the delay seen at the load event
-        x0 = candidate.start_x(nominal.fit.x, strength)
-        evaluated.append(_evaluate(problem, problem.fit(candidate, x0, train_end)))
+            return sig.time_shift_s  # the delay seen at the load event
+        return None
 
-    best_train = min(evaluated, key=lambda e: e.fit.chi2)
-    phi = inflation(best_train.residuals[np.concatenate([train, train])])
-    n_train = int(2 * np.count_nonzero(train))
-    scores = [_score(problem, e, train, n_train, phi) for e in evaluated]
-    nominal_score, candidate_scores = scores[0], scores[1:]
-    decision = decide(nominal_score, candidate_scores)
+    decay_s = _decay_length(record)
+    max_effects, limit = MAX_EFFECTS, ''
+    if decay_s < PAIR_MIN_DECAY_S:
+        max_effects = 1
+        limit = (
+            f'the decay ({decay_s:.1f} s) is too short for a pair of effects (at least '
+            f'{PAIR_MIN_DECAY_S:g} s): one effect at most'
+        )
+    selector = Selector(problem, train, train_end)
+    selection = select(
+        selector, nominal, effect_candidates(problem.nominal), max_effects, start_strength
+    )
+    decision = _decision(selection, limit)
 
     # The final models use the whole record: more data, and the gaps are over all of it.
-    final_nominal = _evaluate(problem, problem.fit(nominal_model, nominal.fit.x))
-    augmented = final_nominal
-    effect_parameters: dict[str, float] = {}
-    if decision.missing_effect not in ('none', 'unexplained'):
-        winner = next(e.fit for e in evaluated if e.fit.name == decision.missing_effect)
-        augmented = _evaluate(problem, problem.fit(winner.candidate, winner.x))
-        effect_parameters = {
-            str(winner.candidate.parameter): winner.candidate.value(augmented.fit.x)
-        }
+    final_nominal = problem.fit(nominal_model, nominal.x)
+    before = problem.simulate(final_nominal.beam)
+    augmented_beam, after = final_nominal.beam, before
+    named: tuple[NamedEffect, ...] = ()
+    if decision.missing_effect not in (NONE, UNEXPLAINED):
+        chosen = selection.model
+        final = problem.fit(chosen.model, chosen.fit.x)
+        augmented_beam, after = final.beam, problem.simulate(final.beam)
+        named = _named(chosen.model, final.x, selection.path, sigma_z, train)
 
+    scores = [e.score for e in selection.rounds[0].fitted] if selection.rounds else []
     return Diagnosis(
         missing_effect=decision.missing_effect,
-        effect_parameters=effect_parameters,
-        gap_before=measure_gap(record, final_nominal.trajectory, measured_mode),
-        gap_after=measure_gap(record, augmented.trajectory, measured_mode),
+        effect_parameters={k: v for e in named for k, v in e.parameters.items()},
+        gap_before=measure_gap(record, before, measured_mode),
+        gap_after=measure_gap(record, after, measured_mode),
         gap_configured=measure_gap(record, configured, measured_mode),
-        candidates=sorted(candidate_scores, key=lambda s: s.bic),
-        nominal=nominal_score,
+        candidates=sorted(scores, key=lambda s: s.bic),
+        nominal=selection.nominal.score,
         decision=decision,
         signatures=sig,
         noise_z_m=sigma_z,
         noise_pitch_rad=sigma_pitch,
         train_end_s=float(train_end),
-        nominal_beam=final_nominal.fit.beam,
-        augmented_beam=augmented.fit.beam,
+        nominal_beam=final_nominal.beam,
+        augmented_beam=augmented_beam,
         record=record,
-        before=final_nominal.trajectory,
-        after=augmented.trajectory,
+        before=before,
+        after=after,
         simulations=problem.simulations,
+        missing_effects=named,
+        confidence=selection.confidence,
+        rounds=tuple(r.as_dict() for r in selection.rounds),
     )
 
 
-def _score(
-    problem: FitProblem, evaluated: _Evaluated, train: np.ndarray, n_train: int, phi: float
-) -> Score:
-    fit = evaluated.fit
-    bic, aic = information_criteria(fit.chi2, n_train, fit.candidate.n_parameters, phi)
-    return Score(
-        name=fit.name,
-        parameters=fit.candidate.values(problem.nominal, fit.x),
-        bic=bic,
-        aic=aic,
-        train_chi2=fit.reduced_chi2,
-        holdout_chi2=_chi2(evaluated.residuals, ~train),
-        record_chi2=_chi2(evaluated.residuals, np.ones_like(train)),
-        physical=fit.physical,
-    )
+def _decay_length(record: Record) -> float:
+    """Seconds of free decay after the first load event (up to the next one or the end)."""
+    event = record.event_time_s
+    end = record.load_events[1][0] if len(record.load_events) > 1 else record.t[-1]
+    return float(min(end, record.t[-1]) - event)
+
+
+def _decision(selection: Selection, limit: str) -> Decision:
+    """The verdict of a selection: its effects, ``none`` or ``unexplained``, and why."""
+    rounds = selection.rounds
+    last = rounds[-1].decision
+    best = rounds[0].decision.best
+    model = selection.model
+    names = model.model.names
+    reasons = [r.decision.reason for r in rounds if r.decision.keep]
+    if not last.keep:
+        reasons.append(last.reason)
+    if limit:
+        reasons.append(limit)
+    reason = '; '.join(reasons)
+    if selection.unphysical:
+        return Decision(UNEXPLAINED, best, reason)
+    if not explains(model.score):
+        return Decision(UNEXPLAINED, best, f'{unexplained_reason(model.score)}; {reason}')
+    return Decision(names[0] if names else NONE, best, reason)
+
+
+def _named(
+    model: Model,
+    x: np.ndarray,
+    path: list[Evaluated],
+    sigma_z: float,
+    train: np.ndarray,
+) -> tuple[NamedEffect, ...]:
+    """The named effects with their whole-record parameters and the gap each one removed."""
+    count = train.size
+
+    def rms(evaluated: Evaluated) -> float:
+        return float(np.sqrt(np.mean(evaluated.residuals[:count] ** 2)) * sigma_z)
+
+    out = []
+    for i, (name, params) in enumerate(model.effect_values(x)):
+        before, after = rms(path[i]), rms(path[i + 1])
+        out.append(NamedEffect(name, params, 1.0 - after / before if before > 0 else 0.0))
+    return tuple(out)

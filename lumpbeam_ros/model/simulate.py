@@ -28,7 +28,7 @@ from lumpbeam_ros.model.trajectory import TipTrajectory
 DEFAULT_STEP_S = 1.0 / 180.0
 
 
-class SimulationDiverged(LumpbeamError):
+class SimulationDivergedError(LumpbeamError):
     """The modal solver cannot integrate a beam and the stiff fallback is off."""
 
 
@@ -42,7 +42,7 @@ class BeamSimulation:
         t0: Start time, s.
         step: Internal grid spacing, s.
         stiff_fallback: Integrate a stretch the modal solver cannot (extreme parameters) with
-            the Radau reference; ``False`` raises :class:`SimulationDiverged` instead (a fit
+            the Radau reference; ``False`` raises :class:`SimulationDivergedError` instead (a fit
             takes such parameters for a bad fit rather than wait minutes for Radau).
     """
 
@@ -114,7 +114,7 @@ class BeamSimulation:
         solution = solver.solve(self.state, duration, self.step)
         if solution is None:
             if not self.stiff_fallback:
-                raise SimulationDiverged(
+                raise SimulationDivergedError(
                     f'the modal solver did not converge over {duration:.3f} s: the beam is '
                     'too far from its linearisation (extreme parameters)'
                 )
@@ -159,7 +159,7 @@ def simulate_loads(
         The tip trajectory at ``t``, with the load at each sample.
 
     Raises:
-        SimulationDiverged: The modal solver failed and ``stiff_fallback`` is off.
+        SimulationDivergedError: The modal solver failed and ``stiff_fallback`` is off.
     """
     t = np.asarray(t, dtype=float)
     latency = beam.effects.latency_s
