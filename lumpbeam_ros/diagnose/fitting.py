@@ -132,7 +132,8 @@ class FitProblem:
     ) -> np.ndarray:
         """Residuals of a model at ``x`` on the samples up to ``end_s``.
 
-        A beam the modal solver cannot simulate (extreme parameters) gets
+        A beam the modal solver cannot simulate, or that cannot carry its load (extreme
+        parameters), gets
         ``DIVERGED_RESIDUAL`` everywhere: a bad fit, not minutes of a stiff solver.
 
         Args:
@@ -144,8 +145,9 @@ class FitProblem:
             The stacked residuals (:meth:`residuals`).
         """
         try:
-            return self.residuals(self.simulate(model.beam(self.nominal, x), end_s))
-        except SimulationDivergedError:
+            with np.errstate(all='ignore'):
+                return self.residuals(self.simulate(model.beam(self.nominal, x), end_s))
+        except (SimulationDivergedError, RuntimeError):  # RuntimeError: no static equilibrium
             count = int(np.count_nonzero(self.record.t <= end_s))
             return np.full(2 * count, DIVERGED_RESIDUAL)
 

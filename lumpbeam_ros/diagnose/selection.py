@@ -395,7 +395,10 @@ def select(
         fitted = []
         for name in promising:
             c = next(c for c in remaining if c.name == name)
-            strength = predictions[name][1] if predictions[name][1] != 0.0 else c.start / c.scale
+            # The linear step's strength, kept inside the plausible range: a far step is a
+            # poor start, and an extreme one may not even simulate.
+            limit = c.plausible_max / c.scale
+            strength = float(np.clip(predictions[name][1], -limit, limit)) or c.start / c.scale
             fitted.append(selector.fit(base.model.plus(c), np.r_[base.fit.x, strength]))
         if not fitted:
             stop = RoundDecision(
