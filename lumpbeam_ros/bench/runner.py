@@ -16,6 +16,7 @@ SUITES = (
     'ident',
     'bagio',
     'diagnose',
+    'diagnose_pairs',
     'campaign',
     'cli',
     'live_graph',
@@ -60,8 +61,12 @@ def format_table(results: Iterable[BenchResult]) -> str:
         results: Benchmark results.
 
     Returns:
-        The table, with details on indented lines below their row.
+        The table, with details on indented lines below their row; the diagnosis cases
+        (results with a ``case`` detail) in their own table after it.
     """
+    results = list(results)
+    cases = [r for r in results if 'case' in r.details]
+    results = [r for r in results if 'case' not in r.details]
     lines = [f'{"benchmark":<34} {"value":>12} {"baseline":>12}  {"ratio":>8}  unit / baseline']
     for r in results:
         lines.append(
@@ -71,4 +76,8 @@ def format_table(results: Iterable[BenchResult]) -> str:
         for key, value in r.details.items():
             shown = f'{value:.4g}' if isinstance(value, float) else str(value)
             lines.append(f'    {key}: {shown}')
+    if cases:
+        from lumpbeam_ros.bench.diagnose_pairs import format_cases
+
+        lines = ([*lines, ''] if results else []) + [format_cases(cases)]
     return '\n'.join(lines)

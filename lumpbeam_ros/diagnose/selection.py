@@ -21,6 +21,7 @@ product over the rounds.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
@@ -327,6 +328,7 @@ def select(
     candidates: Sequence[Candidate],
     max_effects: int = MAX_EFFECTS,
     start_strength: Callable[[Candidate], float | None] = lambda c: None,
+    exhaustive: bool = False,
 ) -> Selection:
     """Forward selection of effects (see the module docstring).
 
@@ -337,6 +339,9 @@ def select(
         max_effects: Most effects named.
         start_strength: A starting strength for a candidate's round-1 fit (``None``: its
             default), e.g. the time shift seen at the load event for the latency.
+        exhaustive: The baseline ``lumpbeam bench`` measures against: every combination of
+            up to ``max_effects`` effects fitted from scratch (from the nominal fit), and
+            each round choosing among those fits instead of screening.
 
     Returns:
         The selection.
@@ -355,6 +360,12 @@ def select(
     singles = [
         selector.fit(Model((c,)), c.start_x(nominal.x, start_strength(c))) for c in candidates
     ]
+    combinations: dict[frozenset[str], Evaluated] = {}
+    if exhaustive:
+        for size in range(2, max_effects + 1):
+            for group in itertools.combinations(candidates, size):
+                x0 = np.r_[nominal.x, [c.start / c.scale for c in group]]
+                combinations[frozenset(c.name for c in group)] = selector.fit(Model(group), x0)
     best_train = min([base, *singles], key=lambda e: e.fit.chi2)
     selector.phi = inflation(best_train.residuals[selector._both(selector.train)])
     base = selector.rescore(base)
@@ -379,6 +390,13 @@ def select(
         if len(base.model.effects) >= max_effects:
             break
         remaining = [c for c in candidates if c.name not in base.model.names]
+        if exhaustive:
+            names = set(base.model.names)
+            fitted = [
+                selector.rescore(combinations[frozenset(names | {c.name})]) for c in remaining
+            ]
+            screened = {}
+            continue
         predictions = selector.screen(base, remaining)
         k = base.model.n_parameters + 1
         ranked = sorted(predictions, key=lambda name: predictions[name][0])

@@ -246,7 +246,10 @@ def _static_seed(model: TipTrajectory, record: Record, problem: FitProblem) -> B
 
 
 def diagnose(
-    record: Record, beam: BeamParameters, train_fraction: float = TRAIN_FRACTION
+    record: Record,
+    beam: BeamParameters,
+    train_fraction: float = TRAIN_FRACTION,
+    exhaustive: bool = False,
 ) -> Diagnosis:
     """Runs the whole workflow on one record.
 
@@ -255,6 +258,8 @@ def diagnose(
         beam: The nominal beam (its k_tE and beta are refit; the rest is taken as is).
         train_fraction: Share of the time after the first load event fitted; the rest is
             held out.
+        exhaustive: Fit every combination of effects from scratch instead of screening
+            (the baseline of ``lumpbeam bench``; same verdicts, many times slower).
 
     Returns:
         The diagnosis.
@@ -266,10 +271,12 @@ def diagnose(
     if not 0.2 < train_fraction < 0.95:
         raise LumpbeamError(f'train fraction must lie in (0.2, 0.95), got {train_fraction}')
     with single_threaded_blas():
-        return _diagnose(record, beam, train_fraction)
+        return _diagnose(record, beam, train_fraction, exhaustive)
 
 
-def _diagnose(record: Record, beam: BeamParameters, train_fraction: float) -> Diagnosis:
+def _diagnose(
+    record: Record, beam: BeamParameters, train_fraction: float, exhaustive: bool
+) -> Diagnosis:
     sigma_z, sigma_pitch = measurement_error(record)
     problem = FitProblem(record, nominal_form(beam), sigma_z, sigma_pitch)
     configured = problem.simulate(problem.nominal)
@@ -305,7 +312,12 @@ def _diagnose(record: Record, beam: BeamParameters, train_fraction: float) -> Di
         )
     selector = Selector(problem, train, train_end)
     selection = select(
-        selector, nominal, effect_candidates(problem.nominal), max_effects, start_strength
+        selector,
+        nominal,
+        effect_candidates(problem.nominal),
+        max_effects,
+        start_strength,
+        exhaustive,
     )
     decision = _decision(selection, limit)
 
