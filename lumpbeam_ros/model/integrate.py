@@ -95,6 +95,23 @@ class ModalSolver:
         self._m0_inv_k = self._m0_inv @ self.linear.stiffness
         self._m0_inv_c = self._m0_inv @ self.linear.damping
 
+    def modal_state(self, state: ChainState) -> np.ndarray:
+        """The modal coordinates of a state (one of each conjugate pair)."""
+        return np.asarray(
+            self._v_inv @ np.concatenate([state.phi - self.linear.phi_eq, state.phi_dot])
+        )
+
+    def friction_recurrence(self, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What :func:`friction_steps` needs for a grid of spacing ``h``.
+
+        Returns:
+            ``e^{lam h}`` per mode, the modal response ``gamma`` to a unit joint-1 torque
+            held over a step, and the row whose real product with the modal coordinates is
+            joint 1's angle.
+        """
+        e, h_phi1, _ = self._coefficients(h)
+        return e, h_phi1 * self._b[:, 0], self._v[0]
+
     def _coefficients(self, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``e^{lam h}`` and the first-order-hold weights ``h phi1``, ``h phi2``."""
         lam_h = self._lam * h
@@ -176,7 +193,7 @@ class ModalSolver:
         h = duration / steps
         t = np.linspace(0.0, duration, steps + 1)
         phi_eq = self.linear.phi_eq
-        z0 = self._v_inv @ np.concatenate([state.phi - phi_eq, state.phi_dot])
+        z0 = self.modal_state(state)
         chain = self.chain
         forcing = np.zeros((t.size, self._n))
         previous = None

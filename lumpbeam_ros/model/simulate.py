@@ -62,9 +62,7 @@ class BeamSimulation:
         self._solvers: dict[float, ModalSolver] = {}
         chain = self._solver(self.load_kg).chain
         self.state = ChainState(static_equilibrium(chain), np.zeros(beam.n_segments))
-        # At rest in the equilibrium of the load it carries: nothing to integrate until the
-        # load changes (a drop test's seconds before the release cost nothing).
-        self._at_rest = True
+        self._rest = (self.state, self.load_kg)
 
     def _solver(self, load_kg: float) -> ModalSolver:
         if load_kg not in self._solvers:
@@ -87,7 +85,6 @@ class BeamSimulation:
         """
         if not np.isfinite(load_kg) or load_kg < 0.0:
             raise ValueError(f'tip load must be a non-negative number of kg, got {load_kg!r}')
-        self._at_rest = self._at_rest and float(load_kg) == self.load_kg
         self.load_kg = float(load_kg)
 
     def advance(self, t_out: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -106,7 +103,10 @@ class BeamSimulation:
         if t_out.size == 0 or np.any(np.diff(t_out) < 0) or t_out[0] < self.time - 1e-12:
             raise ValueError('output times must be increasing and not before the current time')
         duration = float(t_out[-1] - self.time)
-        if duration <= 0.0 or self._at_rest:
+        # Still in the starting rest, with its load: nothing to integrate (a drop test's
+        # seconds before the release cost nothing).
+        at_rest = self.state is self._rest[0] and self.load_kg == self._rest[1]
+        if duration <= 0.0 or at_rest:
             self.time = max(self.time, float(t_out[-1]))
             phi = np.repeat(self.state.phi[None, :], t_out.size, axis=0)
             return phi, np.repeat(self.state.phi_dot[None, :], t_out.size, axis=0)

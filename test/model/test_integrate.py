@@ -5,7 +5,13 @@ import pytest
 from scipy.integrate import quad
 
 from lumpbeam_ros.model.chain import LumpedChain
-from lumpbeam_ros.model.integrate import ChainState, ModalSolver, solve_reference
+from lumpbeam_ros.model.integrate import (
+    ChainState,
+    ModalSolver,
+    friction_steps,
+    friction_steps_loop,
+    solve_reference,
+)
 from lumpbeam_ros.model.parameters import BeamParameters, Effects
 from lumpbeam_ros.model.statics import static_equilibrium
 
@@ -123,3 +129,22 @@ def test_cubic_stiffness_shifts_the_frequency_as_duffing_predicts(k3):
     assert abs(exact / linear - 1.0) > 0.01  # the shift is large enough to test
     assert period == pytest.approx(exact, rel=2e-5)
     assert abs(period / balance - 1.0) < 0.1 * abs(exact / linear - 1.0)
+
+
+@pytest.mark.parametrize('torque', [0.3, 1.0, 3.0])
+def test_sliding_stretches_in_one_go_match_the_step_by_step_friction(torque):
+    beam = replace(BeamParameters(), effects=Effects().with_effect('coulomb_friction', torque))
+    chain, state = _released(beam)
+    solver = ModalSolver(chain)
+    h = 1 / 720
+    e, gamma, angle_row = solver.friction_recurrence(h)
+    drive = np.zeros((4321, e.size), dtype=complex)  # 6 s of free decay
+    drive[0] = solver.modal_state(state)
+    fast = friction_steps(drive, e, gamma, angle_row, torque)
+    loop = friction_steps_loop(drive, e, gamma, angle_row, torque)
+    angles = (loop @ angle_row).real
+    # The decay slides back and forth and sticks for a few steps at the turns: both branches.
+    stuck = np.abs(np.diff(angles)) < 1e-15
+    assert np.ptp(angles) > 1e-3 and 0 < np.count_nonzero(stuck) < 0.5 * stuck.size
+    np.testing.assert_allclose((fast @ angle_row).real, angles, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(fast, loop, rtol=0, atol=1e-12 * np.max(np.abs(loop)))

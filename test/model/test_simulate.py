@@ -6,8 +6,13 @@ import pytest
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.modes import chain_modes
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, Effects
-from lumpbeam_ros.model.simulate import BeamSimulation, simulate_drop_test, simulate_loads
-from lumpbeam_ros.model.statics import static_tip_deflection
+from lumpbeam_ros.model.simulate import (
+    BeamSimulation,
+    SimulationDivergedError,
+    simulate_drop_test,
+    simulate_loads,
+)
+from lumpbeam_ros.model.statics import static_equilibrium, static_tip_deflection
 
 BEAM = BeamParameters()
 
@@ -81,3 +86,20 @@ def test_bad_output_times_are_refused(times):
     simulation = BeamSimulation(BEAM, t0=0.0)
     with pytest.raises(ValueError, match='increasing'):
         simulation.advance(np.array(times))
+
+
+def test_the_at_rest_start_is_the_loaded_equilibrium_exactly():
+    beam = BeamParameters()
+    t = np.linspace(0.0, 1.0, 181)
+    trajectory = simulate_loads(beam, t, [(0.5, 0.0)], 4.5)
+    chain = LumpedChain.from_beam(beam, 4.5)
+    rest = static_equilibrium(chain)
+    before = t < 0.5
+    np.testing.assert_array_equal(trajectory.q[before], np.tile(rest, (before.sum(), 1)))
+    assert np.ptp(trajectory.z[~before]) > 1e-3  # released: it swings
+
+
+def test_a_beam_the_modal_solver_cannot_follow_is_refused_without_the_stiff_fallback():
+    soft = replace(BeamParameters(), k_total_nm_per_rad=100.0)  # sags by tens of degrees
+    with pytest.raises(SimulationDivergedError, match='extreme parameters'):
+        simulate_loads(soft, np.linspace(0, 2, 361), [(0.5, 0.0)], 4.5, stiff_fallback=False)
