@@ -18,7 +18,7 @@ def _candidate(name):
 
 def _x(candidate, value, k_factor=1.0, beta_factor=1.0):
     """x for an effect's contract parameter value."""
-    strength = candidate.reference / value if candidate.reciprocal else value
+    strength = candidate.reference / value if candidate.reciprocal else value - candidate.offset
     return np.array([math.log(k_factor), math.log(beta_factor), strength / candidate.scale])
 
 
@@ -29,7 +29,7 @@ def test_one_candidate_per_spec_effect_and_the_nominal_model_at_strength_zero():
     assert all(c.parameter == EFFECT_PARAMETERS[c.name] for c in candidates)
     for c in candidates:
         lo, hi = c.bounds()
-        assert lo[2] == 0.0 and lo[2] < c.start / c.scale < hi[2]
+        assert lo[2] == (-hi[2] if c.signed else 0.0) and lo[2] < c.start / c.scale < hi[2]
         assert c.beam(BEAM, np.zeros(3)) == BEAM  # strength 0: the nominal beam
 
 
@@ -41,6 +41,12 @@ def test_one_candidate_per_spec_effect_and_the_nominal_model_at_strength_zero():
         ('quadratic_drag', 0.5),
         ('added_mass', 0.3),
         ('sensor_latency', 0.015),
+        ('cubic_stiffness', 1e8),
+        ('cubic_stiffness', -1e8),
+        ('sensor_scale', 1.05),
+        ('sensor_scale', 0.95),
+        ('mount_tilt', 0.05),
+        ('mount_tilt', -0.05),
     ],
 )
 def test_parameters_map_to_the_beam(name, value):
@@ -76,6 +82,12 @@ def test_a_rigid_mount_is_infinitely_stiff_and_switched_off():
         ('quadratic_drag', 200.0, False),
         ('base_compliance', 2e4, True),
         ('base_compliance', K_CLAMP / 50.0, False),
+        ('sensor_scale', 1.2, True),
+        ('sensor_scale', 0.6, False),
+        ('mount_tilt', -0.1, True),
+        ('mount_tilt', 0.5, False),
+        ('cubic_stiffness', 1e8, True),
+        ('cubic_stiffness', -1e10, False),
     ],
 )
 def test_absurd_magnitudes_are_unphysical(name, value, physical):
@@ -88,7 +100,7 @@ def test_nominal_keeps_configured_effects_and_has_two_parameters():
     nominal = nominal_candidate()
     assert nominal.n_parameters == 2
     assert nominal.beam(beam, np.zeros(2)).effects.active() == {'added_mass': 0.2}
-    latency = effect_candidates(beam)[-1]
+    latency = _candidate('sensor_latency')
     both = latency.beam(beam, np.array([0.0, 0.0, 1.0])).effects.active()
     assert both == {'added_mass': 0.2, 'sensor_latency': pytest.approx(0.01)}
 
