@@ -319,7 +319,7 @@ class Selector:
 
 def posterior(chosen: float, options: Sequence[float]) -> float:
     """``exp(-chosen/2)`` normalized over ``exp(-b/2)`` of every option's BIC ``b``."""
-    return 1.0 / sum(math.exp(-0.5 * min(b - chosen, 1400.0)) for b in options)
+    return 1.0 / sum(math.exp(-0.5 * float(np.clip(b - chosen, -1400.0, 1400.0))) for b in options)
 
 
 def select(
