@@ -18,6 +18,8 @@ def _summary(d: Diagnosis, seconds: float) -> str:
     lines = [
         f'missing effect: {d.missing_effect}'
         + ''.join(f'  ({k} = {v:.4g})' for k, v in d.effect_parameters.items()),
+        f'  missing effects: {" + ".join(e.name for e in d.missing_effects) or "-"} '
+        f'(confidence {d.confidence:.3g})',
         f'  {d.decision.reason}',
         f'  noise: z {d.noise_z_m * 1e6:.1f} um, pitch {d.noise_pitch_rad * 1e6:.1f} urad',
     ]
@@ -69,8 +71,9 @@ def run(args: argparse.Namespace) -> int:
     if args.write_model:
         header = (
             f'Written by lumpbeam diagnose from {args.bag}: missing effect '
-            f'{result.missing_effect}.\n{result.decision.reason}\n'
-            'k_total_nm_per_rad and beta_identified are refit on the record with the effect.'
+            f'{" + ".join(e.name for e in result.missing_effects) or result.missing_effect}.'
+            f'\n{result.decision.reason}\n'
+            'k_total_nm_per_rad and beta_identified are refit on the record with the effects.'
         )
         try:
             write_beam_config(args.write_model, result.augmented_beam, drop, header)

@@ -33,7 +33,8 @@ def test_diagnose_writes_json_figures_and_a_model_that_reads_back(late_bag, tmp_
     assert result['missing_effect'] == 'sensor_latency'
     assert result['effect_parameters']['latency_s'] == pytest.approx(0.015, rel=0.1)
     assert result['gap_after']['rms_m'] < 0.3 * result['gap_before']['rms_m']
-    assert len(result['candidates']) == 5
+    assert len(result['candidates']) == 8
+    assert [e['name'] for e in result['missing_effects']] == ['sensor_latency']
     assert all(set(c) == {'name', 'parameters', 'score'} for c in result['candidates'])
     for name in FIGURES:
         assert (plots / name).stat().st_size > 10_000
