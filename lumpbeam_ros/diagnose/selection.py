@@ -198,8 +198,6 @@ class Selection:
         nominal: The nominal model, evaluated.
         unphysical: A round's winner needed an implausible parameter.
         confidence: Product of the rounds' posteriors.
-        limit: Why the search stopped short of ``MAX_EFFECTS`` before any verdict (e.g. too
-            short a record for a pair); empty otherwise.
         path: The evaluated model after each added effect (nominal first).
     """
 
@@ -209,7 +207,6 @@ class Selection:
     nominal: Evaluated
     unphysical: bool
     confidence: float
-    limit: str = ''
     path: list[Evaluated] = field(default_factory=list)
 
 

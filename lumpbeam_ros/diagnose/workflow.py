@@ -332,14 +332,13 @@ def _diagnose(
         augmented_beam, after = final.beam, problem.simulate(final.beam)
         named = _named(chosen.model, final.x, selection.path, sigma_z, train)
 
-    scores = [e.score for e in selection.rounds[0].fitted] if selection.rounds else []
     return Diagnosis(
         missing_effect=decision.missing_effect,
         effect_parameters={k: v for e in named for k, v in e.parameters.items()},
         gap_before=measure_gap(record, before, measured_mode),
         gap_after=measure_gap(record, after, measured_mode),
         gap_configured=measure_gap(record, configured, measured_mode),
-        candidates=sorted(scores, key=lambda s: s.bic),
+        candidates=sorted(selection.singles, key=lambda s: s.bic),
         nominal=selection.nominal.score,
         decision=decision,
         signatures=sig,
