@@ -317,6 +317,16 @@ def add_compare(subparsers: Subparsers) -> argparse.ArgumentParser:
     return parser
 
 
+def add_namespace(parser: argparse.ArgumentParser, what: str) -> None:
+    """Declares ``--namespace NS`` (checked by rclpy when the command runs).
+
+    Args:
+        parser: A subcommand's parser.
+        what: What the namespace does for that command.
+    """
+    parser.add_argument('--namespace', metavar='NS', help=f'{what}, e.g. /beam_a')
+
+
 def add_record(subparsers: Subparsers) -> argparse.ArgumentParser:
     """Declares ``lumpbeam record OUT [TOPIC...] [--all]``.
 
@@ -342,6 +352,7 @@ def add_record(subparsers: Subparsers) -> argparse.ArgumentParser:
         default=0.5,
         help='longest time a message stays in memory, s (default 0.5)',
     )
+    add_namespace(parser, "record this namespace's topics, stored under the bag's names")
     return parser
 
 
@@ -414,6 +425,7 @@ def add_play(subparsers: Subparsers) -> argparse.ArgumentParser:
         default=0.5,
         help='wait this long before the first message, for subscribers to connect (s)',
     )
+    add_namespace(parser, "publish the bag's topics in this namespace (/clock stays global)")
     return parser
 
 

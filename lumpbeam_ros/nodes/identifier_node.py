@@ -100,11 +100,11 @@ class IdentifierNode(SchemaNode):
             )
             return
         try:
-            stamp_ns, _, z, pitch, _ = pose_values(msg)
+            stamp_ns, x, z, pitch, _ = pose_values(msg)
         except LumpbeamError:
             # An invalid quaternion: the window counts it with the other non-finite samples.
-            stamp_ns, z, pitch = 0, math.nan, math.nan
-        self.window.push(stamp_ns * 1e-9, z, pitch)
+            stamp_ns, x, z, pitch = 0, math.nan, math.nan, math.nan
+        self.window.push(stamp_ns * 1e-9, z, pitch, x)
         counts = self.window.counts
         if counts.resets != self._resets:
             self._resets = counts.resets
