@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lumpbeam_ros.bagio.tipseries import TipSeries
-from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow, SampleCounts
+from lumpbeam_ros.bagio.tipseries import SampleCounts, TipSeries
+from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow
 from lumpbeam_ros.ident.settings import IdentifierConfig
 
 
