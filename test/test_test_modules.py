@@ -23,8 +23,6 @@ WITHOUT_TEST_MODULE = {
     'params/diagnosis_params.py',
     'params/identifier_params.py',
     'params/simulator_params.py',
-    'plots/beam.py',
-    'plots/comparison.py',
     'resources.py',
     'vision/messages.py',
     'vision/offline.py',
