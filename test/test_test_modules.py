@@ -29,8 +29,6 @@ WITHOUT_TEST_MODULE = {
     'vision/session.py',
     'vision/sources/frame.py',
     'viz/foxglove_server.py',
-    'viz/markers.py',
-    'viz/marker_messages.py',
 }
 
 
