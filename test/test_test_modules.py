@@ -28,7 +28,6 @@ WITHOUT_TEST_MODULE = {
     'vision/offline.py',
     'vision/session.py',
     'vision/sources/frame.py',
-    'viz/foxglove_server.py',
 }
 
 
