@@ -24,10 +24,8 @@ WITHOUT_TEST_MODULE = {
     'params/identifier_params.py',
     'params/simulator_params.py',
     'resources.py',
-    'vision/messages.py',
     'vision/offline.py',
     'vision/session.py',
-    'vision/sources/frame.py',
 }
 
 
