@@ -25,7 +25,6 @@ WITHOUT_TEST_MODULE = {
     'params/simulator_params.py',
     'resources.py',
     'vision/offline.py',
-    'vision/session.py',
 }
 
 

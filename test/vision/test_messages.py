@@ -70,8 +70,8 @@ def test_a_bayer_mosaic_of_a_grey_scene_is_that_grey(pattern):
         (image_cdr(GREY, '32FC1'), 'unsupported image encoding'),
         (image_cdr(GREY, 'yuv422'), 'unsupported image encoding'),
         (image_cdr(GREY[:, :9], 'bgr8'), 'data has|shorter than'),
-        (b'\x00\x01\x00\x00\xff', ''),
-        (b'', ''),
+        (b'\x00\x01\x00\x00\xff', r'corrupt sensor_msgs/msg/Image message \(5 bytes\)'),
+        (b'', r'corrupt sensor_msgs/msg/Image message \(0 bytes\)'),
     ],
     ids=['float', 'yuv', 'size-mismatch', 'corrupt', 'empty'],
 )
