@@ -24,7 +24,6 @@ WITHOUT_TEST_MODULE = {
     'params/identifier_params.py',
     'params/simulator_params.py',
     'resources.py',
-    'vision/offline.py',
 }
 
 

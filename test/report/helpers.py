@@ -142,8 +142,9 @@ def write_epoch_drop(path: Path, duration_s: float = 5.0, noise_m: float = 20e-6
         for stamp, load in load_messages(drop, duration_s):
             bag.write_float(TIP_LOAD, T0 + stamp, load)
         for i, t in enumerate(measured.t):
-            bag.write_pose(TIP_POSE, T0 + t, measured.x[i], measured.z[i] + noise[i],
-                           measured.pitch[i])  # fmt: skip
+            bag.write_pose(
+                TIP_POSE, T0 + t, measured.x[i], measured.z[i] + noise[i], measured.pitch[i]
+            )
 
 
 def late_diagnosis() -> Diagnosis:

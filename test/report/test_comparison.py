@@ -37,9 +37,11 @@ def test_the_page_names_the_bag_and_counts(comparison, page):
     assert page.title == 'lumpbeam compare: tracked'
     data = comparison.as_dict()
     assert page.paragraphs == [
-        (f'/bags/tracked: {data["pairs"]} pairs, {data["reference_samples"]} reference samples',
-         None)
-    ]  # fmt: skip
+        (
+            f'/bags/tracked: {data["pairs"]} pairs, {data["reference_samples"]} reference samples',
+            None,
+        )
+    ]
     assert page.h2 == [
         'Alignment (1 sigma)',
         'Difference after alignment (camera - tracker)',

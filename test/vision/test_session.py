@@ -117,8 +117,11 @@ def test_bad_pixels_are_counted_by_status(session, frames):
 
 def test_reject_counts_a_frame_that_never_decoded(session):
     result = session.reject('truncated PNG', 4.5)
-    assert (result.status, result.reason, result.stamp) == (TrackStatus.BAD_IMAGE,
-                                                            'truncated PNG', 4.5)  # fmt: skip
+    assert (result.status, result.reason, result.stamp) == (
+        TrackStatus.BAD_IMAGE,
+        'truncated PNG',
+        4.5,
+    )
     assert session.stats.last_stamp == 4.5 and session.stats.last_reason == 'truncated PNG'
 
 

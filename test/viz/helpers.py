@@ -12,8 +12,9 @@ from lumpbeam_ros.viz.markers import BeamScene, BoardPlacement, MarkerSpec, TipP
 #: ``L_s`` of the scenes, m.
 SEGMENT_M = 0.23
 #: A board placement (a quarter turn about z), not read from any config.
-BOARD = BoardPlacement((1.2, 0.8, -0.1), (0.0, 0.0, 0.7071067811865476, 0.7071067811865476),
-                       0.66, 0.54)  # fmt: skip
+BOARD = BoardPlacement(
+    (1.2, 0.8, -0.1), (0.0, 0.0, 0.7071067811865476, 0.7071067811865476), 0.66, 0.54
+)
 
 
 def full_scene(load_kg: float = 4.5) -> BeamScene:

@@ -49,7 +49,7 @@ SPECS = {
         position=(1e-9, -2.5, 3e3),
         color=(0.1, 0.2, 0.3, 0.4),
         lifetime_s=12.345678901,
-    ),  # fmt: skip
+    ),
 }
 
 
@@ -93,8 +93,13 @@ def test_the_scene_bytes_are_the_scenes_marker_array():
     data = scene_cdr(scene, STAMP_NS, 0.1)
     assert data == serialize(marker_array(scene_markers(scene, 0.1), STAMP_NS))
     message = serialization.deserialize_message(data, visualization_msgs.MarkerArray)
-    assert [m.ns for m in message.markers] == ['beam', 'tip_measured', 'tip_predicted', 'load',
-                                               'board']  # fmt: skip
+    assert [m.ns for m in message.markers] == [
+        'beam',
+        'tip_measured',
+        'tip_predicted',
+        'load',
+        'board',
+    ]
     assert len(message.markers[0].points) == 11  # ten segments, eleven joints
 
 
@@ -137,8 +142,9 @@ def marker_bag(tmp_path_factory):
 def test_a_bag_gives_back_each_array_at_its_stamp(marker_bag):
     path, scenes = marker_bag
     arrays = list(read_marker_arrays(path))
-    assert [t for t, _ in arrays] == pytest.approx([1_700_000_000.0, 1_700_000_000.1,
-                                                    1_700_000_000.2, 0.0], abs=1e-6)  # fmt: skip
+    assert [t for t, _ in arrays] == pytest.approx(
+        [1_700_000_000.0, 1_700_000_000.1, 1_700_000_000.2, 0.0], abs=1e-6
+    )
     for (_, markers), scene in zip(arrays, scenes, strict=False):
         assert_same_markers(markers, scene_markers(scene, 0.3))
     assert arrays[-1][1] == []  # an empty array has no stamp to read
@@ -146,8 +152,11 @@ def test_a_bag_gives_back_each_array_at_its_stamp(marker_bag):
     assert reader.topics[MARKERS_TOPIC].msgtype == MARKER_ARRAY_TYPE
     assert reader.topics[MARKERS_TOPIC].count == 4
     log_times = [raw.log_time_ns for raw in reader.iter_raw([MARKERS_TOPIC])][:3]
-    assert log_times == [1_700_000_000_000_000_000, 1_700_000_000_100_000_000,
-                         1_700_000_000_200_000_000]  # fmt: skip
+    assert log_times == [
+        1_700_000_000_000_000_000,
+        1_700_000_000_100_000_000,
+        1_700_000_000_200_000_000,
+    ]
 
 
 def test_a_bag_without_markers_is_a_bag_error(tmp_path):

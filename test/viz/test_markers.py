@@ -84,8 +84,13 @@ def test_the_board_placement_is_the_configured_pose():
 def test_a_full_scene_has_one_marker_per_object():
     scene = full_scene()
     markers = scene_markers(scene, 0.1)
-    assert [m.namespace for m in markers] == [NS_BEAM, NS_MEASURED, NS_PREDICTED, NS_LOAD,
-                                              NS_BOARD]  # fmt: skip
+    assert [m.namespace for m in markers] == [
+        NS_BEAM,
+        NS_MEASURED,
+        NS_PREDICTED,
+        NS_LOAD,
+        NS_BOARD,
+    ]
     assert all(m.marker_id == 0 and m.action == Action.ADD for m in markers)
     assert all(m.lifetime_s == 0.1 for m in markers)
     beam, measured, predicted, load, board = markers
