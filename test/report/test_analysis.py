@@ -109,8 +109,7 @@ def test_a_failed_identification_has_no_fit_figure(analysis, tmp_path):
     assert page.table_dict(0)['natural_frequency_hz'] == ['n/a', 'n/a']
 
 
-@pytest.mark.parametrize('name', ['analyze.png', 'analyze'])
-def test_a_path_that_is_not_html_is_refused_before_any_file(analysis, tmp_path, name):
+def test_a_path_that_is_not_html_is_refused_before_any_file(analysis, tmp_path):
     with pytest.raises(LumpbeamError, match='the report is an HTML file'):
-        write_analysis_report(analysis, tmp_path / name)
+        write_analysis_report(analysis, tmp_path / 'analyze.png')
     assert list(tmp_path.iterdir()) == []

@@ -96,8 +96,7 @@ def test_the_difference_figure_alone(comparison):
     assert png_size(difference_figure(comparison)) == (990, 660)
 
 
-@pytest.mark.parametrize('name', ['compare.pdf', 'compare'])
-def test_a_path_that_is_not_html_is_refused(comparison, tmp_path, name):
+def test_a_path_that_is_not_html_is_refused(comparison, tmp_path):
     with pytest.raises(LumpbeamError, match='the report is an HTML file'):
-        write_comparison_report(comparison, 'bag', tmp_path / name)
+        write_comparison_report(comparison, 'bag', tmp_path / 'compare.pdf')
     assert list(tmp_path.iterdir()) == []
