@@ -23,20 +23,7 @@ WITHOUT_TEST_MODULE = {
     'params/diagnosis_params.py',
     'params/identifier_params.py',
     'params/simulator_params.py',
-    'plots/beam.py',
-    'plots/comparison.py',
-    'report/analysis.py',
-    'report/comparison.py',
-    'report/diagnosis.py',
-    'report/html.py',
     'resources.py',
-    'vision/messages.py',
-    'vision/offline.py',
-    'vision/session.py',
-    'vision/sources/frame.py',
-    'viz/foxglove_server.py',
-    'viz/markers.py',
-    'viz/marker_messages.py',
 }
 
 
