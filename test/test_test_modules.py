@@ -11,13 +11,10 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: Core modules still tested only through the modules and commands that use them.
 WITHOUT_TEST_MODULE = {
-    'bagio/repair.py',
-    'bagio/typestore.py',
     'blas.py',
     'campaign/summary.py',
     'campaign/task.py',
     'diagnose/fitting.py',
-    'ident/onset.py',
     'model/trajectory.py',
     'params/camera_params.py',
     'params/diagnosis_params.py',
