@@ -13,7 +13,6 @@ ROOT = Path(__file__).resolve().parents[1]
 WITHOUT_TEST_MODULE = {
     'blas.py',
     'campaign/summary.py',
-    'campaign/task.py',
     'diagnose/fitting.py',
     'model/trajectory.py',
     'params/camera_params.py',
