@@ -12,7 +12,6 @@ ROOT = Path(__file__).resolve().parents[1]
 #: Core modules still tested only through the modules and commands that use them.
 WITHOUT_TEST_MODULE = {
     'blas.py',
-    'campaign/summary.py',
     'diagnose/fitting.py',
     'model/trajectory.py',
     'params/camera_params.py',
