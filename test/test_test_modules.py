@@ -11,9 +11,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: Core modules still tested only through the modules and commands that use them.
 WITHOUT_TEST_MODULE = {
-    'blas.py',
     'diagnose/fitting.py',
-    'model/trajectory.py',
     'params/camera_params.py',
     'params/diagnosis_params.py',
     'params/identifier_params.py',
@@ -24,7 +22,6 @@ WITHOUT_TEST_MODULE = {
     'report/comparison.py',
     'report/diagnosis.py',
     'report/html.py',
-    'resources.py',
     'vision/messages.py',
     'vision/offline.py',
     'vision/session.py',
