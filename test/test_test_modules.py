@@ -12,10 +12,6 @@ ROOT = Path(__file__).resolve().parents[1]
 #: Core modules still tested only through the modules and commands that use them.
 WITHOUT_TEST_MODULE = {
     'diagnose/fitting.py',
-    'params/camera_params.py',
-    'params/diagnosis_params.py',
-    'params/identifier_params.py',
-    'params/simulator_params.py',
     'plots/beam.py',
     'plots/comparison.py',
     'report/analysis.py',
