@@ -11,7 +11,6 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: Core modules still tested only through the modules and commands that use them.
 WITHOUT_TEST_MODULE = {
-    'diagnose/fitting.py',
     'plots/beam.py',
     'plots/comparison.py',
     'report/analysis.py',
