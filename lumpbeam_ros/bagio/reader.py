@@ -109,7 +109,9 @@ class BagReader:
             yield _raw(schema, channel, message)
 
     def iter_records(
-        self, topics: Iterable[str] | None = None
+        self,
+        topics: Iterable[str] | None = None,
+        declared: dict[str, tuple[Schema | None, Channel]] | None = None,
     ) -> Iterator[tuple[Schema | None, Channel, Message]]:
         """Iterates over the MCAP records of the messages, with their schema and channel.
 
@@ -119,6 +121,8 @@ class BagReader:
 
         Args:
             topics: Topics to read; all when ``None``.
+            declared: Filled, when given, with the schema and channel of every topic the data
+                files declare, messages or not (as :func:`stream_messages` fills it).
 
         Yields:
             ``(schema, channel, message)``, in log-time order within each data file.
@@ -128,9 +132,12 @@ class BagReader:
         for file in self.info.files:
             with file.open('rb') as stream:
                 if file in self.truncated:
-                    messages = stream_messages(stream, str(file), wanted)
+                    messages = stream_messages(stream, str(file), wanted, declared)
                 else:
-                    messages = SeekingReader(stream).iter_messages(topics=wanted)
+                    reader = SeekingReader(stream)
+                    if declared is not None:
+                        _declared_in_summary(reader, declared)
+                    messages = reader.iter_messages(topics=wanted)
                 try:
                     for schema, channel, message in messages:
                         read[channel.topic] = read.get(channel.topic, 0) + 1
@@ -271,6 +278,17 @@ def stream_messages(
             type(exc).__name__,
             count,
         )
+
+
+def _declared_in_summary(
+    reader: SeekingReader, declared: dict[str, tuple[Schema | None, Channel]]
+) -> None:
+    """Adds the channels a complete file's summary lists (see :func:`stream_messages`)."""
+    summary = reader.get_summary()
+    if summary is None:
+        return
+    for channel in summary.channels.values():
+        declared.setdefault(channel.topic, (summary.schemas.get(channel.schema_id), channel))
 
 
 def _raw(schema: Schema | None, channel: Channel, message: Message) -> RawMessage:

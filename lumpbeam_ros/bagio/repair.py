@@ -98,8 +98,9 @@ def repair_bag(bag: str | Path, out: str | Path | None = None) -> RepairSummary:
 
     The copy has one MCAP file with chunk indexes, statistics and summary, its messages in
     log-time order, and a ``metadata.yaml`` whose counts are those of the copy. Topics keep
-    their types, message definitions, type hashes and offered QoS. Messages after an
-    incomplete or damaged record are lost (the reader warns, naming the topic and count).
+    their types, message definitions, type hashes and offered QoS, those without messages
+    too. Messages after an incomplete or damaged record are lost (the reader warns, naming
+    the topic and count).
 
     Args:
         bag: The damaged bag folder (e.g. a recording whose recorder was killed).
@@ -118,14 +119,20 @@ def repair_bag(bag: str | Path, out: str | Path | None = None) -> RepairSummary:
         listed={name: entry.count for name, entry in reader.topics.items()},
         truncated=bool(reader.truncated),
     )
+    declared: dict[str, tuple[Schema | None, Channel]] = {}
     with BagWriter(target) as writer:
-        for schema, channel, message in reader.iter_records():
+        for schema, channel, message in reader.iter_records(declared=declared):
             topic = channel.topic
             if not writer.has_topic(topic):
                 _declare(writer, reader, topic, schema)
                 summary.kept[topic] = 0
             writer.write_raw(topic, message.log_time, message.data)
             summary.kept[topic] += 1
+        # Topics without a message: the file's own schema describes a type Jazzy lacks.
+        for name, (schema, _) in declared.items():
+            if not writer.has_topic(name):
+                _declare(writer, reader, name, schema)
+                summary.kept[name] = 0
         for name, entry in reader.topics.items():
             if not writer.has_topic(name) and is_known(entry.msgtype):
                 writer.add_topic(name, entry.msgtype, qos=[from_dict(p) for p in entry.qos])

@@ -29,8 +29,10 @@ def _with_silent_topics(path):
 
 
 def _with_an_unknown_type(path):
+    """A topic of a type ROS 2 Jazzy lacks, and one more that never published."""
     with BagWriter(path) as bag:
         bag.add_topic('/custom', 'my_pkg/msg/Thing', msgdef=UNKNOWN_DEF, type_hash='RIHS01_ab')
+        bag.add_topic('/silent', 'my_pkg/msg/Other', msgdef='int32 n', type_hash='RIHS01_cd')
         for i in range(5):
             bag.write_raw('/custom', 10 + i, b'\0\1\0\0' + np.float64(i).tobytes())
         bag.write_float('/tip_load', T0, 4.5)
@@ -150,9 +152,12 @@ def test_an_unknown_type_keeps_its_definition(tmp_path):
     repair_bag(tmp_path / 'b', tmp_path / 'copy')
     with (tmp_path / 'copy' / 'copy.mcap').open('rb') as stream:
         schemas = make_reader(stream).get_summary().schemas.values()
-    [thing] = [s for s in schemas if s.name == 'my_pkg/msg/Thing']
-    assert (thing.encoding, thing.data.decode()) == ('ros2msg', UNKNOWN_DEF)
-    assert BagReader(tmp_path / 'copy').topics['/custom'].type_hash == 'RIHS01_ab'
+    definitions = {s.name: (s.encoding, s.data.decode()) for s in schemas}
+    assert definitions['my_pkg/msg/Thing'] == ('ros2msg', UNKNOWN_DEF)
+    assert definitions['my_pkg/msg/Other'] == ('ros2msg', 'int32 n')  # declared, no message
+    topics = BagReader(tmp_path / 'copy').topics
+    assert (topics['/custom'].type_hash, topics['/silent'].type_hash) == ('RIHS01_ab', 'RIHS01_cd')
+    assert (topics['/custom'].count, topics['/silent'].count) == (5, 0)
 
 
 @pytest.mark.parametrize('keep', [0.25, 0.5, 0.9])
