@@ -93,6 +93,21 @@ def check_known_keys(
         raise ConfigError(source, unknown[0], 'unknown key')
 
 
+def _lookup(
+    params: Mapping[str, Any], key: str, source: str | Path, default: Any
+) -> tuple[Any, bool]:
+    """The value of ``key`` and ``True``; ``(default, False)`` when it is absent.
+
+    Raises:
+        ConfigError: The key is absent and has no default (``None``).
+    """
+    if key in params:
+        return params[key], True
+    if default is None:
+        raise ConfigError(source, key, 'missing')
+    return default, False
+
+
 def get_float(
     params: Mapping[str, Any],
     key: str,
@@ -119,11 +134,9 @@ def get_float(
         ConfigError: The key is missing (and required), not a number, not finite or out of
             range.
     """
-    if key not in params:
-        if default is None:
-            raise ConfigError(source, key, 'missing')
-        return float(default)
-    value = params[key]
+    value, given = _lookup(params, key, source, default)
+    if not given:
+        return float(value)
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise ConfigError(source, key, f'must be a number, got {value!r}')
     value = float(value)
@@ -159,11 +172,9 @@ def get_int(
     Raises:
         ConfigError: The key is missing (and required), not an integer, or below ``minimum``.
     """
-    if key not in params:
-        if default is None:
-            raise ConfigError(source, key, 'missing')
-        return default
-    value = params[key]
+    value, given = _lookup(params, key, source, default)
+    if not given:
+        return int(value)
     if isinstance(value, bool) or not isinstance(value, int):
         raise ConfigError(source, key, f'must be an integer, got {value!r}')
     if minimum is not None and value < minimum:
@@ -193,11 +204,9 @@ def get_choice(
     Raises:
         ConfigError: The key is missing (and required) or not one of ``choices``.
     """
-    if key not in params:
-        if default is None:
-            raise ConfigError(source, key, 'missing')
-        return default
-    value = params[key]
+    value, given = _lookup(params, key, source, default)
+    if not given:
+        return str(value)
     if value not in choices:
         raise ConfigError(source, key, f'must be one of {", ".join(choices)}; got {value!r}')
     return str(value)

@@ -15,8 +15,8 @@ import itertools
 import os
 import socket
 from collections.abc import Sequence
-from types import TracebackType
 
+from lumpbeam_ros.closing import ClosedOnExit
 from lumpbeam_ros.errors import LumpbeamError
 
 #: Fast DDS maps domain ids to UDP ports; 1..101 are valid on Linux for any number of
@@ -27,7 +27,7 @@ _NAME_PREFIX = b'\0lumpbeam_ros.ros_domain.'
 _calls = itertools.count()
 
 
-class DomainClaim:
+class DomainClaim(ClosedOnExit):
     """A domain id held by this process until :meth:`release` (or the ``with`` block's end).
 
     Args:
@@ -48,16 +48,7 @@ class DomainClaim:
             self._lock.close()
             self._lock = None
 
-    def __enter__(self) -> DomainClaim:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
-        self.release()
+    close = release
 
 
 def claim_domain_id(candidates: Sequence[int] = PRIVATE_DOMAIN_IDS) -> DomainClaim:

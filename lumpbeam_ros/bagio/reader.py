@@ -109,7 +109,9 @@ class BagReader:
             yield _raw(schema, channel, message)
 
     def iter_records(
-        self, topics: Iterable[str] | None = None
+        self,
+        topics: Iterable[str] | None = None,
+        declared: dict[str, tuple[Schema | None, Channel]] | None = None,
     ) -> Iterator[tuple[Schema | None, Channel, Message]]:
         """Iterates over the MCAP records of the messages, with their schema and channel.
 
@@ -119,6 +121,8 @@ class BagReader:
 
         Args:
             topics: Topics to read; all when ``None``.
+            declared: Filled, when given, with the schema and channel of every topic the data
+                files declare, messages or not (as :func:`stream_messages` fills it).
 
         Yields:
             ``(schema, channel, message)``, in log-time order within each data file.
@@ -128,9 +132,12 @@ class BagReader:
         for file in self.info.files:
             with file.open('rb') as stream:
                 if file in self.truncated:
-                    messages = stream_messages(stream, str(file), wanted)
+                    messages = stream_messages(stream, str(file), wanted, declared)
                 else:
-                    messages = SeekingReader(stream).iter_messages(topics=wanted)
+                    reader = SeekingReader(stream)
+                    if declared is not None:
+                        _declared_in_summary(reader, declared)
+                    messages = reader.iter_messages(topics=wanted)
                 try:
                     for schema, channel, message in messages:
                         read[channel.topic] = read.get(channel.topic, 0) + 1
@@ -194,25 +201,44 @@ class BagReader:
 
     def _probe(self, file: Path) -> object | None:
         """Returns the file's MCAP summary, or ``None`` when it has none (cut recording)."""
-        try:
-            size = file.stat().st_size
-            with file.open('rb') as stream:
-                if size == 0:
-                    raise BagError(f'{self.path}: data file {file.name} is empty')
-                try:
-                    reader = SeekingReader(stream)
-                except _READ_ERRORS:
-                    raise BagError(f'{self.path}: {file.name} is not an MCAP file') from None
-                try:
-                    return reader.get_summary()
-                except (*_READ_ERRORS, OSError):  # OSError: a file shorter than a footer
-                    return None
-        except OSError as exc:
-            raise BagError(f'{self.path}: cannot read {file.name}: {exc.strerror}') from None
+        return probe(file, self.path)
+
+
+def probe(file: Path, bag: Path) -> object | None:
+    """Returns an MCAP file's summary, or ``None`` when it has none (a cut recording).
+
+    Args:
+        file: The data file.
+        bag: Its bag folder, to name in errors.
+
+    Returns:
+        The summary, or ``None``.
+
+    Raises:
+        BagError: The file is empty, unreadable or not an MCAP file.
+    """
+    try:
+        size = file.stat().st_size
+        with file.open('rb') as stream:
+            if size == 0:
+                raise BagError(f'{bag}: data file {file.name} is empty')
+            try:
+                reader = SeekingReader(stream)
+            except _READ_ERRORS:
+                raise BagError(f'{bag}: {file.name} is not an MCAP file') from None
+            try:
+                return reader.get_summary()
+            except (*_READ_ERRORS, OSError):  # OSError: a file shorter than a footer
+                return None
+    except OSError as exc:
+        raise BagError(f'{bag}: cannot read {file.name}: {exc.strerror}') from None
 
 
 def stream_messages(
-    stream: BinaryIO, label: str, wanted: set[str] | None = None
+    stream: BinaryIO,
+    label: str,
+    wanted: set[str] | None = None,
+    declared: dict[str, tuple[Schema | None, Channel]] | None = None,
 ) -> Iterator[tuple[Schema | None, Channel, Message]]:
     """Walks an MCAP file from its start, stopping with a warning at an incomplete record.
 
@@ -220,6 +246,9 @@ def stream_messages(
         stream: The open file.
         label: How to name the file in the warning.
         wanted: Topics to yield; all when ``None``.
+        declared: Filled, when given, with the schema and channel of every topic the walk
+            meets, by topic, whether or not any message of it follows (a declared topic that
+            never published is still part of the bag).
 
     Yields:
         ``(schema, channel, message)`` in file order.
@@ -233,6 +262,8 @@ def stream_messages(
                 schemas[record.id] = record
             elif isinstance(record, Channel):
                 channels[record.id] = record
+                if declared is not None:
+                    declared.setdefault(record.topic, (schemas.get(record.schema_id), record))
             elif isinstance(record, Message):
                 channel = channels.get(record.channel_id)
                 if channel is None or (wanted is not None and channel.topic not in wanted):
@@ -247,6 +278,17 @@ def stream_messages(
             type(exc).__name__,
             count,
         )
+
+
+def _declared_in_summary(
+    reader: SeekingReader, declared: dict[str, tuple[Schema | None, Channel]]
+) -> None:
+    """Adds the channels a complete file's summary lists (see :func:`stream_messages`)."""
+    summary = reader.get_summary()
+    if summary is None:
+        return
+    for channel in summary.channels.values():
+        declared.setdefault(channel.topic, (summary.schemas.get(channel.schema_id), channel))
 
 
 def _raw(schema: Schema | None, channel: Channel, message: Message) -> RawMessage:

@@ -13,11 +13,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import yaml
-from rosbags.interfaces import Qos
+from mcap.records import Channel, Schema
 
 from lumpbeam_ros.bagio import metadata
 from lumpbeam_ros.bagio.qos import from_dict
-from lumpbeam_ros.bagio.reader import BagReader, stream_messages
+from lumpbeam_ros.bagio.reader import BagReader, probe, stream_messages
 from lumpbeam_ros.bagio.typestore import is_known, type_description
 from lumpbeam_ros.bagio.writer import BagWriter
 from lumpbeam_ros.errors import BagError
@@ -27,7 +27,8 @@ def reindex(path: str | Path) -> int:
     """Scans a bag folder's single ``.mcap`` file and writes a matching ``metadata.yaml``.
 
     Topics, types, offered QoS (stored per channel in the MCAP) and exact message counts come
-    from the data; an incomplete last record is skipped with a warning.
+    from the data; a topic the file declares without messages is listed with a count of 0;
+    an incomplete last record is skipped with a warning.
 
     Args:
         path: The bag folder.
@@ -36,7 +37,8 @@ def reindex(path: str | Path) -> int:
         The number of messages found.
 
     Raises:
-        BagError: No folder, not exactly one ``.mcap`` file, or it cannot be read or written.
+        BagError: No folder, not exactly one ``.mcap`` file, an empty or non-MCAP file, or it
+            cannot be read or written.
     """
     folder = Path(path)
     if not folder.is_dir():
@@ -45,32 +47,23 @@ def reindex(path: str | Path) -> int:
     if len(files) != 1:
         raise BagError(f'{folder}: reindex needs exactly one .mcap file, found {len(files)}')
     data_file = files[0]
+    probe(data_file, folder)  # an empty or foreign file is no bag: write no metadata for it
+    declared: dict[str, tuple[Schema | None, Channel]] = {}
     counts: dict[str, int] = {}
-    types: dict[str, str] = {}
-    qos: dict[str, list[Qos]] = {}
     start, end = 2**63 - 1, 0
     try:
         with data_file.open('rb') as stream:
-            for schema, channel, message in stream_messages(stream, str(data_file)):
-                topic = channel.topic
-                if topic not in counts:
-                    counts[topic] = 0
-                    types[topic] = schema.name if schema is not None else ''
-                    profiles = yaml.safe_load(channel.metadata.get('offered_qos_profiles', ''))
-                    qos[topic] = [from_dict(p) for p in profiles or [] if isinstance(p, dict)]
-                counts[topic] += 1
+            for _, channel, message in stream_messages(stream, str(data_file), None, declared):
+                counts[channel.topic] = counts.get(channel.topic, 0) + 1
                 start = min(start, message.log_time)
                 end = max(end, message.log_time)
-        topics = [
-            (
-                name,
-                types[name],
-                n,
-                qos[name],
-                type_description(types[name])[1] if is_known(types[name]) else '',
-            )
-            for name, n in counts.items()
-        ]
+        topics = []
+        for name, (schema, channel) in declared.items():
+            msgtype = schema.name if schema is not None else ''
+            profiles = yaml.safe_load(channel.metadata.get('offered_qos_profiles', ''))
+            qos = [from_dict(p) for p in profiles or [] if isinstance(p, dict)]
+            type_hash = type_description(msgtype)[1] if is_known(msgtype) else ''
+            topics.append((name, msgtype, counts.get(name, 0), qos, type_hash))
         metadata.write(folder, metadata.build(data_file.name, topics, start, end))
     except OSError as exc:
         raise BagError(f'{folder}: cannot reindex: {exc.strerror or exc}') from None
@@ -105,8 +98,9 @@ def repair_bag(bag: str | Path, out: str | Path | None = None) -> RepairSummary:
 
     The copy has one MCAP file with chunk indexes, statistics and summary, its messages in
     log-time order, and a ``metadata.yaml`` whose counts are those of the copy. Topics keep
-    their types, message definitions, type hashes and offered QoS. Messages after an
-    incomplete or damaged record are lost (the reader warns, naming the topic and count).
+    their types, message definitions, type hashes and offered QoS, those without messages
+    too. Messages after an incomplete or damaged record are lost (the reader warns, naming
+    the topic and count).
 
     Args:
         bag: The damaged bag folder (e.g. a recording whose recorder was killed).
@@ -125,14 +119,20 @@ def repair_bag(bag: str | Path, out: str | Path | None = None) -> RepairSummary:
         listed={name: entry.count for name, entry in reader.topics.items()},
         truncated=bool(reader.truncated),
     )
+    declared: dict[str, tuple[Schema | None, Channel]] = {}
     with BagWriter(target) as writer:
-        for schema, channel, message in reader.iter_records():
+        for schema, channel, message in reader.iter_records(declared=declared):
             topic = channel.topic
             if not writer.has_topic(topic):
                 _declare(writer, reader, topic, schema)
                 summary.kept[topic] = 0
             writer.write_raw(topic, message.log_time, message.data)
             summary.kept[topic] += 1
+        # Topics without a message: the file's own schema describes a type Jazzy lacks.
+        for name, (schema, _) in declared.items():
+            if not writer.has_topic(name):
+                _declare(writer, reader, name, schema)
+                summary.kept[name] = 0
         for name, entry in reader.topics.items():
             if not writer.has_topic(name) and is_known(entry.msgtype):
                 writer.add_topic(name, entry.msgtype, qos=[from_dict(p) for p in entry.qos])

@@ -7,7 +7,7 @@ synthetic bags and is the receive time in recorded ones.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
@@ -21,6 +21,8 @@ from lumpbeam_ros.interface import (
     BEAM_PARAMS,
     CAMERA_INFO,
     IMAGE,
+    POINT_STAMPED,
+    POSE_STAMPED,
     TIP_LOAD,
     TIP_POSE,
     TRACKER_POINT,
@@ -66,10 +68,30 @@ def _stamp_s(msg: object) -> float:
     return convert.ns_to_seconds(convert.time_ns(msg.header.stamp))  # type: ignore[attr-defined]
 
 
-def _single_frame(frames: set[str], bag: BagReader, topic: str) -> str:
+def _stamped_columns(
+    values: Iterable[tuple[int, float, float, float, str]], bag: BagReader, topic: str
+) -> tuple[list[np.ndarray], str]:
+    """The decoded messages of a stamped topic as columns, and the one frame they are in.
+
+    Args:
+        values: ``(stamp_ns, a, b, c, frame_id)`` per message, as :mod:`~.convert` decodes
+            a pose or a point.
+        bag: The bag they come from (for the error message).
+        topic: Their topic.
+
+    Returns:
+        ``[t, a, b, c]`` sorted by stamp (t in s), and the frame (``''`` for no message).
+
+    Raises:
+        BagError: The messages are in more than one frame.
+    """
+    rows, frames = [], set()
+    for ns, a, b, c, frame in values:
+        rows.append((convert.ns_to_seconds(ns), a, b, c))
+        frames.add(frame)
     if len(frames) > 1:
         raise BagError(f'{bag.path}: topic {topic} mixes frames {sorted(frames)}')
-    return next(iter(frames), '')
+    return _sorted_columns(rows, 4), next(iter(frames), '')
 
 
 def _sorted_columns(rows: Sequence[tuple[float, ...]], width: int) -> list[np.ndarray]:
@@ -99,13 +121,9 @@ def read_tip_poses(bag: Bag, topic: str = TIP_POSE, *, fast: bool = True) -> Tip
         poses = _fast_poses(reader, topic)
         if poses is not None:
             return poses
-    rows, frames = [], set()
-    for _, msg in reader.messages(topic, 'geometry_msgs/msg/PoseStamped'):
-        ns, x, z, pitch, frame = convert.pose_values(msg)
-        rows.append((convert.ns_to_seconds(ns), x, z, pitch))
-        frames.add(frame)
-    t, xs, zs, pitches = _sorted_columns(rows, 4)
-    return TipSeries(t, xs, zs, pitches, frame_id=_single_frame(frames, reader, topic))
+    decoded = (convert.pose_values(m) for _, m in reader.messages(topic, POSE_STAMPED))
+    (t, x, z, pitch), frame = _stamped_columns(decoded, reader, topic)
+    return TipSeries(t, x, z, pitch, frame_id=frame)
 
 
 def _fast_scan(reader: BagReader, topic: str) -> tuple[list[int], list[bytes]] | None:
@@ -177,13 +195,9 @@ def read_points(bag: Bag, topic: str = TRACKER_POINT) -> PointSeries:
         BagError: Missing topic, another type, corrupt messages or mixed frames.
     """
     reader = open_bag(bag)
-    rows, frames = [], set()
-    for _, msg in reader.messages(topic, 'geometry_msgs/msg/PointStamped'):
-        ns, x, y, z, frame = convert.point_values(msg)
-        rows.append((convert.ns_to_seconds(ns), x, y, z))
-        frames.add(frame)
-    t, xs, ys, zs = _sorted_columns(rows, 4)
-    return PointSeries(t, xs, ys, zs, _single_frame(frames, reader, topic))
+    decoded = (convert.point_values(m) for _, m in reader.messages(topic, POINT_STAMPED))
+    (t, x, y, z), frame = _stamped_columns(decoded, reader, topic)
+    return PointSeries(t, x, y, z, frame)
 
 
 def iter_images(bag: Bag, topic: str = IMAGE) -> Iterator[ImageFrame]:

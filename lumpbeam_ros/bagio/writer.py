@@ -29,7 +29,6 @@ import operator
 import time
 from collections.abc import Iterable, Sequence
 from pathlib import Path
-from types import TracebackType
 from typing import Any
 
 import numpy as np
@@ -39,6 +38,7 @@ from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
 from lumpbeam_ros.bagio import convert, metadata
 from lumpbeam_ros.bagio.qos import default_profile
 from lumpbeam_ros.bagio.typestore import serialize, type_description
+from lumpbeam_ros.closing import ClosedOnExit
 from lumpbeam_ros.errors import BagError
 from lumpbeam_ros.interface import BASE_FRAME, CAMERA_FRAME, CLOCK
 
@@ -48,7 +48,7 @@ _log = logging.getLogger(__name__)
 PENDING_LIMIT_BYTES = 1 << 20
 
 
-class BagWriter:
+class BagWriter(ClosedOnExit):
     """A new rosbag2 bag, written message by message.
 
     Use as a context manager (closing writes the MCAP summary and the final metadata)::
@@ -300,18 +300,6 @@ class BagWriter:
         self._guard(self._write_pending)
         self._guard(self._writer.close)
         self._closed = True
-
-    def __enter__(self) -> BagWriter:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        # Close cleanly even when the caller failed: what was written is still worth keeping.
-        self.close()
 
     # -- internals --------------------------------------------------------------------------
 

@@ -216,22 +216,12 @@ def summary_figure(summary: CampaignSummary) -> bytes:
     axes[0, 0].legend(fontsize=8)
     fit = summary.beam_fit
     if fit is not None:
-        axes[0, 0].axhline(
-            fit.frequency_predicted_hz,
-            color='tab:red',
-            ls='--',
-            lw=1,
-            label='from the static fit (Rayleigh)',
-        )
-        axes[0, 0].legend(fontsize=8)
-        axes[1, 0].axhline(
-            fit.k_total_nm_per_rad,
-            color='tab:red',
-            ls='--',
-            lw=1,
-            label='2 EI / L across the campaign',
-        )
-        axes[1, 0].legend(fontsize=8)
+        for ax, value, label in (
+            (axes[0, 0], fit.frequency_predicted_hz, 'from the static fit (Rayleigh)'),
+            (axes[1, 0], fit.k_total_nm_per_rad, '2 EI / L across the campaign'),
+        ):
+            ax.axhline(value, color='tab:red', ls='--', lw=1, label=label)
+            ax.legend(fontsize=8)
     ax = axes[1, 1]
     deflection = _column(summary.ok, 'static_deflection_m')
     ax.errorbar(

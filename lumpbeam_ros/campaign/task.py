@@ -84,29 +84,31 @@ def flatten(data: dict[str, Any], prefix: str = '') -> Row:
         prefix: Prepended to every key.
 
     Returns:
-        ``{column: scalar}``; NaN and infinity become ``None``.
+        ``{column: scalar}``; NaN and infinity become ``None`` (``null`` inside lists).
     """
     out: Row = {}
     for key, value in data.items():
         name = f'{prefix}{key}'
         if isinstance(value, dict):
             out.update(flatten(value, f'{name}.'))
-        elif isinstance(value, list | tuple):
-            out[name] = json.dumps(value, default=_plain_number)
-        elif isinstance(value, float) and not math.isfinite(value):
-            out[name] = None
-        elif hasattr(value, 'item'):  # a numpy scalar
-            out[name] = _plain_number(value)
-        else:
-            out[name] = value
+            continue
+        plain = _plain(value)
+        # allow_nan=False: NaN is not JSON; _plain has made every non-finite number null.
+        out[name] = json.dumps(plain, allow_nan=False) if isinstance(plain, list) else plain
     return out
 
 
-def _plain_number(value: Any) -> Any:
-    number = value.item() if hasattr(value, 'item') else value
-    if isinstance(number, float) and not math.isfinite(number):
+def _plain(value: Any) -> Any:
+    """A value as plain Python for JSON: numpy to Python, tuples to lists, NaN and inf to None."""
+    if hasattr(value, 'tolist'):  # a numpy scalar or array
+        value = value.tolist()
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
         return None
-    return number
+    return value
 
 
 def error_line(exc: BaseException) -> str:
@@ -143,9 +145,10 @@ def process_bag(bag: str, settings: CampaignSettings) -> Row:
         'error': '',
     }
     try:
+        facts = bag_facts(path)  # first: a folder that is no bag gets the reader's message
         row['content_hash'] = fingerprint(path)
         row['key'] = row_key(str(path), row['content_hash'], settings_hash)
-        row.update(asdict(bag_facts(path)))
+        row.update(asdict(facts))
         analysis = analyze_bag(path, settings.beam, settings.identifier, show_progress=False)
         row.update(flatten(result_json(analysis.result)))
         row['load_kg'] = row.get('released_load_kg')

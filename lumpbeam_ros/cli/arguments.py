@@ -10,12 +10,44 @@ as literals so that help needs no numpy; test/cli/test_arguments.py checks that 
 from __future__ import annotations
 
 import argparse
+import functools
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from lumpbeam_ros.cli.output import non_negative_float, positive_float
 from lumpbeam_ros.interface import CAMERA_INFO, TIP_POSE, TRACKER_POINT
 
 Subparsers = argparse._SubParsersAction
+
+#: Adds a subcommand to the top-level parser and returns the subcommand's parser.
+Declare = Callable[[Subparsers], argparse.ArgumentParser]
+
+
+def _subcommand(name: str, **options: Any) -> Callable[[Callable[..., None]], Declare]:
+    """Makes a function that adds a subcommand's arguments the one that declares it.
+
+    Args:
+        name: What the user types (``'record'``).
+        **options: The subcommand parser's ``help``, ``description``, ``formatter_class``.
+
+    Returns:
+        A decorator: the decorated ``add_X(parser)`` becomes ``add_X(subparsers)``, which
+        adds the parser named ``name`` to the top-level subcommands, declares its arguments
+        and returns it.
+    """
+
+    def declare(add_arguments: Callable[[argparse.ArgumentParser], None]) -> Declare:
+        @functools.wraps(add_arguments)
+        def add(subparsers: Subparsers) -> argparse.ArgumentParser:
+            parser = subparsers.add_parser(name, **options)
+            add_arguments(parser)
+            return parser
+
+        return add
+
+    return declare
+
 
 POSE_TOPIC = TIP_POSE
 REFERENCE_TOPIC = TRACKER_POINT
@@ -60,33 +92,16 @@ The board's pattern and square size come from --config (config/camera.yaml), and
 BEAM_CONFIG_HELP = 'beam parameter file (default: config/paper_beam.yaml)'
 
 
-def add_reproduce(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam reproduce``.
-
-    Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
-    """
-    parser = subparsers.add_parser(
-        'reproduce', help="the paper's Tables B.1, B.2, frequencies and static deflections"
-    )
+@_subcommand('reproduce', help="the paper's Tables B.1, B.2, frequencies and static deflections")
+def add_reproduce(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam reproduce``."""
     parser.add_argument('--config', help=BEAM_CONFIG_HELP)
     parser.add_argument('--json', metavar='FILE', help='write the results as JSON')
-    return parser
 
 
-def add_synth(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam synth``.
-
-    Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
-    """
-    parser = subparsers.add_parser('synth', help='write a synthetic drop-test bag')
+@_subcommand('synth', help='write a synthetic drop-test bag')
+def add_synth(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam synth``."""
     parser.add_argument('out', help='bag folder to create (must not exist)')
     parser.add_argument(
         '--loads',
@@ -151,7 +166,6 @@ def add_synth(subparsers: Subparsers) -> argparse.ArgumentParser:
         help='image size with --images (2048x2048: 4 MB a frame, 8.6 GB for 12 s)',
     )
     parser.add_argument('--camera-config', help='camera file (default: config/camera.yaml)')
-    return parser
 
 
 def tracker_pose(text: str) -> tuple[float, ...]:
@@ -175,21 +189,14 @@ def tracker_pose(text: str) -> tuple[float, ...]:
     return values
 
 
-def add_track(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam track``.
-
-    Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
-    """
-    parser = subparsers.add_parser(
-        'track',
-        help='track the tip in a bag, a video or an image folder, offline',
-        description=TRACK_DESCRIPTION,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+@_subcommand(
+    'track',
+    help='track the tip in a bag, a video or an image folder, offline',
+    description=TRACK_DESCRIPTION,
+    formatter_class=argparse.RawDescriptionHelpFormatter,
+)
+def add_track(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam track``."""
     parser.add_argument('src', help='rosbag2 folder, video file, or folder of images')
     parser.add_argument('out', help='bag folder to create (must not exist)')
     parser.add_argument('--config', help='camera file (default: config/camera.yaml)')
@@ -225,19 +232,11 @@ def add_track(subparsers: Subparsers) -> argparse.ArgumentParser:
         "board's frame)",
     )
     parser.add_argument('--json', metavar='FILE', help='also write the summary as JSON')
-    return parser
 
 
-def add_analyze(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam analyze``.
-
-    Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
-    """
-    parser = subparsers.add_parser('analyze', help='identify frequency, damping and stiffness')
+@_subcommand('analyze', help='identify frequency, damping and stiffness')
+def add_analyze(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam analyze``."""
     parser.add_argument('bag', help='rosbag2 folder with /tip_pose (and /tip_load)')
     parser.add_argument('--json', help='write the result as JSON to this file')
     parser.add_argument('--plots', help='write figures (PNG) into this folder')
@@ -246,25 +245,17 @@ def add_analyze(subparsers: Subparsers) -> argparse.ArgumentParser:
         '--identifier-config', help='identifier parameter file (default: config/identifier.yaml)'
     )
     parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
-    return parser
 
 
-def add_diagnose(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam diagnose``.
-
-    Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
-    """
-    parser = subparsers.add_parser(
-        'diagnose',
-        help='find the effect the model misses, add it, show the gap shrink',
-        description='Fits the nominal beam and each effect of the library to a drop-test '
-        'bag (/tip_pose, /tip_load), names the missing effect (or none, or unexplained) and '
-        'reports the gap between model and measurement before and after adding it.',
-    )
+@_subcommand(
+    'diagnose',
+    help='find the effect the model misses, add it, show the gap shrink',
+    description='Fits the nominal beam and each effect of the library to a drop-test '
+    'bag (/tip_pose, /tip_load), names the missing effect (or none, or unexplained) and '
+    'reports the gap between model and measurement before and after adding it.',
+)
+def add_diagnose(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam diagnose``."""
     parser.add_argument('bag', help='bag folder with /tip_pose and /tip_load')
     parser.add_argument('--config', help='nominal beam file (default: config/paper_beam.yaml)')
     parser.add_argument('--json', metavar='FILE', help='write the result as JSON')
@@ -273,26 +264,18 @@ def add_diagnose(subparsers: Subparsers) -> argparse.ArgumentParser:
         '--write-model', metavar='FILE', help='write the augmented beam parameter file'
     )
     parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
-    return parser
 
 
-def add_compare(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam compare``.
-
-    Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
-    """
-    parser = subparsers.add_parser(
-        'compare',
-        help='camera poses against a reference sensor (/tracker/point)',
-        description='Aligns a reference sensor (a laser tracker on the tip) to the camera in '
-        'time and space from the data alone, then reports their difference, the clock '
-        'offset (tracker_stamp = camera_stamp + offset) and the frequency and damping '
-        'identified from each.',
-    )
+@_subcommand(
+    'compare',
+    help='camera poses against a reference sensor (/tracker/point)',
+    description='Aligns a reference sensor (a laser tracker on the tip) to the camera in '
+    'time and space from the data alone, then reports their difference, the clock '
+    'offset (tracker_stamp = camera_stamp + offset) and the frequency and damping '
+    'identified from each.',
+)
+def add_compare(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam compare``."""
     parser.add_argument('bag', help='bag folder with /tip_pose and /tracker/point')
     parser.add_argument('--json', metavar='FILE', help='write the result as JSON')
     parser.add_argument('--plots', metavar='DIR', help='write compare.png (Fig. B.8) here')
@@ -314,24 +297,26 @@ def add_compare(subparsers: Subparsers) -> argparse.ArgumentParser:
     parser.add_argument('--camera-topic', default=POSE_TOPIC)
     parser.add_argument('--reference-topic', default=REFERENCE_TOPIC)
     parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
-    return parser
 
 
-def add_record(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam record OUT [TOPIC...] [--all]``.
+def add_namespace(parser: argparse.ArgumentParser, what: str) -> None:
+    """Declares ``--namespace NS`` (checked by rclpy when the command runs).
 
     Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
+        parser: A subcommand's parser.
+        what: What the namespace does for that command.
     """
-    parser = subparsers.add_parser(
-        'record',
-        help='record topics from the live graph into a bag',
-        description='Records topics into a new rosbag2 bag (MCAP, CDR). Stops on Ctrl-C, '
-        'SIGTERM or after --duration; a killed recorder loses at most the last flush period.',
-    )
+    parser.add_argument('--namespace', metavar='NS', help=f'{what}, e.g. /beam_a')
+
+
+@_subcommand(
+    'record',
+    help='record topics from the live graph into a bag',
+    description='Records topics into a new rosbag2 bag (MCAP, CDR). Stops on Ctrl-C, '
+    'SIGTERM or after --duration; a killed recorder loses at most the last flush period.',
+)
+def add_record(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam record OUT [TOPIC...] [--all]``."""
     parser.add_argument('out', help='bag folder to create (never overwritten)')
     parser.add_argument('topics', nargs='*', metavar='TOPIC', help='topics to record')
     parser.add_argument('--all', action='store_true', help='record every topic that appears')
@@ -342,68 +327,45 @@ def add_record(subparsers: Subparsers) -> argparse.ArgumentParser:
         default=0.5,
         help='longest time a message stays in memory, s (default 0.5)',
     )
-    return parser
+    add_namespace(parser, "record this namespace's topics, stored under the bag's names")
 
 
-def add_repair(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam repair BAG [OUT]``.
-
-    Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
-    """
-    parser = subparsers.add_parser(
-        'repair',
-        help='copy the readable messages of a damaged bag into a whole one',
-        description='Copies every readable message of a bag whose recorder was killed (or '
-        'whose data file is damaged) into a new bag with a complete MCAP summary and exact '
-        'counts in metadata.yaml, so that rosbags, ros2 bag and the mcap tools open it '
-        '(as `mcap recover` does for a bare MCAP file). The damaged bag is left as it is.',
-    )
+@_subcommand(
+    'repair',
+    help='copy the readable messages of a damaged bag into a whole one',
+    description='Copies every readable message of a bag whose recorder was killed (or '
+    'whose data file is damaged) into a new bag with a complete MCAP summary and exact '
+    'counts in metadata.yaml, so that rosbags, ros2 bag and the mcap tools open it '
+    '(as `mcap recover` does for a bare MCAP file). The damaged bag is left as it is.',
+)
+def add_repair(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam repair BAG [OUT]``."""
     parser.add_argument('bag', help='the damaged rosbag2 folder (MCAP)')
     parser.add_argument('out', nargs='?', help='bag folder to create (default: BAG-repaired)')
-    return parser
 
 
-def add_doctor(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam doctor BAG [BAG ...]``.
-
-    Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
-    """
-    parser = subparsers.add_parser(
-        'doctor',
-        help="check bags as the mcap CLI's doctor does",
-        description="Checks each bag's MCAP files (record framing, chunk CRCs and time "
-        'ranges, log-time order, message and chunk indexes, statistics) and that '
-        'metadata.yaml counts what the files hold, as `mcap doctor` does. Prints each '
-        'problem on its own line, or that the bag is clean; exit code 1 when any bag has '
-        'a problem.',
-    )
+@_subcommand(
+    'doctor',
+    help="check bags as the mcap CLI's doctor does",
+    description="Checks each bag's MCAP files (record framing, chunk CRCs and time "
+    'ranges, log-time order, message and chunk indexes, statistics) and that '
+    'metadata.yaml counts what the files hold, as `mcap doctor` does. Prints each '
+    'problem on its own line, or that the bag is clean; exit code 1 when any bag has '
+    'a problem.',
+)
+def add_doctor(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam doctor BAG [BAG ...]``."""
     parser.add_argument('bags', nargs='+', metavar='BAG', help='rosbag2 folders (MCAP)')
-    return parser
 
 
-def add_play(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam play BAG``.
-
-    Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
-    """
-    parser = subparsers.add_parser(
-        'play',
-        help='replay a bag into the live graph with /clock',
-        description='Publishes a bag with its original relative timing and /clock '
-        '(for nodes run with use_sim_time). Stops at the end, on Ctrl-C or on SIGTERM.',
-    )
+@_subcommand(
+    'play',
+    help='replay a bag into the live graph with /clock',
+    description='Publishes a bag with its original relative timing and /clock '
+    '(for nodes run with use_sim_time). Stops at the end, on Ctrl-C or on SIGTERM.',
+)
+def add_play(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam play BAG``."""
     parser.add_argument('bag', help='rosbag2 folder (MCAP)')
     parser.add_argument('--rate', type=positive_float, default=1.0, help='speed factor')
     parser.add_argument('--loop', action='store_true', help='start again at the end')
@@ -414,43 +376,28 @@ def add_play(subparsers: Subparsers) -> argparse.ArgumentParser:
         default=0.5,
         help='wait this long before the first message, for subscribers to connect (s)',
     )
-    return parser
+    add_namespace(parser, "publish the bag's topics in this namespace (/clock stays global)")
 
 
-def add_bench(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam bench``.
-
-    Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
-    """
-    parser = subparsers.add_parser('bench', help='speed benchmarks against same-run baselines')
+@_subcommand('bench', help='speed benchmarks against same-run baselines')
+def add_bench(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam bench``."""
     parser.add_argument(
         '--only', action='append', metavar='SUITE', help='run only this suite (repeatable)'
     )
     parser.add_argument('--quick', action='store_true', help='small inputs (a smoke test)')
     parser.add_argument('--json', metavar='FILE', help='write the results as JSON')
-    return parser
 
 
-def add_demo(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam demo``.
-
-    Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
-    """
-    parser = subparsers.add_parser(
-        'demo',
-        help='the whole pipeline on the built-in synthetic experiment',
-        description='Synthesizes a drop test, replays it through the live node graph '
-        '(player, simulator, identifier, recorder as separate processes on a private ROS '
-        'domain), analyzes the recording and draws measured against predicted.',
-    )
+@_subcommand(
+    'demo',
+    help='the whole pipeline on the built-in synthetic experiment',
+    description='Synthesizes a drop test, replays it through the live node graph '
+    '(player, simulator, identifier, recorder as separate processes on a private ROS '
+    'domain), analyzes the recording and draws measured against predicted.',
+)
+def add_demo(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam demo``."""
     parser.add_argument('--out', type=Path, default=Path('results'), help='output folder')
     parser.add_argument(
         '--duration', type=positive_float, default=12.0, help='record length, s (default 12)'
@@ -478,7 +425,6 @@ def add_demo(subparsers: Subparsers) -> argparse.ArgumentParser:
         help='effect hidden in the data for the diagnosis (repeatable; default '
         'sensor_latency=0.015); --effect none hides nothing',
     )
-    return parser
 
 
 def workers_count(text: str) -> int:
@@ -492,23 +438,16 @@ def workers_count(text: str) -> int:
     return value
 
 
-def add_campaign(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam campaign``.
-
-    Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
-    """
-    parser = subparsers.add_parser(
-        'campaign',
-        help='analyze (and diagnose) many bags on a Dask cluster',
-        description='Runs lumpbeam analyze (and with --diagnose, lumpbeam diagnose) over '
-        'many bags on Dask, one row per bag in RESULTS/results.parquet and .csv, then fits '
-        "the beam's EI and mass across the campaign (RESULTS/report.html). A rerun skips "
-        'the bags already done.',
-    )
+@_subcommand(
+    'campaign',
+    help='analyze (and diagnose) many bags on a Dask cluster',
+    description='Runs lumpbeam analyze (and with --diagnose, lumpbeam diagnose) over '
+    'many bags on Dask, one row per bag in RESULTS/results.parquet and .csv, then fits '
+    "the beam's EI and mass across the campaign (RESULTS/report.html). A rerun skips "
+    'the bags already done.',
+)
+def add_campaign(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam campaign``."""
     parser.add_argument('bags', nargs='+', metavar='BAG', help='bag folders or glob patterns')
     parser.add_argument('--out', required=True, metavar='RESULTS', help='results folder')
     parser.add_argument('--diagnose', action='store_true', help='also run lumpbeam diagnose')
@@ -527,7 +466,6 @@ def add_campaign(subparsers: Subparsers) -> argparse.ArgumentParser:
     )
     parser.add_argument('--config', help='beam parameter file (default: config/paper_beam.yaml)')
     parser.add_argument('--identifier-config', help='identifier parameter file')
-    return parser
 
 
 def port_number(text: str) -> int:
@@ -541,21 +479,14 @@ def port_number(text: str) -> int:
     return value
 
 
-def add_view(subparsers: Subparsers) -> argparse.ArgumentParser:
-    """Declares ``lumpbeam view``.
-
-    Args:
-        subparsers: The top-level parser's subcommands.
-
-    Returns:
-        The subcommand's parser.
-    """
-    parser = subparsers.add_parser(
-        'view',
-        help='serve the live graph (or a bag) to Foxglove over its WebSocket protocol',
-        description='Serves the live ROS graph, or a bag replayed in its own timing, to '
-        'Foxglove at ws://HOST:PORT (messages as their CDR bytes, ros2msg schemas).',
-    )
+@_subcommand(
+    'view',
+    help='serve the live graph (or a bag) to Foxglove over its WebSocket protocol',
+    description='Serves the live ROS graph, or a bag replayed in its own timing, to '
+    'Foxglove at ws://HOST:PORT (messages as their CDR bytes, ros2msg schemas).',
+)
+def add_view(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam view``."""
     parser.add_argument('--bag', help='replay this bag instead of the live graph')
     parser.add_argument(
         '--port', type=port_number, default=8765, help='TCP port (0: any free one)'
@@ -565,4 +496,3 @@ def add_view(subparsers: Subparsers) -> argparse.ArgumentParser:
     parser.add_argument('--rate', type=positive_float, default=1.0, help='bag speed factor')
     parser.add_argument('--loop', action='store_true', help='replay the bag again at its end')
     parser.add_argument('--duration', type=positive_float, help='stop after this many seconds')
-    return parser

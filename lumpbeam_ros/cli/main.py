@@ -35,7 +35,7 @@ class Command(NamedTuple):
     """
 
     name: str
-    declare: Callable[[arguments.Subparsers], argparse.ArgumentParser]
+    declare: arguments.Declare
     target: str
 
 

@@ -1,11 +1,9 @@
-"""``lumpbeam play BAG [--rate R] [--loop] [--topics ...]``: replay a bag with ``/clock``."""
+"""``lumpbeam play BAG [--rate R] [--loop] [--topics ...] [--namespace NS]``: replay a bag."""
 
 from __future__ import annotations
 
 import argparse
-import signal
 import sys
-from typing import Any
 
 from lumpbeam_ros.interface import CLOCK
 
@@ -17,47 +15,38 @@ def run(args: argparse.Namespace) -> int:
         0 after the bag played (or playback was stopped).
 
     Raises:
+        LumpbeamError: rclpy rejects the namespace.
         BagError: The bag cannot be read, a topic is missing or its type is not installed.
     """
     import time
 
-    import rclpy
-    from rclpy.signals import SignalHandlerOptions
-
     from lumpbeam_ros.bagio import BagReader
+    from lumpbeam_ros.nodes.lifecycle import checked_namespace, stoppable_session
     from lumpbeam_ros.nodes.player import Player
 
+    namespace = checked_namespace(args.namespace)
     reader = BagReader(args.bag)
-    stopped = {'signal': None}
-
-    def request_stop(signum: int, _frame: Any) -> None:
-        stopped['signal'] = signum
-
-    previous = {s: signal.signal(s, request_stop) for s in (signal.SIGINT, signal.SIGTERM)}
-    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-    player = None
-    try:
-        player = Player(reader, args.topics, rate=args.rate)
-        time.sleep(args.delay)
-        # A message sent before a reliable subscriber is matched is not delivered to it.
-        unheard = player.wait_for_subscribers(args.delay)
-        if unheard:
-            print(
-                f'lumpbeam play: warning: no subscriber yet on {", ".join(unheard)}',
-                file=sys.stderr,
-            )
-        passes = 0
-        while True:
-            stats = player.play(lambda: stopped['signal'] is not None)
-            passes += 1
-            if not args.loop or stopped['signal'] is not None:
-                break
-    finally:
-        if player is not None:
-            player.destroy_node()
-        rclpy.try_shutdown()
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+    with stoppable_session() as stop:
+        player = None
+        try:
+            player = Player(reader, args.topics, rate=args.rate, namespace=namespace)
+            time.sleep(args.delay)
+            # A message sent before a reliable subscriber is matched is not delivered to it.
+            unheard = player.wait_for_subscribers(args.delay)
+            if unheard:
+                print(
+                    f'lumpbeam play: warning: no subscriber yet on {", ".join(unheard)}',
+                    file=sys.stderr,
+                )
+            passes = 0
+            while True:
+                stats = player.play(lambda: stop.requested)
+                passes += 1
+                if not args.loop or stop.requested:
+                    break
+        finally:
+            if player is not None:
+                player.destroy_node()
     from lumpbeam_ros.nodes.counts import write_counts
 
     write_counts('player', {**stats.published, CLOCK: stats.clock_published})

@@ -1,9 +1,8 @@
-"""``lumpbeam record OUT [TOPIC...] [--all]``: record live topics into a bag."""
+"""``lumpbeam record OUT [TOPIC...] [--all] [--namespace NS]``: record live topics into a bag."""
 
 from __future__ import annotations
 
 import argparse
-import signal
 import time
 from typing import Any
 
@@ -17,52 +16,49 @@ def run(args: argparse.Namespace) -> int:
         0 after a clean stop.
 
     Raises:
-        LumpbeamError: No topic given, an existing OUT, or a write error.
+        LumpbeamError: No topic given, a namespace rclpy rejects, an existing OUT, or a
+            write error.
     """
     if not args.topics and not args.all:
         raise LumpbeamError('name the topics to record, or pass --all')
     if args.topics and args.all:
         raise LumpbeamError('give either topics or --all, not both')
     # Imported here so that `lumpbeam --help` and the ROS-free commands never load rclpy.
-    import rclpy
     from rclpy.executors import SingleThreadedExecutor
-    from rclpy.signals import SignalHandlerOptions
 
     from lumpbeam_ros.bagio import BagWriter
+    from lumpbeam_ros.nodes.lifecycle import checked_namespace, stoppable_session
     from lumpbeam_ros.nodes.recorder import Recorder
 
+    namespace = checked_namespace(args.namespace)
     bag = BagWriter(args.out, flush_period_s=args.flush_period)
-    stop = {'signal': None}
-
-    def request_stop(signum: int, _frame: Any) -> None:
-        stop['signal'] = signum
-
-    previous = {s: signal.signal(s, request_stop) for s in (signal.SIGINT, signal.SIGTERM)}
-    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-    node = None
-    try:
-        node = Recorder(bag, None if args.all else args.topics, flush_period_s=args.flush_period)
-        executor = SingleThreadedExecutor()
-        executor.add_node(node)
-        deadline = None if args.duration is None else time.monotonic() + args.duration
-        print(f'recording into {args.out} (Ctrl-C to stop)', flush=True)
-        while stop['signal'] is None and node.error is None:
-            if deadline is not None and time.monotonic() >= deadline:
-                break
-            executor.spin_once(timeout_sec=0.05)
-        if node.error is None and stop['signal'] is not None:
-            _drain(executor, node)
-        if node.error is not None:
-            raise node.error
-    finally:
+    with stoppable_session() as stop:
+        node = None
         try:
-            bag.close()
+            node = Recorder(
+                bag,
+                None if args.all else args.topics,
+                flush_period_s=args.flush_period,
+                namespace=namespace,
+            )
+            executor = SingleThreadedExecutor()
+            executor.add_node(node)
+            deadline = None if args.duration is None else time.monotonic() + args.duration
+            print(f'recording into {args.out} (Ctrl-C to stop)', flush=True)
+            while not stop.requested and node.error is None:
+                if deadline is not None and time.monotonic() >= deadline:
+                    break
+                executor.spin_once(timeout_sec=0.05)
+            if node.error is None and stop.requested:
+                _drain(executor, node)
+            if node.error is not None:
+                raise node.error
         finally:
-            if node is not None:
-                node.destroy_node()
-            rclpy.try_shutdown()
-            for sig, handler in previous.items():
-                signal.signal(sig, handler)
+            try:
+                bag.close()
+            finally:
+                if node is not None:
+                    node.destroy_node()
     counts = ', '.join(f'{t} {n}' for t, n in sorted(node.received.items())) or 'nothing'
     print(f'recorded {bag.message_count} messages into {args.out}: {counts}')
     for topic in node.missing():

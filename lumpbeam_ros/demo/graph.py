@@ -17,9 +17,9 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from types import TracebackType
 from typing import IO
 
+from lumpbeam_ros.closing import ClosedOnExit
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.resources import large_frames_profile
 from lumpbeam_ros.ros_domain import PRIVATE_DOMAIN_IDS, claim_domain_id
@@ -76,7 +76,7 @@ class Child:
         return ' | '.join(text.splitlines()[-lines:]) or '(empty log)'
 
 
-class ProcessGraph:
+class ProcessGraph(ClosedOnExit):
     """Starts, watches and stops the processes of one ROS graph.
 
     Use it as a context manager: leaving the block stops every child still running.
@@ -106,17 +106,6 @@ class ProcessGraph:
             FASTRTPS_DEFAULT_PROFILES_FILE=str(large_frames_profile()),
         )
         self.children: dict[str, Child] = {}
-
-    def __enter__(self) -> ProcessGraph:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> None:
-        self.close()
 
     def start(self, name: str, argv: Sequence[str]) -> Child:
         """Starts a child in its own process group, logging to ``log_dir/<name>.log``.

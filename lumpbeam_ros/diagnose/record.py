@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from lumpbeam_ros.bagio import TipSeries, read_load_events, read_tip_poses
+from lumpbeam_ros.bagio.tipseries import HoldsTipSeries, clean_tip_series
 from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.interface import BASE_FRAME
 from lumpbeam_ros.model.trajectory import TipTrajectory
@@ -29,7 +30,7 @@ MIN_TRACKED_SAMPLES = 20
 
 
 @dataclass(frozen=True)
-class Record:
+class Record(HoldsTipSeries):
     """Tip poses in ``beam_base`` and the ``/tip_load`` schedule (doc/interfaces.md).
 
     Attributes:
@@ -43,24 +44,6 @@ class Record:
     initial_load_kg: float
     load_events: tuple[tuple[float, float], ...]
     notes: tuple[str, ...] = ()
-
-    @property
-    def t(self) -> np.ndarray:
-        """Pose stamps, s, increasing."""
-        return self.poses.t
-
-    @property
-    def z(self) -> np.ndarray:
-        """Vertical tip position, m."""
-        return self.poses.z
-
-    @property
-    def pitch(self) -> np.ndarray:
-        """Tip slope, rad."""
-        return self.poses.pitch
-
-    def __len__(self) -> int:
-        return len(self.poses)
 
     @property
     def event_time_s(self) -> float:
@@ -164,10 +147,7 @@ def record_from_series(
         LumpbeamError: A negative or non-finite load, no load change inside the record, or
             fewer than ``MIN_SAMPLES_AFTER_EVENT`` poses after it.
     """
-    poses = poses.select(np.isfinite(poses.t) & np.isfinite(poses.z) & np.isfinite(poses.pitch))
-    poses = poses.select(np.argsort(poses.t, kind='stable'))
-    if len(poses) and np.any(np.diff(poses.t) <= 0.0):
-        poses = poses.select(np.concatenate([[True], np.diff(poses.t) > 0.0]))
+    poses, _ = clean_tip_series(poses)
     poses, note = _stretch_with_event(poses, load_events)
     t = poses.t
     if t.size < MIN_SAMPLES_AFTER_EVENT:

@@ -91,10 +91,13 @@ def fit_onset(t: np.ndarray, z: np.ndarray, departure: int, quiet_start: int, pe
     end_s = t[departure] + PEAK_FRACTION * (t[peak] - t[departure])
     stop = int(np.searchsorted(t, end_s, side='right'))
     span = slice(quiet_start, max(stop, departure + len(_POWERS) + 1))
-    ts, zs = t[span], z[span]
-    if ts.size < len(_POWERS) + 4 or ts[-1] <= t[departure]:
+    # Time from the departing sample: the minimizer's tolerance grows with |t| (a relative
+    # term of ~1.5e-8), which at epoch stamps (~1.7e9 s) is seconds, far more than a frame.
+    origin = float(t[departure])
+    ts, zs = t[span] - origin, z[span]
+    if ts.size < len(_POWERS) + 4 or ts[-1] <= 0.0:
         raise LumpbeamError('too few samples between the release and the first peak')
-    low, high = float(t[lowest]), float(t[departure])
+    low, high = float(t[lowest]) - origin, 0.0
     grid = np.linspace(low, high, _GRID_POINTS)
     costs = [_residual(ts, zs, g) for g in grid]
     k = int(np.argmin(costs))
@@ -108,7 +111,7 @@ def fit_onset(t: np.ndarray, z: np.ndarray, departure: int, quiet_start: int, pe
     )
     onset_s = float(best.x) if best.fun <= costs[k] else float(grid[k])
     coef = _solve(ts, zs, onset_s)[0]
-    return Onset(onset_s, _onset_std(ts, zs, onset_s), float(coef[0]), int(ts.size))
+    return Onset(origin + onset_s, _onset_std(ts, zs, onset_s), float(coef[0]), int(ts.size))
 
 
 def _onset_std(t: np.ndarray, z: np.ndarray, onset_s: float) -> float:

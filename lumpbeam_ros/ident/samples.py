@@ -4,7 +4,8 @@ A :class:`PoseWindow` is what the identifier analyses: a tip series (stamps, ver
 position and tip pitch, doc/interfaces.md) and the ``/tip_load`` readings that fall in or just
 before it.
 :func:`clean_window` turns raw samples (a bag, a live buffer) into strictly increasing, finite
-arrays and counts what it dropped, so a bad sample never becomes an exception in a live node.
+arrays (:func:`~lumpbeam_ros.bagio.tipseries.clean_tip_series`) and counts what it dropped, so
+a bad sample never becomes an exception in a live node.
 """
 
 from __future__ import annotations
@@ -13,7 +14,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lumpbeam_ros.bagio.tipseries import TipSeries
+from lumpbeam_ros.bagio.tipseries import (
+    HoldsTipSeries,
+    SampleCounts,
+    TipSeries,
+    clean_tip_series,
+)
 from lumpbeam_ros.errors import LumpbeamError
 
 
@@ -34,44 +40,7 @@ class LoadReadings:
 
 
 @dataclass(frozen=True)
-class SampleCounts:
-    """What validation removed from a window.
-
-    Attributes:
-        received: Samples given.
-        non_finite: Samples dropped for a NaN or inf stamp, z or pitch.
-        duplicates: Samples dropped because an earlier one had the same stamp.
-        reordered: Whether the stamps had to be sorted.
-    """
-
-    received: int = 0
-    non_finite: int = 0
-    duplicates: int = 0
-    reordered: bool = False
-
-    @property
-    def kept(self) -> int:
-        """Samples left after validation."""
-        return self.received - self.non_finite - self.duplicates
-
-    def note(self) -> str:
-        """What validation did, in one line (``''`` when it changed nothing)."""
-        parts = []
-        if self.non_finite:
-            parts.append(f'{self.non_finite} with a NaN or inf stamp, position or orientation')
-        if self.duplicates:
-            parts.append(f'{self.duplicates} with a repeated or out-of-order stamp')
-        notes = []
-        if parts:
-            dropped = self.non_finite + self.duplicates
-            notes.append(f'dropped {dropped} of {self.received} poses ({"; ".join(parts)})')
-        if self.reordered:
-            notes.append('stamps out of order: sorted')
-        return '; '.join(notes)
-
-
-@dataclass(frozen=True)
-class PoseWindow:
+class PoseWindow(HoldsTipSeries):
     """Tip poses in frame ``beam_base`` over a stretch of time, with their load readings.
 
     Attributes:
@@ -83,34 +52,6 @@ class PoseWindow:
     poses: TipSeries
     loads: LoadReadings = field(default_factory=LoadReadings)
     counts: SampleCounts = field(default_factory=SampleCounts)
-
-    @property
-    def t(self) -> np.ndarray:
-        """Stamps, s."""
-        return self.poses.t
-
-    @property
-    def z(self) -> np.ndarray:
-        """Vertical tip position, m."""
-        return self.poses.z
-
-    @property
-    def pitch(self) -> np.ndarray:
-        """Tip slope about +y, rad."""
-        return self.poses.pitch
-
-    def __len__(self) -> int:
-        return len(self.poses)
-
-    @property
-    def start_s(self) -> float:
-        """First stamp (NaN when empty)."""
-        return self.poses.start_s
-
-    @property
-    def end_s(self) -> float:
-        """Last stamp (NaN when empty)."""
-        return self.poses.end_s
 
 
 def _as_1d(name: str, values: object) -> np.ndarray:
@@ -185,19 +126,7 @@ def clean_window(
         )
     if x_arr.size != t_arr.size:
         raise LumpbeamError(f'pose samples: {t_arr.size} stamps but {x_arr.size} x values')
-    received = int(t_arr.size)
-    keep = np.isfinite(t_arr) & np.isfinite(z_arr)
-    if pitch is not None:
-        keep &= np.isfinite(p_arr)
-    non_finite = received - int(np.count_nonzero(keep))
-    poses = TipSeries(t_arr, x_arr, z_arr, p_arr).select(keep)
-    reordered = bool(np.any(np.diff(poses.t) < 0.0))
-    if reordered:
-        poses = poses.select(np.argsort(poses.t, kind='stable'))
-    first = np.ones(len(poses), dtype=bool)
-    first[1:] = np.diff(poses.t) > 0.0
-    duplicates = int(len(poses) - np.count_nonzero(first))
-    if duplicates:
-        poses = poses.select(first)
-    counts = SampleCounts(received, non_finite, duplicates, reordered)
+    poses, counts = clean_tip_series(
+        TipSeries(t_arr, x_arr, z_arr, p_arr), pitch_required=pitch is not None
+    )
     return PoseWindow(poses, loads or LoadReadings(), counts)

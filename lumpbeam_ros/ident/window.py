@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lumpbeam_ros.bagio.tipseries import TipSeries
-from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow, SampleCounts
+from lumpbeam_ros.bagio.tipseries import SampleCounts, TipSeries
+from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow
 from lumpbeam_ros.ident.settings import IdentifierConfig
 
 
@@ -45,7 +45,7 @@ class SlidingWindow:
     Example (in a node's callbacks)::
 
         window = SlidingWindow.from_config(config)
-        window.push(stamp, z, pitch)          # each /tip_pose
+        window.push(stamp, z, pitch, x)       # each /tip_pose
         window.push_load(stamp, kg)           # each /tip_load
         result = identify(window.snapshot(), beam, config)   # on the publish timer
 
@@ -69,6 +69,7 @@ class SlidingWindow:
         self.reset_jump_back_s = float(reset_jump_back_s)
         self._capacity = int(math.ceil(length_s * max_rate_hz)) + 1
         self._t = np.empty(self._capacity)
+        self._x = np.empty(self._capacity)
         self._z = np.empty(self._capacity)
         self._pitch = np.empty(self._capacity)
         self._head = 0
@@ -104,13 +105,15 @@ class SlidingWindow:
         self._load_t.clear()
         self._load_kg.clear()
 
-    def push(self, stamp: float, z: float, pitch: float = 0.0) -> bool:
+    def push(self, stamp: float, z: float, pitch: float = 0.0, x: float = math.nan) -> bool:
         """Adds one tip pose.
 
         Args:
             stamp: Header stamp, s.
             z: Vertical tip position, m.
             pitch: Tip pitch, rad.
+            x: Tip position along the beam, m (NaN when not measured). The estimators do not
+                use it, so a non-finite x does not reject the pose.
 
         Returns:
             Whether the sample was stored.
@@ -134,6 +137,7 @@ class SlidingWindow:
                 return False
         i = self._head
         self._t[i] = stamp
+        self._x[i] = x
         self._z[i] = z
         self._pitch[i] = pitch
         self._head = (i + 1) % self._capacity
@@ -200,23 +204,24 @@ class SlidingWindow:
         start = (self._head - n) % self._capacity
         if start + n <= self._capacity:
             part = slice(start, start + n)
-            t, z, pitch = self._t[part].copy(), self._z[part].copy(), self._pitch[part].copy()
+            t, x, z, pitch = (a[part].copy() for a in (self._t, self._x, self._z, self._pitch))
         else:
             first, second = slice(start, self._capacity), slice(0, self._head)
-            t = np.concatenate([self._t[first], self._t[second]])
-            z = np.concatenate([self._z[first], self._z[second]])
-            pitch = np.concatenate([self._pitch[first], self._pitch[second]])
+            t, x, z, pitch = (
+                np.concatenate([a[first], a[second]])
+                for a in (self._t, self._x, self._z, self._pitch)
+            )
         cut = int(np.searchsorted(t, self._last - self.length_s, side='left')) if n else 0
-        t, z, pitch = t[cut:], z[cut:], pitch[cut:]
+        poses = TipSeries(t, x, z, pitch).select(slice(cut, None))
         self._prune_loads(self._last - self.length_s)
         loads = LoadReadings(np.asarray(self._load_t), np.asarray(self._load_kg))
         c = self._counts
         counts = SampleCounts(
-            received=t.size + c['non_finite'] + c['out_of_order'] + c['duplicates'],
+            received=len(poses) + c['non_finite'] + c['out_of_order'] + c['duplicates'],
             non_finite=c['non_finite'],
             duplicates=c['out_of_order'] + c['duplicates'],
         )
-        return PoseWindow(TipSeries.vertical(t, z, pitch), loads, counts)
+        return PoseWindow(poses, loads, counts)
 
     def _prune_loads(self, start: float) -> None:
         """Drops readings before ``start`` but the last of them: it gives the load then."""

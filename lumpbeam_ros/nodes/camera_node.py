@@ -38,15 +38,13 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from collections.abc import Callable, Sequence
+from typing import Any, Unpack
 
 import numpy as np
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
-from rclpy.context import Context
-from rclpy.parameter import Parameter
 from sensor_msgs.msg import CameraInfo as CameraInfoMsg
 from sensor_msgs.msg import Image
 
@@ -65,7 +63,7 @@ from lumpbeam_ros.interface import (
 )
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
-from lumpbeam_ros.nodes.ros_parameters import SchemaNode
+from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
 from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
 from lumpbeam_ros.vision.config import camera_config_from_parameters
@@ -95,24 +93,15 @@ class CameraNode(SchemaNode):
     """Tracks the tip in camera frames and publishes its pose.
 
     Args:
-        context: The rclpy context (``None``: the default one).
-        parameter_overrides: Parameters instead of a params file (tests).
-        namespace: The node's namespace (``'/beam_a'``); its topics resolve in it.
-        cli_args: Node-specific ``--ros-args`` (e.g. ``--params-file``, ``-r``).
+        **options: See :class:`~lumpbeam_ros.nodes.ros_parameters.NodeOptions`.
 
     Raises:
         ConfigError: A camera parameter is invalid.
         LumpbeamError: The configured board is not in view of the configured camera.
     """
 
-    def __init__(
-        self,
-        context: Context | None = None,
-        parameter_overrides: Mapping[str, Any] | Sequence[Parameter] | None = None,
-        namespace: str = '',
-        cli_args: Sequence[str] | None = None,
-    ):
-        super().__init__(CAMERA_SCHEMA, context, parameter_overrides, namespace, cli_args)
+    def __init__(self, **options: Unpack[NodeOptions]):
+        super().__init__(CAMERA_SCHEMA, **options)
         values = self.parameter_values
         self.config = camera_config_from_parameters(
             {key: values[key] for key in CONFIG_KEYS}, f'{self.get_name()} parameters'

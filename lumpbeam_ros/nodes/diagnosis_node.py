@@ -31,12 +31,11 @@ import signal
 import sys
 from collections.abc import Mapping, Sequence
 from multiprocessing.pool import AsyncResult, Pool, ThreadPool
-from typing import Any
+from typing import Any, Unpack
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
 from rclpy.clock import Clock, ClockType
-from rclpy.context import Context
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.task import Future as RclpyFuture
@@ -65,7 +64,7 @@ from lumpbeam_ros.interface import (
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
-from lumpbeam_ros.nodes.ros_parameters import SchemaNode
+from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
 from lumpbeam_ros.params.diagnosis_params import DIAGNOSIS_SCHEMA
 
 #: Seconds between repeated warnings about the same kind of bad input.
@@ -93,30 +92,14 @@ class DiagnosisNode(SchemaNode):
     """Publishes ``/model_discrepancy`` from the measured and predicted tip and the load.
 
     Args:
-        context: The rclpy context (default: the global one).
-        parameter_overrides: Parameter values by name, on top of any ``--params-file``.
-        namespace: The node's namespace (``'/beam_a'``); its topics resolve in it.
-        cli_args: Node-specific ``--ros-args`` (e.g. ``--params-file``, ``-r``).
+        **options: See :class:`~lumpbeam_ros.nodes.ros_parameters.NodeOptions`.
 
     Raises:
         ConfigError: A parameter or the beam configuration is invalid.
     """
 
-    def __init__(
-        self,
-        context: Context | None = None,
-        parameter_overrides: Mapping[str, Any] | Sequence[Parameter] | None = None,
-        namespace: str = '',
-        cli_args: Sequence[str] | None = None,
-    ):
-        super().__init__(
-            DIAGNOSIS_SCHEMA,
-            context,
-            parameter_overrides,
-            namespace,
-            cli_args,
-            on_change=self._on_change,
-        )
+    def __init__(self, **options: Unpack[NodeOptions]):
+        super().__init__(DIAGNOSIS_SCHEMA, self._on_change, **options)
         values = self.parameter_values
         self.adopt = bool(values['adopt'])
         self.hardware_id = str(values['hardware_id'])

@@ -22,28 +22,26 @@ from __future__ import annotations
 
 import math
 import sys
-from collections.abc import Mapping, Sequence
-from typing import Any
+from collections.abc import Sequence
+from typing import Unpack
 
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
-from rclpy.context import Context
-from rclpy.parameter import Parameter
 from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio.convert import pose_values
+from lumpbeam_ros.bagio.tipseries import SampleCounts
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.identification import Identification, Status
 from lumpbeam_ros.ident.identify import FitState, identify_from
-from lumpbeam_ros.ident.samples import SampleCounts
 from lumpbeam_ros.ident.settings import PARAMETER_KEYS, IdentifierConfig, config_from_parameters
 from lumpbeam_ros.ident.window import SlidingWindow
 from lumpbeam_ros.interface import BASE_FRAME, BEAM_PARAMS, IDENTIFIER_STATUS, TIP_LOAD, TIP_POSE
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
-from lumpbeam_ros.nodes.ros_parameters import SchemaNode
+from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
 from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA
 
 #: Seconds between repeated warnings about the same kind of bad input.
@@ -54,24 +52,14 @@ class IdentifierNode(SchemaNode):
     """Publishes ``/beam_params`` from ``/tip_pose`` and ``/tip_load``.
 
     Args:
-        context: The rclpy context (default: the global one).
-        parameter_overrides: Parameter values by name (e.g. ``{'publish_rate_hz': 5.0}``),
-            on top of any ``--params-file``.
-        namespace: The node's namespace (``'/beam_a'``); its topics resolve in it.
-        cli_args: Node-specific ``--ros-args`` (e.g. ``--params-file``, ``-r``).
+        **options: See :class:`~lumpbeam_ros.nodes.ros_parameters.NodeOptions`.
 
     Raises:
-        ConfigError: A parameter or the beam configuration is invalid.
+        ConfigError: A parameter (window, fit, release, rates) or the beam file is invalid.
     """
 
-    def __init__(
-        self,
-        context: Context | None = None,
-        parameter_overrides: Mapping[str, Any] | Sequence[Parameter] | None = None,
-        namespace: str = '',
-        cli_args: Sequence[str] | None = None,
-    ):
-        super().__init__(IDENTIFIER_SCHEMA, context, parameter_overrides, namespace, cli_args)
+    def __init__(self, **options: Unpack[NodeOptions]):
+        super().__init__(IDENTIFIER_SCHEMA, **options)
         values = self.parameter_values
         settings = {key: values[key] for key in PARAMETER_KEYS.values()}
         self.config: IdentifierConfig = config_from_parameters(
@@ -100,11 +88,11 @@ class IdentifierNode(SchemaNode):
             )
             return
         try:
-            stamp_ns, _, z, pitch, _ = pose_values(msg)
+            stamp_ns, x, z, pitch, _ = pose_values(msg)
         except LumpbeamError:
             # An invalid quaternion: the window counts it with the other non-finite samples.
-            stamp_ns, z, pitch = 0, math.nan, math.nan
-        self.window.push(stamp_ns * 1e-9, z, pitch)
+            stamp_ns, x, z, pitch = 0, math.nan, math.nan, math.nan
+        self.window.push(stamp_ns * 1e-9, z, pitch, x)
         counts = self.window.counts
         if counts.resets != self._resets:
             self._resets = counts.resets

@@ -1,21 +1,29 @@
 """How every node process runs: init, build the node, spin, count, shut down.
 
-One place for what each node's ``main`` did alike: a configuration error while the node is
-built is one line on stderr and exit code 2 (no traceback); Ctrl-C or an external shutdown
-ends the spin quietly; what the node published is written for the demo's per-topic counts
-(:mod:`lumpbeam_ros.nodes.counts`) however it stopped.
+One place for what each node's ``main`` did alike (:func:`run_node`): a configuration error
+while the node is built is one line on stderr and exit code 2 (no traceback); Ctrl-C or an
+external shutdown ends the spin quietly; what the node published is written for the demo's
+per-topic counts (:mod:`lumpbeam_ros.nodes.counts`) however it stopped. The commands that
+run a node in their own loop (``lumpbeam play``, ``lumpbeam record``) take their namespace
+from :func:`checked_namespace` and their rclpy session and stop request from
+:func:`stoppable_session`.
 """
 
 from __future__ import annotations
 
+import signal
 import sys
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from types import FrameType
 from typing import TypeVar
 
 import rclpy
-from rclpy.exceptions import ParameterException
+from rclpy.exceptions import InvalidNamespaceException, ParameterException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
+from rclpy.validate_namespace import validate_namespace
 
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.nodes.counts import write_counts
@@ -64,3 +72,66 @@ def run_node(
             node.destroy_node()
         rclpy.try_shutdown()
     return 0
+
+
+def checked_namespace(namespace: str | None) -> str:
+    """A node namespace given on the command line, checked by rclpy's validator.
+
+    Args:
+        namespace: An absolute namespace (``'/beam_a'``); ``None`` or ``''`` for none.
+
+    Returns:
+        The namespace (``''`` for none).
+
+    Raises:
+        LumpbeamError: rclpy rejects it; the message is its first line (what is wrong).
+    """
+    if not namespace:
+        return ''
+    try:
+        validate_namespace(namespace)
+    except InvalidNamespaceException as exc:
+        reason = str(exc).splitlines()[0].removeprefix('Invalid namespace: ').rstrip(':')
+        raise LumpbeamError(f'--namespace {namespace!r}: {reason}') from None
+    return namespace
+
+
+class StopRequest:
+    """Whether SIGINT or SIGTERM asked a command to stop (see :func:`stoppable_session`).
+
+    Attributes:
+        signal: The signal received, ``None`` while none came.
+    """
+
+    def __init__(self) -> None:
+        self.signal: int | None = None
+
+    @property
+    def requested(self) -> bool:
+        """Whether a stop was asked for."""
+        return self.signal is not None
+
+    def _handle(self, signum: int, _frame: FrameType | None) -> None:
+        self.signal = signum
+
+
+@contextmanager
+def stoppable_session() -> Iterator[StopRequest]:
+    """An rclpy session whose SIGINT and SIGTERM only ask the caller's loop to stop.
+
+    rclpy's own handlers would shut the context down at once; a recorder then loses what is
+    still on its way and a player cannot finish its statistics. The handlers are restored
+    and rclpy shut down on exit.
+
+    Yields:
+        The stop request the caller's loop polls.
+    """
+    stop = StopRequest()
+    previous = {s: signal.signal(s, stop._handle) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+        yield stop
+    finally:
+        rclpy.try_shutdown()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)

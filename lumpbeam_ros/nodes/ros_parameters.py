@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from typing import Any, TypedDict, Unpack
 
 from rcl_interfaces.msg import (
     FloatingPointRange,
@@ -34,6 +34,24 @@ from lumpbeam_ros.params.schema import ParameterSchema, ParameterSpec
 
 #: Checks (and may apply) changes the schema accepted: ``None``, or why they are refused.
 ChangeHook = Callable[[Mapping[str, Any]], str | None]
+
+
+class NodeOptions(TypedDict, total=False):
+    """How a node of the package is made, every one alike (all optional, by keyword).
+
+    Attributes:
+        context: The rclpy context (default: the global one).
+        parameter_overrides: Values by name (``{'publish_rate_hz': 5.0}``), or ``Parameter``
+            objects, on top of any ``--params-file`` (as ``-p`` would give them).
+        namespace: The node's namespace (``'/beam_a'``); its topics resolve in it.
+        cli_args: Node-specific ``--ros-args`` (e.g. ``--params-file``, ``-r``).
+    """
+
+    context: Context | None
+    parameter_overrides: Mapping[str, Any] | Sequence[Parameter] | None
+    namespace: str
+    cli_args: Sequence[str] | None
+
 
 _TYPES = {
     'bool': ParameterType.PARAMETER_BOOL,
@@ -169,12 +187,9 @@ class SchemaNode(Node):
 
     Args:
         schema: The node's parameters (and its name).
-        context: The rclpy context (default: the global one).
-        parameter_overrides: Values by name, or ``Parameter`` objects, on top of any
-            ``--params-file``.
-        namespace: The node's namespace (``'/beam_a'``); its topics resolve in it.
-        cli_args: Node-specific ``--ros-args`` (e.g. ``--params-file``, ``-r``).
         on_change: See :func:`declare_parameters`.
+        **options: The node's :class:`NodeOptions` (context, overrides, namespace,
+            ``--ros-args``).
 
     Attributes:
         parameter_values: The declared values, by name.
@@ -186,20 +201,19 @@ class SchemaNode(Node):
     def __init__(
         self,
         schema: ParameterSchema,
-        context: Context | None = None,
-        parameter_overrides: Mapping[str, Any] | Sequence[Parameter] | None = None,
-        namespace: str = '',
-        cli_args: Sequence[str] | None = None,
         on_change: ChangeHook | None = None,
+        **options: Unpack[NodeOptions],
     ):
+        parameter_overrides = options.get('parameter_overrides')
+        cli_args = options.get('cli_args')
         if isinstance(parameter_overrides, Mapping):
             overrides = [Parameter(k, value=v) for k, v in parameter_overrides.items()]
         else:
             overrides = list(parameter_overrides or [])
         super().__init__(
             schema.node,
-            context=context,
-            namespace=namespace,
+            context=options.get('context'),
+            namespace=options.get('namespace', ''),
             cli_args=list(cli_args) if cli_args is not None else None,
             parameter_overrides=overrides,
         )

@@ -24,12 +24,11 @@ import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Unpack
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseStamped
 from rclpy.clock import Clock, ClockType
-from rclpy.context import Context
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64
 from visualization_msgs.msg import MarkerArray
@@ -52,7 +51,7 @@ from lumpbeam_ros.model.stream import PredictionStream
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
-from lumpbeam_ros.nodes.ros_parameters import SchemaNode
+from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
 from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA, effect_parameter_name
 from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.viz.marker_messages import scene_cdr
@@ -95,31 +94,15 @@ class SimulatorNode(SchemaNode):
     """Publishes the predicted tip pose of the lumped beam under the live tip load.
 
     Args:
-        context: The rclpy context (``None``: the default one).
-        parameter_overrides: Parameter values that replace the defaults (as ``-p`` would).
-        namespace: The node's namespace (``'/beam_a'``); its topics resolve in it.
-        cli_args: Node-specific ``--ros-args`` (e.g. ``--params-file``, ``-r``).
+        **options: See :class:`~lumpbeam_ros.nodes.ros_parameters.NodeOptions`.
 
     Raises:
         ConfigError: The beam file is missing or malformed, or a parameter is of the wrong
             type or out of range.
     """
 
-    def __init__(
-        self,
-        context: Context | None = None,
-        parameter_overrides: Mapping[str, Any] | Sequence[Parameter] | None = None,
-        namespace: str = '',
-        cli_args: Sequence[str] | None = None,
-    ):
-        super().__init__(
-            SIMULATOR_SCHEMA,
-            context,
-            parameter_overrides,
-            namespace,
-            cli_args,
-            on_change=self._on_change,
-        )
+    def __init__(self, **options: Unpack[NodeOptions]):
+        super().__init__(SIMULATOR_SCHEMA, self._on_change, **options)
         values = self.parameter_values
         self._settings = values
         self._base_beam = load_beam(values['beam_config'])

@@ -69,21 +69,29 @@ class Bounds:
         """The interval in words: ``positive``, ``at least 64``, ``in [0, 1]``, ``in (0, 0.5)``."""
         if self.high is None and self.low == 0.0:
             return 'positive' if self.low_open else 'non-negative'
-        if self.high is None:
-            return f'{"above" if self.low_open else "at least"} {_number(self.low or 0.0)}'
-        if self.low is None:
-            return f'{"below" if self.high_open else "at most"} {_number(self.high)}'
-        left, right = '(' if self.low_open else '[', ')' if self.high_open else ']'
-        return f'in {left}{_number(self.low)}, {_number(self.high)}{right}'
+        return self._spelled(('above', 'at least'), ('below', 'at most'), 'in ')
 
     def notation(self) -> str:
         """The interval as a formula for tables: ``> 0``, ``>= 64``, ``[0, 1]``, ``(0, 0.5)``."""
+        return self._spelled(('>', '>='), ('<', '<='), '')
+
+    def _spelled(self, low: tuple[str, str], high: tuple[str, str], interval: str) -> str:
+        """The interval in the words given (each pair: when open, when closed).
+
+        Args:
+            low: Before the number of a lower bound alone (``('above', 'at least')``).
+            high: Before the number of an upper bound alone.
+            interval: Before a bracketed pair of bounds (``'in '``).
+
+        Returns:
+            The interval spelled.
+        """
         if self.high is None:
-            return f'{">" if self.low_open else ">="} {_number(self.low or 0.0)}'
+            return f'{low[0] if self.low_open else low[1]} {_number(self.low or 0.0)}'
         if self.low is None:
-            return f'{"<" if self.high_open else "<="} {_number(self.high)}'
+            return f'{high[0] if self.high_open else high[1]} {_number(self.high)}'
         left, right = '(' if self.low_open else '[', ')' if self.high_open else ']'
-        return f'{left}{_number(self.low)}, {_number(self.high)}{right}'
+        return f'{interval}{left}{_number(self.low)}, {_number(self.high)}{right}'
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ from matplotlib.figure import Figure  # noqa: E402
 from lumpbeam_ros.errors import LumpbeamError  # noqa: E402
 from lumpbeam_ros.ident.identification import Estimate, Identification  # noqa: E402
 from lumpbeam_ros.ident.samples import PoseWindow  # noqa: E402
+from lumpbeam_ros.plots.files import save_figure  # noqa: E402
 
 #: File names written into the plots folder.
 FILES = ('trajectory.png', 'spectrum.png', 'estimates.png')
@@ -175,8 +176,6 @@ def write_analysis_plots(window: PoseWindow, result: Identification, folder: Pat
 def _save(fig: Figure, path: Path) -> None:
     try:
         fig.tight_layout()
-        fig.savefig(path, dpi=110)
-    except OSError as exc:
-        raise LumpbeamError(f'cannot write {path}: {exc.strerror}') from None
+        save_figure(fig, path, dpi=110)
     finally:
         plt.close(fig)

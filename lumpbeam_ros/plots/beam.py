@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.plots.files import save_figure
 from lumpbeam_ros.viz.marker_messages import read_marker_arrays
 from lumpbeam_ros.viz.markers import (
     NS_BEAM,
@@ -135,15 +136,9 @@ def plot_beam_snapshots(
         time_axis.legend(fontsize=8, loc='lower right')
         figure.suptitle(title)
         figure.tight_layout()
-        path = Path(path)
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            figure.savefig(path, dpi=110)
-        except OSError as exc:
-            raise LumpbeamError(f'cannot write {path}: {exc.strerror or exc}') from None
+        return save_figure(figure, path, dpi=110)
     finally:
         plt.close(figure)
-    return path
 
 
 def drop_snapshot_times(release_time_s: float, period_s: float) -> list[float]:

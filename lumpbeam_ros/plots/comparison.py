@@ -11,7 +11,7 @@ matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402  (the backend is chosen first)
 
 from lumpbeam_ros.compare.comparison import Comparison  # noqa: E402
-from lumpbeam_ros.errors import LumpbeamError  # noqa: E402
+from lumpbeam_ros.plots.files import save_figure  # noqa: E402
 
 FILE_NAME = 'compare.png'
 
@@ -63,10 +63,6 @@ def plot_comparison(comparison: Comparison, folder: str | Path) -> Path:
         for axes in (top, bottom):
             axes.grid(alpha=0.3)
         figure.tight_layout()
-        folder.mkdir(parents=True, exist_ok=True)
-        figure.savefig(path, dpi=110)
-    except OSError as exc:
-        raise LumpbeamError(f'cannot write the plot {path}: {exc.strerror or exc}') from None
+        return save_figure(figure, path, dpi=110, what='the plot ')
     finally:
         plt.close(figure)
-    return path

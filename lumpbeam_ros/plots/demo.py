@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.plots.files import save_figure
 
 
 @dataclass(frozen=True)
@@ -136,12 +137,6 @@ def plot_measured_vs_predicted(
         bottom.text(
             0.01, 0.9, f'RMS {rms * scale:.3f} {unit}', transform=bottom.transAxes, va='top'
         )
-        path = Path(path)
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            figure.savefig(path, dpi=120, bbox_inches='tight')
-        except OSError as exc:
-            raise LumpbeamError(f'cannot write {path}: {exc.strerror or exc}') from None
+        return save_figure(figure, path, dpi=120, bbox_inches='tight')
     finally:
         plt.close(figure)
-    return path

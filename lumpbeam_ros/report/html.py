@@ -28,9 +28,24 @@ p.note { color: #555; }
 
 Cell = str | float | int | None
 
+#: Below this magnitude a float's integer part is exact (2**53 ~ 9.0e15): it is printed whole.
+_WHOLE_BELOW = 1e15
+
 
 def format_value(value: Cell, digits: int = 5) -> str:
-    """A table cell as text: numbers to ``digits`` significant digits, NaN and None as n/a."""
+    """A table cell as text: numbers to ``digits`` significant digits, NaN and None as n/a.
+
+    A float with more integer digits than ``digits`` (an epoch stamp, 1.7e9 s) keeps all of
+    them and up to ``digits`` decimals, trailing zeros dropped: rounded to ``digits``
+    significant digits it would read ``1.7e+09``, years rounded away.
+
+    Args:
+        value: The cell.
+        digits: Significant digits of a float.
+
+    Returns:
+        The text.
+    """
     if value is None:
         return 'n/a'
     if isinstance(value, bool):
@@ -38,7 +53,11 @@ def format_value(value: Cell, digits: int = 5) -> str:
     if isinstance(value, int):
         return str(value)
     if isinstance(value, float):
-        return f'{value:.{digits}g}' if math.isfinite(value) else 'n/a'
+        if not math.isfinite(value):
+            return 'n/a'
+        if 10.0**digits <= abs(value) < _WHOLE_BELOW:
+            return f'{value:.{digits}f}'.rstrip('0').rstrip('.')
+        return f'{value:.{digits}g}'
     return str(value)
 
 

@@ -53,3 +53,36 @@ def test_a_trajectory_is_a_tip_series_and_cuts_its_own_arrays():
 def test_the_series_is_frozen():
     with pytest.raises(dataclasses.FrozenInstanceError):
         _series().t = T  # type: ignore[misc]
+
+
+def test_clean_tip_series_drops_sorts_and_counts():
+    from lumpbeam_ros.bagio.tipseries import SampleCounts, clean_tip_series
+
+    t = np.array([0.3, 0.1, np.nan, 0.2, 0.2, 0.4, 0.5])
+    z = np.array([3.0, 1.0, 9.0, 2.0, 7.0, np.inf, 5.0])
+    pitch = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, np.nan])
+    trajectory = TipTrajectory(t, t + 2.0, z, pitch, np.full(7, 4.5), None, frame_id='f')
+    cleaned, counts = clean_tip_series(trajectory)
+    assert type(cleaned) is TipTrajectory and cleaned.frame_id == 'f'
+    np.testing.assert_array_equal(cleaned.t, [0.1, 0.2, 0.3])
+    np.testing.assert_array_equal(cleaned.z, [1.0, 2.0, 3.0])  # the first of stamp 0.2
+    np.testing.assert_array_equal(cleaned.x, cleaned.t + 2.0)
+    np.testing.assert_array_equal(cleaned.load_kg, [4.5] * 3)
+    assert counts == SampleCounts(received=7, non_finite=3, duplicates=1, reordered=True)
+    assert counts.kept == 3
+    assert counts.note() == (
+        'dropped 4 of 7 poses (3 with a NaN or inf stamp, position or orientation; '
+        '1 with a repeated or out-of-order stamp); stamps out of order: sorted'
+    )
+    # A sensor without pitch: a NaN pitch keeps the sample.
+    _, counts = clean_tip_series(TipSeries(t, t, z, pitch), pitch_required=False)
+    assert counts.non_finite == 2
+
+
+def test_clean_tip_series_of_clean_poses_changes_nothing():
+    from lumpbeam_ros.bagio.tipseries import SampleCounts, clean_tip_series
+
+    series = _series()
+    cleaned, counts = clean_tip_series(series)
+    assert counts == SampleCounts(received=10) and counts.note() == ''
+    np.testing.assert_array_equal(cleaned.t, series.t)

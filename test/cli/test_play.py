@@ -1,12 +1,14 @@
 import logging
 import os
+import subprocess
+import sys
 import threading
 import time
 
 import numpy as np
 import pytest
 from geometry_msgs.msg import PoseStamped
-from harness import SENSOR_QOS
+from harness import SENSOR_QOS, ros_env
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Image
@@ -100,6 +102,14 @@ def test_a_truncated_bag_plays_what_is_readable(ros_graph, tmp_path, caplog):
         (['play', '{bag}', '--topics', '/nope'], 'no topic /nope'),
         (['play', '{custom}'], 'message type my_pkg/msg/Thing is not installed'),
         (['play', '{missing}'], 'no such bag'),
+        (
+            ['play', '{bag}', '--namespace', 'beam_a'],
+            "lumpbeam play: error: --namespace 'beam_a': namespace must be absolute",
+        ),
+        (
+            ['play', '{missing}', '--namespace', '/beam a'],
+            "--namespace '/beam a': namespace must not contain characters other than",
+        ),
     ],
 )
 def test_bad_invocations_print_one_line(tmp_path, short_bag, capsys, argv, match):
@@ -116,6 +126,28 @@ def test_play_command_end_to_end(short_bag, capsys, monkeypatch, ros_domain_id):
     assert main(['play', str(short_bag), '--rate', '5', '--delay', '0.1']) == 0
     out = capsys.readouterr().out
     assert 'played' in out and '64 messages' in out
+
+
+def test_play_command_in_a_namespace(ros_graph, short_bag):
+    spaced = ros_graph.collect('/beam_a/tip_pose', PoseStamped, 100)
+    unspaced = ros_graph.collect('/tip_pose', PoseStamped, 100)
+    clock = ros_graph.collect('/clock', Clock, 100)
+    argv = ['play', str(short_bag), '--topics', '/tip_pose', '--namespace', '/beam_a']
+    proc = subprocess.Popen(
+        [sys.executable, '-m', 'lumpbeam_ros.cli.main', *argv, '--delay', '1.0'],
+        env=ros_env(ros_graph.domain_id),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert ros_graph.spin_until(lambda: len(spaced) == 60, 30.0)
+    finally:
+        stdout, stderr = proc.communicate(timeout=30)
+    assert proc.returncode == 0, stderr
+    assert '(1 pass): 60 messages in the last pass' in stdout
+    assert ros_graph.spin_until(lambda: len(clock) == 60, 5.0)  # /clock stays graph-wide
+    assert unspaced == []
 
 
 def test_player_waits_for_subscribers_and_for_delivery(ros_graph, short_bag):

@@ -26,16 +26,16 @@ def _start_recorder(ros_graph, out, *extra):
     )
 
 
-def _publish_poses(ros_graph, n, rate_hz=200.0):
+def _publish_poses(ros_graph, n, rate_hz=200.0, topic='/tip_pose'):
     msg = PoseStamped()
     msg.header.frame_id = 'beam_base'
-    ros_graph.publish('/tip_pose', msg)  # creates the publisher
-    assert ros_graph.wait_for_subscribers('/tip_pose', timeout=15.0)
+    ros_graph.publish(topic, msg)  # creates the publisher
+    assert ros_graph.wait_for_subscribers(topic, timeout=15.0)
     ros_graph.spin_for(0.3)  # the recorder's subscription settles on the new publisher
     for i in range(n):
         msg.header.stamp.sec, msg.header.stamp.nanosec = 100 + i, 0
         msg.pose.position.z = -0.001 * i
-        ros_graph.publish('/tip_pose', msg)
+        ros_graph.publish(topic, msg)
         time.sleep(1.0 / rate_hz)
 
 
@@ -103,6 +103,14 @@ def test_a_signal_closes_the_bag_cleanly(ros_graph, tmp_path, sig, mcap_doctor):
         (['record', '{out}', '/a', '--all'], 'either topics or --all'),
         (['record', '{existing}', '/a'], 'exists already; a bag is never overwritten'),
         (['record', '{file}/bag', '/a'], 'cannot create bag'),
+        (
+            ['record', '{out}', '/a', '--namespace', 'beam_a'],
+            "--namespace 'beam_a': namespace must be absolute, it must lead with a '/'",
+        ),
+        (
+            ['record', '{out}', '/a', '--namespace', '/beam_a/'],
+            "--namespace '/beam_a/': namespace must not end with a '/'",
+        ),
     ],
 )
 def test_bad_invocations_print_one_line(tmp_path, capsys, argv, match):
@@ -111,4 +119,22 @@ def test_bad_invocations_print_one_line(tmp_path, capsys, argv, match):
     paths = {'out': tmp_path / 'out', 'existing': tmp_path / 'existing', 'file': tmp_path / 'file'}
     assert main([a.format(**paths) for a in argv]) == 2
     err = capsys.readouterr().err.strip()
+    assert err.startswith('lumpbeam record: error: ')
     assert match in err and '\n' not in err
+    assert not (tmp_path / 'out').exists()  # nothing was created
+
+
+def test_a_namespaced_recorder_stores_its_topics_under_the_bag_names(ros_graph, tmp_path):
+    out = tmp_path / 'spaced'
+    proc = _start_recorder(ros_graph, out, '/tip_pose', '--namespace', '/beam_a')
+    try:
+        _publish_poses(ros_graph, 20, topic='/beam_a/tip_pose')
+        ros_graph.spin_for(0.3)
+    finally:
+        proc.send_signal(signal.SIGINT)
+        stdout, stderr = proc.communicate(timeout=15)
+    assert proc.returncode == 0, stderr
+    assert 'recorded 20 messages' in stdout and '/tip_pose 20' in stdout
+    reader = BagReader(out)
+    assert set(reader.topics) == {'/tip_pose'}
+    np.testing.assert_array_equal(read_tip_poses(reader).t, 100.0 + np.arange(20))

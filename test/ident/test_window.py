@@ -110,3 +110,16 @@ def test_a_second_reading_with_the_same_stamp_replaces_the_first():
 def test_a_reading_before_any_pose_takes_the_clock():
     w = SlidingWindow(length_s=2.0, max_rate_hz=10.0)
     assert w.push_load_on_arrival(4.5, 7.0) == (True, 7.0)
+
+
+def test_the_tip_x_is_carried_through_the_ring_and_nan_when_not_given():
+    w = SlidingWindow(length_s=1.0, max_rate_hz=10.0)  # 11 slots: 30 pushes wrap the ring
+    t = np.arange(30) * 0.1
+    for stamp in t:
+        assert w.push(stamp, -0.01, 0.0, x=2.3 + stamp)
+    assert not w.push(5.0, -0.01, math.nan, x=2.0)  # the pose is judged by z and pitch
+    assert w.push(3.0, -0.01, 0.0)
+    snap = w.snapshot()
+    np.testing.assert_allclose(snap.poses.x[:-1], 2.3 + snap.t[:-1])
+    np.testing.assert_allclose(snap.t[:-1], t[t >= 2.0 - 1e-9])
+    assert math.isnan(snap.poses.x[-1])

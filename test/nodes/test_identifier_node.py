@@ -5,6 +5,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import PoseStamped
@@ -210,6 +211,18 @@ def _pose(stamp, z, frame='beam_base', pitch_w=1.0, pitch=0.0, x=2.3):
     if pitch_w != 1.0:
         q.w = pitch_w
     return msg
+
+
+def test_the_window_carries_the_tip_x_of_the_poses(ros_graph):
+    node = IdentifierNode(context=ros_graph.context)
+    ros_graph.add_node(node)
+    ros_graph.publish('/tip_pose', _pose(10.0, -0.01, x=2.25), qos=100)
+    assert ros_graph.wait_for_subscribers('/tip_pose')
+    for i in range(1, 4):
+        ros_graph.publish('/tip_pose', _pose(10.0 + i / 100, -0.01, x=2.25 + i / 1000))
+    assert ros_graph.spin_until(lambda: node.window.newest_s >= 10.03, 10.0)
+    poses = node.window.snapshot().poses
+    np.testing.assert_allclose(poses.x[-3:], [2.251, 2.252, 2.253])
 
 
 def test_bad_input_gives_errors_not_crashes_or_garbage(ros_graph):

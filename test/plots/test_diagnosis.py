@@ -3,26 +3,16 @@
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+from report.helpers import late_diagnosis
 
-from lumpbeam_ros.diagnose.record import make_record
-from lumpbeam_ros.diagnose.workflow import diagnose
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.plots.diagnosis import FIGURES, plot_diagnosis, signature_figure
-from lumpbeam_ros.synthetic.drop_test import SynthOptions, simulate_experiment
 
 
 @pytest.fixture(scope='module')
 def late():
     """A short ring-down whose camera is 15 ms late, diagnosed."""
-    beam, drop = load_beam_config()
-    m, _ = simulate_experiment(
-        beam, drop, SynthOptions(duration_s=4.5, effects={'sensor_latency': 0.015})
-    )
-    rng = np.random.default_rng(3)
-    noise = 20e-6 * rng.standard_normal((2, len(m)))
-    record = make_record(m.t, m.z + noise[0], m.pitch + noise[1], drop.load_kg, [(2.0, 0.0)])
-    return diagnose(record, beam)
+    return late_diagnosis()
 
 
 def test_every_figure_is_written(late, tmp_path):

@@ -24,7 +24,7 @@ def rest_pose() -> np.ndarray:
     return np.array([2.3107, -0.012, 0.004])
 
 
-@pytest.fixture
+@pytest.fixture(scope='session')
 def no_calibration(config: CameraConfig) -> CameraConfig:
     """The config with the rig trusted as configured (no calibration phase)."""
     return dataclasses.replace(

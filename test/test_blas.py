@@ -1,0 +1,47 @@
+"""The BLAS limit, read back through threadpoolctl's own report of the loaded libraries."""
+
+import numpy as np
+import pytest
+from threadpoolctl import threadpool_info, threadpool_limits
+
+from lumpbeam_ros.blas import single_threaded_blas
+
+
+def _blas_threads():
+    return [pool['num_threads'] for pool in threadpool_info() if pool['user_api'] == 'blas']
+
+
+@pytest.fixture
+def two_threads():
+    """Every BLAS at two threads (whatever the environment set), restored afterwards."""
+    if not _blas_threads():
+        pytest.skip('no BLAS that threadpoolctl can see')
+    with threadpool_limits(limits=2, user_api='blas'):
+        yield
+
+
+def test_every_blas_runs_one_thread_inside_and_is_restored_after(two_threads):
+    assert set(_blas_threads()) == {2}
+    with single_threaded_blas():
+        assert set(_blas_threads()) == {1}
+    assert set(_blas_threads()) == {2}
+
+
+def test_the_limit_nests_and_is_restored_after_an_error(two_threads):
+    with pytest.raises(RuntimeError, match='inside'):
+        with single_threaded_blas():
+            with single_threaded_blas():
+                assert set(_blas_threads()) == {1}
+            assert set(_blas_threads()) == {1}
+            raise RuntimeError('inside')
+    assert set(_blas_threads()) == {2}
+
+
+def test_one_thread_computes_the_same_products():
+    rng = np.random.default_rng(3)
+    a, b = rng.standard_normal((60, 40)), rng.standard_normal((40, 30))
+    with single_threaded_blas():
+        inside = a @ b
+        solved = np.linalg.lstsq(a, a @ np.arange(40.0), rcond=None)[0]
+    np.testing.assert_allclose(inside, a @ b, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(solved, np.arange(40.0), rtol=1e-9, atol=1e-9)
