@@ -8,6 +8,7 @@ from geometry_msgs.msg import PoseStamped
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
+from scipy.optimize import curve_fit
 from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio.convert import quaternion_to_pitch
@@ -92,8 +93,16 @@ def test_drop_oscillates_about_the_unloaded_level_at_the_first_mode(ros_graph):
     before, after = z[t < release - 0.01], z[t > release + 0.5]
     assert before[-1] == pytest.approx(-0.0694, abs=5e-4)
     assert 0.5 * (after.max() + after.min()) == pytest.approx(-0.029, abs=1.5e-3)
-    crossings = t[t > release + 0.5][np.flatnonzero(np.diff(np.sign(after + 0.0286)) > 0)]
-    assert 1 / np.mean(np.diff(crossings)) == pytest.approx(3.06, abs=0.04)
+    # The frequency from a damped-sine fit (scipy) over the stamps, not from zero crossings:
+    # a starved test executor may drop a few samples, and a gap at a crossing moves it.
+    t_after = t[t > release + 0.5] - release
+
+    def ring(tt, amp, freq, phase, decay, level):
+        return amp * np.exp(-decay * tt) * np.cos(2 * np.pi * freq * tt + phase) + level
+
+    start = (0.5 * np.ptp(after), 3.0, 0.0, 0.0, float(np.mean(after)))
+    fit, _ = curve_fit(ring, t_after, after, p0=start)
+    assert abs(fit[1]) == pytest.approx(3.06, abs=0.04)
     # The same stamps through the batch simulation, released within 5 ms of the arrival.
     assert mismatch(release) < 0.04 * 2 * np.pi * 3.06 * 0.025
 
