@@ -13,6 +13,7 @@ of ROS (``image_geometry``) and OpenCV:
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -24,6 +25,9 @@ EQUIDISTANT = 'equidistant'
 
 #: Supported distortion models and their number of coefficients.
 DISTORTION_MODELS = {PLUMB_BOB: 5, RATIONAL_POLYNOMIAL: 8, EQUIDISTANT: 4}
+
+#: The camera matrix OpenCV's undistortion works with here (normalized coordinates in and out).
+_EYE = np.eye(3)
 
 
 @dataclass(frozen=True)
@@ -101,10 +105,20 @@ class CameraInfo:
             int(width), int(height), k, np.asarray(distortion, dtype=float), distortion_model
         )
 
-    @property
+    @cached_property
     def has_distortion(self) -> bool:
         """Whether the lens departs from a pinhole (an equidistant lens always does)."""
         return self.distortion_model == EQUIDISTANT or bool(np.any(self.d != 0.0))
+
+    @cached_property
+    def _pinhole(self) -> tuple[float, float, float, float, float]:
+        """``(fx, fy, cx, cy, skew)`` as floats.
+
+        The tracker applies K (or its inverse) to every frame's corners; the fields are fixed
+        for the instance's life, so they are read out once.
+        """
+        k = self.k
+        return float(k[0, 0]), float(k[1, 1]), float(k[0, 2]), float(k[1, 2]), float(k[0, 1])
 
     def check_image_size(self, width: int, height: int, source: str = 'image') -> None:
         """Checks that images of the given size belong to this calibration.
@@ -163,7 +177,7 @@ class CameraInfo:
         x, y = xy[:, 0], xy[:, 1]
         r2 = x * x + y * y
         if self.distortion_model == EQUIDISTANT:
-            k1, k2, k3, k4 = self.d
+            k1, k2, k3, k4 = self._coefficients
             r = np.sqrt(r2)
             theta = np.arctan(r)
             t2 = theta * theta
@@ -171,17 +185,21 @@ class CameraInfo:
             # theta_d / r -> 1 on the optical axis.
             scale = np.divide(theta_d, r, out=np.ones_like(r), where=r > 1e-12)
             return np.asarray(xy * scale[:, None])
-        k1, k2, p1, p2, k3 = self.d[:5]
+        k1, k2, p1, p2, k3 = self._coefficients[:5]
         radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
         if self.distortion_model == RATIONAL_POLYNOMIAL:
-            k4, k5, k6 = self.d[5:]
+            k4, k5, k6 = self._coefficients[5:]
             radial = radial / (1.0 + r2 * (k4 + r2 * (k5 + r2 * k6)))
-        return np.column_stack(
-            [
-                x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
-                y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y,
-            ]
-        )
+        xy_2 = 2.0 * x * y
+        out = np.empty_like(xy)
+        out[:, 0] = x * radial + p1 * xy_2 + p2 * (r2 + 2.0 * x * x)
+        out[:, 1] = y * radial + p1 * (r2 + 2.0 * y * y) + p2 * xy_2
+        return out
+
+    @cached_property
+    def _coefficients(self) -> tuple[float, ...]:
+        """The distortion coefficients as floats (scalar arithmetic beats 0-d arrays')."""
+        return tuple(float(v) for v in self.d)
 
     def undistort_normalized(self, xy_distorted: np.ndarray, iterations: int = 20) -> np.ndarray:
         """Inverts :meth:`distort_normalized`: OpenCV's estimate, polished by Newton's method.
@@ -208,11 +226,10 @@ class CameraInfo:
         # OpenCV's fixed-point iteration run to convergence (Newton only polishes the rest).
         criteria = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-15)
         pts = np.ascontiguousarray(target).reshape(-1, 1, 2)
-        eye = np.eye(3)
         if self.distortion_model == EQUIDISTANT:
-            xy = cv2.fisheye.undistortPoints(pts, eye, self.d, criteria=criteria)
+            xy = cv2.fisheye.undistortPoints(pts, _EYE, self.d, criteria=criteria)
         else:
-            xy = cv2.undistortPoints(pts, eye, self.d, None, None, None, criteria)
+            xy = cv2.undistortPoints(pts, _EYE, self.d, None, None, None, criteria)
         xy = xy.reshape(-1, 2)
         if not np.all(np.isfinite(xy)):
             xy = target.copy()
@@ -249,16 +266,20 @@ class CameraInfo:
 
     def to_pixels(self, xy: np.ndarray) -> np.ndarray:
         """Applies K to normalized coordinates (N x 2)."""
-        return np.asarray(
-            xy * np.diag(self.k)[:2] + self.k[:2, 2] + np.outer(xy[:, 1], [self.k[0, 1], 0])
-        )
+        fx, fy, cx, cy, skew = self._pinhole
+        out = np.empty_like(xy, dtype=float)
+        out[:, 0] = xy[:, 0] * fx + skew * xy[:, 1] + cx
+        out[:, 1] = xy[:, 1] * fy + cy
+        return out
 
     def to_normalized(self, pixels: np.ndarray) -> np.ndarray:
         """Applies K's inverse to pixels (N x 2)."""
         pixels = np.asarray(pixels, dtype=float).reshape(-1, 2)
-        y = (pixels[:, 1] - self.k[1, 2]) / self.k[1, 1]
-        x = (pixels[:, 0] - self.k[0, 2] - self.k[0, 1] * y) / self.k[0, 0]
-        return np.column_stack([x, y])
+        fx, fy, cx, cy, skew = self._pinhole
+        out = np.empty_like(pixels)
+        out[:, 1] = (pixels[:, 1] - cy) / fy
+        out[:, 0] = (pixels[:, 0] - cx - skew * out[:, 1]) / fx
+        return out
 
     def undistort_pixels(self, pixels: np.ndarray) -> np.ndarray:
         """Maps measured (distorted) pixels to where an ideal pinhole camera sees them.

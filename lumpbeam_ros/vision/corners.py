@@ -35,21 +35,26 @@ def refine_corners(
     w = int(half_window)
     guess = np.asarray(guess, dtype=np.float64).reshape(-1, 2)
     h_img, w_img = image.shape[:2]
+    # NaN fails every comparison, so a corner not predicted is outside too.
     inside = (
-        np.all(np.isfinite(guess), axis=1)
-        & (guess[:, 0] >= w + 1)
+        (guess[:, 0] >= w + 1)
         & (guess[:, 0] <= w_img - w - 2)
         & (guess[:, 1] >= w + 1)
         & (guess[:, 1] <= h_img - w - 2)
     )
-    refined = np.full_like(guess, np.nan)
-    if not np.any(inside):
-        return refined
     criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_MAX_ITER, max_iterations, 0.001)
-    pts = np.ascontiguousarray(guess[inside], dtype=np.float32).reshape(-1, 1, 2)
-    out = cv2.cornerSubPix(image, pts, (w, w), (-1, -1), criteria).reshape(-1, 2)
-    refined[inside] = out
-    moved = np.max(np.abs(refined - guess), axis=1)
+    if inside.all():
+        pts = guess.astype(np.float32).reshape(-1, 1, 2)
+        refined = cv2.cornerSubPix(image, pts, (w, w), (-1, -1), criteria).reshape(-1, 2)
+        refined = refined.astype(np.float64)
+    else:
+        refined = np.full_like(guess, np.nan)
+        if not np.any(inside):
+            return refined
+        pts = np.ascontiguousarray(guess[inside], dtype=np.float32).reshape(-1, 1, 2)
+        out = cv2.cornerSubPix(image, pts, (w, w), (-1, -1), criteria).reshape(-1, 2)
+        refined[inside] = out
+    moved = np.abs(refined - guess).max(axis=1)
     refined[~(moved <= w)] = np.nan
     return refined
 

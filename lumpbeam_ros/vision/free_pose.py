@@ -15,6 +15,7 @@ certain than the plane-constrained fit's three numbers; the covariance says by h
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,6 +23,7 @@ import numpy as np
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import RigGeometry
 from lumpbeam_ros.vision.geometry import Transform, rotation_rpy
+from lumpbeam_ros.vision.partial import sorted_median
 
 #: The pose models a tracker fits: ``plane`` (x, z, pitch in the plane of bending) or
 #: ``free`` (the full 6-DoF pose).
@@ -42,6 +44,7 @@ class FreeFit:
         rms_px: RMS reprojection error per corner, px.
         max_px: The largest reprojection error of a corner, px.
         converged: Whether Gauss-Newton met its step tolerance.
+        median_px: The median reprojection error of a corner, px.
     """
 
     pose: np.ndarray
@@ -49,6 +52,7 @@ class FreeFit:
     rms_px: float
     max_px: float
     converged: bool
+    median_px: float = math.nan
 
 
 def rpy_from_rotation(rotation: np.ndarray) -> np.ndarray:
@@ -186,8 +190,10 @@ class FreeModel:
         except np.linalg.LinAlgError:
             covariance = np.full((6, 6), np.inf)
         rms = float(np.sqrt(ssr / residual.shape[0]))
-        worst = float(np.sqrt(np.max(np.sum(residual * residual, axis=1))))
-        return FreeFit(pose, covariance, rms, worst, converged and bool(np.isfinite(rms)))
+        distances = np.sqrt(np.sum(residual * residual, axis=1))
+        worst = float(np.max(distances))
+        ok = converged and bool(np.isfinite(rms))
+        return FreeFit(pose, covariance, rms, worst, ok, sorted_median(distances))
 
 
 def free_pose_from_board_pose(rig: RigGeometry, camera_board: Transform) -> np.ndarray:

@@ -469,6 +469,87 @@ def select_corners(
     return CornerSelection(mask, int(np.count_nonzero(~found)), int(np.count_nonzero(~good)), 0)
 
 
+#: Nearest a colour sample comes to a corner's edge lines, px: at 3 px a 1.8 px blur (the
+#: widest of :data:`BLURS_PX`) still leaves 90 % of the saddle's amplitude.
+COLOUR_EDGE_PX = 3
+
+#: How far a colour sample may stray from its square's mean, as a fraction of the corner's
+#: light-dark difference: a clean corner's samples stray by blur (at most some 7 %) and
+#: noise (2 DN of 190 DN), an occluder's by its own contrast with the square.
+COLOUR_TOLERANCE = 0.25
+
+
+@functools.lru_cache(maxsize=8)
+def _colour_offsets(radius: int) -> np.ndarray:
+    """Board-axis offsets ``(a, b)`` of the colour samples (K x 2), px.
+
+    First the quadrants with ``a b > 0``, then those with ``a b < 0``, every other pixel from
+    :data:`COLOUR_EDGE_PX` to ``radius`` from the edge lines. The array is shared between
+    calls (read-only).
+    """
+    steps = np.arange(COLOUR_EDGE_PX, max(radius, COLOUR_EDGE_PX) + 1, 2, dtype=float)
+    a, b = (v.ravel() for v in np.meshgrid(steps, steps, indexing='ij'))
+    offsets = np.stack([np.concatenate([a, -a, a, -a]), np.concatenate([b, -b, -b, b])], axis=1)
+    offsets.flags.writeable = False
+    return offsets
+
+
+def colours_as_expected(
+    image: np.ndarray,
+    corners: np.ndarray,
+    predicted: np.ndarray,
+    pattern_size: tuple[int, int],
+    radius: int,
+    min_contrast_dn: float,
+    polarity: float,
+) -> bool:
+    """Whether every corner shows its four squares in the expected colours, untouched.
+
+    A cheap screen for a clean frame, before :func:`select_corners`: per corner, a sparse
+    grid of pixels in each of its four squares, within the saddle check's window but
+    :data:`COLOUR_EDGE_PX` away from the edge lines (nearest pixel, no model, no blur
+    search). The two light squares' samples must be lighter than the two dark squares' by
+    ``min_contrast_dn`` on average, in the colour order of ``polarity``, and every sample
+    within :data:`COLOUR_TOLERANCE` of the difference from its squares' mean. A cable, a
+    hand or a sheet's edge inside a window changes some samples; a corner off the image
+    border, or a pale, noisy or defocused frame, fails too. The screen only decides that
+    nothing needs checking: when it fails, the saddle check runs as usual.
+
+    Args:
+        image: Grey image (H x W).
+        corners: Refined corners (N x 2, all of the board's).
+        predicted: The prediction of every corner (N x 2, finite): gives the board's axes.
+        pattern_size: ``(corners per row, rows)``.
+        radius: The refinement window's half-size, px (the samples reach
+            :data:`CHECK_MARGIN_PX` beyond it, as the saddle check does).
+        min_contrast_dn: Least light-dark difference at a corner, DN.
+        polarity: The board's colour order (:func:`board_polarity`).
+
+    Returns:
+        ``True`` when every corner passes.
+    """
+    if not np.all(np.isfinite(corners)) or not image.flags.c_contiguous:
+        return False
+    along_x, along_y = grid_axes(predicted, pattern_size)
+    # Per corner, the unit vectors of the board's axes as the rows of a 2 x 2 matrix.
+    axes = np.stack([along_x, along_y], axis=1)
+    axes /= np.maximum(np.hypot(axes[:, :, 0], axes[:, :, 1]), 1e-9)[:, :, None]
+    pixel = np.rint(corners[:, None, :] + _colour_offsets(radius + CHECK_MARGIN_PX) @ axes)
+    h, w = image.shape[:2]
+    if pixel.min() < 0 or pixel[:, :, 0].max() >= w or pixel[:, :, 1].max() >= h:
+        return False
+    flat = (pixel[:, :, 1] * w + pixel[:, :, 0]).astype(np.intp)
+    values = image.reshape(-1).take(flat).reshape(len(corners), 2, -1)
+    means = values.mean(axis=2)
+    # Positive where the quadrants with a b > 0 (the (+x, +y) one among them) are light.
+    contrast = (means[:, 0] - means[:, 1]) * (corner_parity(pattern_size) * polarity)
+    stray = np.maximum(values.max(axis=2) - means, means - values.min(axis=2))
+    return bool(
+        np.all(contrast >= min_contrast_dn)
+        and np.all(stray.max(axis=1) <= COLOUR_TOLERANCE * contrast)
+    )
+
+
 def board_polarity(
     image: np.ndarray, corners: np.ndarray, pattern_size: tuple[int, int], radius: int
 ) -> float:

@@ -42,7 +42,9 @@ from lumpbeam_ros.vision.free_pose import (
 )
 from lumpbeam_ros.vision.partial import (
     OUTLIER_FLOOR_PX,
+    OUTLIER_MEDIANS,
     board_polarity,
+    colours_as_expected,
     coverage_problem,
     labelling_is_unambiguous,
     reject_outliers,
@@ -330,6 +332,12 @@ class TipTracker:
         """Tracks from predicted corners, with those seen; the reason when too few are."""
         corners = refine_corners(gray, guess, self._half_window)
         pattern = self._board.pattern_size
+        clean = self._clean_fit(gray, corners, guess, pose_guess)
+        if clean is not None:
+            # Every corner kept: what follows for a partial view has nothing to decide.
+            result = self._accept(stamp, corners, *clean, detected=False)
+            self._prediction_error = sorted_median(np.linalg.norm(corners - guess, axis=1))
+            return result, ''
         selection = select_corners(
             gray, corners, guess, pattern, self._half_window, self.settings.min_contrast_dn,
             self._polarity,
@@ -363,6 +371,52 @@ class TipTracker:
         result = self._accept(stamp, corners, ideal, fit, detected=False)
         self._prediction_error = error
         return result, ''
+
+    def _clean_fit(
+        self, gray: np.ndarray, corners: np.ndarray, guess: np.ndarray, pose_guess: np.ndarray
+    ) -> tuple[np.ndarray, PlaneFit | FreeFit] | None:
+        """The fit of every corner when the frame is clean, else ``None`` (the checks decide).
+
+        Most frames show the whole board untouched, and the saddle check and the homography
+        loop then keep every corner. They are left out when a cheaper screen says so: every
+        corner refined, :func:`colours_as_expected` passing, and the calibrated pose model
+        passing every corner within the residual check's own limit (:data:`OUTLIER_MEDIANS`
+        times the median corner residual, at least :data:`OUTLIER_FLOOR_PX`), with the whole
+        board meeting the documented minimum (it does but in an odd configuration). The model
+        has fewer degrees of freedom than the check's homography, so a corner within that
+        limit of it is within the limit of the homography too (up to the refit's share).
+        When anything looks off the checks run as before, so partial views and occluders are
+        handled exactly as without the screen.
+
+        Args:
+            gray: The frame.
+            corners: The refined corners (N x 2; NaN where refinement failed).
+            guess: The predicted corners (N x 2).
+            pose_guess: The predicted pose.
+
+        Returns:
+            The undistorted corners and their fit, or ``None``.
+        """
+        if (
+            not self._is_calibrated()
+            or self._polarity is None
+            or self._coverage_problem(np.ones(len(corners), dtype=bool))
+            or not colours_as_expected(
+                gray,
+                corners,
+                guess,
+                self._board.pattern_size,
+                self._half_window,
+                self.settings.min_contrast_dn,
+                self._polarity,
+            )
+        ):
+            return None
+        ideal = self.camera_info.undistort_pixels(corners)
+        fit, _ = self._fit(ideal, pose_guess)
+        if fit is None or not fit.max_px <= max(OUTLIER_FLOOR_PX, OUTLIER_MEDIANS * fit.median_px):
+            return None
+        return ideal, fit
 
     def _fit_within_outlier_floor(
         self, ideal: np.ndarray, mask: np.ndarray, pose_guess: np.ndarray

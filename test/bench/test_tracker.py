@@ -12,6 +12,13 @@ def test_quick_run_reports_speed_accuracy_and_end_to_end_against_same_run_baseli
     assert abs(speed.ratio - speed.value / speed.baseline_value) < 1e-9
     assert speed.details['frames_lost'] == 0
     assert speed.details['baseline_frames_found'] == speed.details['frames']
+    cpu, baseline_cpu = (
+        speed.details[k] for k in ('cpu_ms_per_frame', 'baseline_cpu_ms_per_frame')
+    )
+    assert cpu > 0 and baseline_cpu > 0
+    assert abs(speed.details['cpu_ratio'] - baseline_cpu / cpu) < 1e-9
+    verdict = 'pass' if speed.value >= 180 and speed.ratio >= 10 else 'FAIL'
+    assert speed.details['target'] == f'{verdict} (>= 180 fps and >= 10x)'
     # Free PnP per frame errs far more than the tracker, on the same distorted frames.
     assert speed.details['baseline_z_rms_um'] > 5 * speed.details['z_rms_um']
     assert accuracy.name == 'tracker_z_rms_640x480' and accuracy.unit == 'um'

@@ -8,12 +8,15 @@ import cv2
 import numpy as np
 import pytest
 
+from lumpbeam_ros.vision import tracker as tracker_module
 from lumpbeam_ros.vision.corners import refine_corners
 from lumpbeam_ros.vision.partial import (
     MAX_SADDLE_MISFIT,
     MISFIT_CEILING,
     MISFIT_MEDIANS,
+    board_polarity,
     checked_saddle_fit,
+    colours_as_expected,
     coverage_problem,
     grid_axes,
     labelling_is_unambiguous,
@@ -240,6 +243,46 @@ def test_clean_corners_all_pass(config, rest_pose):
     wrong = select_corners(image, refined, truth, config.rig.board.pattern_size, 5, 20.0, -1.0)
     right = select_corners(image, refined, truth, config.rig.board.pattern_size, 5, 20.0, 1.0)
     assert {wrong.count, right.count} == {0, 48}
+
+
+def test_the_colour_screen_passes_a_clean_board_only(config, drop_frames):
+    """Right colours pass; the wrong order, a pale frame and every occluder fail."""
+    frame = drop_frames[10]
+    truth = PlaneModel(config.rig, config.camera_info).project(frame.truth)
+    pattern = config.rig.board.pattern_size
+
+    def screen(image, polarity):
+        refined = refine_corners(image, truth + 0.3, 5)
+        return colours_as_expected(image, refined, truth, pattern, 5, 20.0, polarity)
+
+    polarity = board_polarity(frame.image, truth, pattern, 5)
+    assert screen(frame.image, polarity)
+    assert not screen(frame.image, -polarity)
+    pale = (frame.image * 0.08 + 110).astype(np.uint8)  # 15 DN between the squares
+    assert not screen(pale, polarity)
+    for kind, image in _occluders(frame, config).items():
+        assert not screen(image, polarity), kind
+
+
+def test_the_clean_frame_screen_changes_no_pose(no_calibration, drop_frames, monkeypatch):
+    """With the screen, clean frames give the very poses the saddle and residual checks give."""
+    passed = []
+
+    def counted(*args):
+        passed.append(colours_as_expected(*args))
+        return passed[-1]
+
+    monkeypatch.setattr(tracker_module, 'colours_as_expected', counted)
+    tracker = TipTracker(no_calibration.camera_info, no_calibration)
+    screened = [tracker.process(f.image, f.stamp) for f in drop_frames]
+    monkeypatch.setattr(tracker_module, 'colours_as_expected', lambda *args: False)
+    tracker = TipTracker(no_calibration.camera_info, no_calibration)
+    checked = [tracker.process(f.image, f.stamp) for f in drop_frames]
+    assert sum(passed) >= len(drop_frames) - 2  # all but the detection frame (and one)
+    for a, b in zip(screened, checked, strict=True):
+        assert a.ok and b.ok and a.corners_used == b.corners_used == 48
+        np.testing.assert_array_equal(a.pose, b.pose)
+        np.testing.assert_array_equal(a.covariance, b.covariance)
 
 
 def test_grid_axes_are_one_square(config, rest_pose):
