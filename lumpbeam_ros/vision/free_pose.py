@@ -23,7 +23,6 @@ import numpy as np
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import RigGeometry
 from lumpbeam_ros.vision.geometry import Transform, rotation_rpy
-from lumpbeam_ros.vision.partial import sorted_median
 
 #: The pose models a tracker fits: ``plane`` (x, z, pitch in the plane of bending) or
 #: ``free`` (the full 6-DoF pose).
@@ -193,7 +192,7 @@ class FreeModel:
         distances = np.sqrt(np.sum(residual * residual, axis=1))
         worst = float(np.max(distances))
         ok = converged and bool(np.isfinite(rms))
-        return FreeFit(pose, covariance, rms, worst, ok, sorted_median(distances))
+        return FreeFit(pose, covariance, rms, worst, ok, float(np.median(distances)))
 
 
 def free_pose_from_board_pose(rig: RigGeometry, camera_board: Transform) -> np.ndarray:
