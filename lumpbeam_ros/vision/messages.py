@@ -62,7 +62,8 @@ def camera_info_from_data(data: CameraInfoData) -> CameraInfo:
 
     Raises:
         LumpbeamError: An unusable calibration: zero focal length (an uncalibrated camera
-            publishes K = 0), a distortion model other than plumb_bob, a bad size.
+            publishes K = 0), a distortion model other than plumb_bob,
+            rational_polynomial and equidistant, a bad size.
     """
     return CameraInfo(
         int(data.width),
