@@ -244,7 +244,7 @@ def add_analyze(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         '--identifier-config', help='identifier parameter file (default: config/identifier.yaml)'
     )
-    parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
+    add_report(parser)
 
 
 @_subcommand(
@@ -263,7 +263,7 @@ def add_diagnose(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         '--write-model', metavar='FILE', help='write the augmented beam parameter file'
     )
-    parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
+    add_report(parser)
 
 
 @_subcommand(
@@ -296,7 +296,38 @@ def add_compare(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument('--camera-topic', default=POSE_TOPIC)
     parser.add_argument('--reference-topic', default=REFERENCE_TOPIC)
-    parser.add_argument('--report', metavar='FILE.html', help='write a self-contained HTML report')
+    add_report(parser)
+
+
+def html_file(text: str) -> str:
+    """Argument type: a file name ending in ``.html`` or ``.htm``.
+
+    Checked when the arguments are parsed, so a wrong name is refused before a long analysis
+    runs (the report writer refuses it too).
+
+    Args:
+        text: The option's value.
+
+    Returns:
+        The file name.
+
+    Raises:
+        argparse.ArgumentTypeError: Another suffix.
+    """
+    if Path(text).suffix.lower() not in ('.html', '.htm'):
+        raise argparse.ArgumentTypeError(f'the report is an HTML file (FILE.html), not {text!r}')
+    return text
+
+
+def add_report(parser: argparse.ArgumentParser) -> None:
+    """Declares ``--report FILE.html``.
+
+    Args:
+        parser: The subcommand's parser.
+    """
+    parser.add_argument(
+        '--report', type=html_file, metavar='FILE.html', help='write a self-contained HTML report'
+    )
 
 
 def add_namespace(parser: argparse.ArgumentParser, what: str) -> None:

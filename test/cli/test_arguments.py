@@ -45,3 +45,18 @@ def test_a_bad_tracker_pose_is_a_usage_error(capsys):
         build_parser().parse_args(['synth', 'out', '--tracker-pose', '1,2'])
     assert exit_.value.code == 2
     assert "expected 6 comma-separated numbers, got '1,2'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize('command', [['analyze', 'bag'], ['diagnose', 'bag'], ['compare', 'bag']])
+@pytest.mark.parametrize('name', ['report.html', 'out/Report.HTM'])
+def test_report_takes_an_html_file(command, name):
+    assert build_parser().parse_args([*command, '--report', name]).report == name
+
+
+@pytest.mark.parametrize('command', [['analyze', 'bag'], ['diagnose', 'bag'], ['compare', 'bag']])
+@pytest.mark.parametrize('name', ['report.txt', 'report', 'html'])
+def test_a_report_that_is_not_html_is_refused_before_any_work(command, name, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        build_parser().parse_args([*command, '--report', name])
+    assert exit_.value.code == 2
+    assert f"the report is an HTML file (FILE.html), not '{name}'" in capsys.readouterr().err
