@@ -1,11 +1,16 @@
 """How every node process runs: init, build the node, spin, count, shut down.
 
-One place for what each node's ``main`` did alike (:func:`run_node`): a configuration error
-while the node is built is one line on stderr and exit code 2 (no traceback); Ctrl-C or an
-external shutdown ends the spin quietly; what the node published is written for the demo's
-per-topic counts (:mod:`lumpbeam_ros.nodes.counts`) however it stopped. The commands that
-run a node in their own loop (``lumpbeam play``, ``lumpbeam record``) take their namespace
-from :func:`checked_namespace` and their rclpy session and stop request from
+One place for what each node's ``main`` did alike (:func:`run_node`):
+
+* a configuration error while the node is built is one line on stderr and exit code 2 (no
+  traceback);
+* Ctrl-C, SIGTERM or an external shutdown ends the spin quietly, also when the shutdown cuts
+  into a callback that publishes;
+* what the node published is written for the demo's per-topic counts
+  (:mod:`lumpbeam_ros.nodes.counts`) however it stopped.
+
+The commands that run a node in their own loop (``lumpbeam play``, ``lumpbeam record``) take
+their namespace from :func:`checked_namespace` and their rclpy session and stop request from
 :func:`stoppable_session`.
 """
 
@@ -21,6 +26,7 @@ from typing import TypeVar
 import rclpy
 from rclpy.exceptions import InvalidNamespaceException, ParameterException
 from rclpy.executors import ExternalShutdownException
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from rclpy.validate_namespace import validate_namespace
@@ -66,6 +72,11 @@ def run_node(
         return CONFIG_ERROR
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except _rclpy.RCLError:
+        # rclpy's SIGINT/SIGTERM handler shuts the context down under a running callback,
+        # whose next publish then fails: that is the stop, not a fault.
+        if rclpy.ok():
+            raise
     finally:
         if node is not None:
             write_counts(name, published(node), received(node) if received else None)

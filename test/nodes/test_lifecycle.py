@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import pytest
+import rclpy
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
+from std_msgs.msg import Float64
 
 from lumpbeam_ros.errors import ConfigError, LumpbeamError
 from lumpbeam_ros.nodes.counts import COUNTS_DIR_ENV, read_counts
@@ -60,3 +63,35 @@ def test_a_configuration_error_is_one_line_and_exit_2(counts_dir, capsys, error,
     assert err == [f'counting_node: error: {error}']
     # A node that was never built published nothing and writes no counts.
     assert ('counting_node' in read_counts(counts_dir)) == (when == 'run')
+
+
+class _Publishing(_Counting):
+    def __init__(self) -> None:
+        super().__init__()
+        self.sent = 0
+        self.publisher = self.create_publisher(Float64, 'x', 1)
+
+    def publish(self) -> None:
+        self.publisher.publish(Float64(data=1.0))
+        self.sent += 1
+
+
+def test_a_shutdown_that_cuts_into_a_publish_is_a_quiet_stop(counts_dir, capsys):
+    def run(node: _Publishing) -> None:
+        node.publish()
+        # What rclpy's SIGINT/SIGTERM handler does while a timer callback runs.
+        rclpy.shutdown()
+        node.publish()
+
+    assert run_node('counting_node', _Publishing, lambda n: {'/x': n.sent}, [], run=run) == 0
+    assert capsys.readouterr().err == ''
+    assert read_counts(counts_dir)['counting_node']['published'] == {'/x': 1}
+
+
+def test_a_middleware_error_while_running_is_not_hidden(counts_dir):
+    def run(node: _Publishing) -> None:
+        raise _rclpy.RCLError('failed to take a message')
+
+    with pytest.raises(_rclpy.RCLError, match='failed to take'):
+        run_node('counting_node', _Publishing, lambda n: {'/x': n.sent}, [], run=run)
+    assert read_counts(counts_dir)['counting_node']['published'] == {'/x': 0}
