@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import subprocess
 import sys
@@ -54,9 +55,12 @@ class StreamFigures:
         received: Poses received.
         duration_s: Publishing time, s.
         latency_ms: Per received pose, receive time minus image stamp, ms.
-        params_latency_ms: Per ``/beam_params`` message (when an identifier node runs),
-            its publication stamp minus the stamp of the newest frame in its window
-            (``window_end_s``), ms.
+        params_latency_ms: Per ``/beam_params`` message with a newer frame than the message
+            before it (when an identifier node runs), its publication stamp minus the stamp
+            of the newest frame in its window (``window_end_s``), ms.
+        params_repeated: ``/beam_params`` messages whose window had no newer frame: their
+            age measures a pause in the poses (the stream's end, a stalled camera), not the
+            chain, so they are counted here and not timed.
     """
 
     published: int
@@ -64,6 +68,7 @@ class StreamFigures:
     duration_s: float
     latency_ms: np.ndarray
     params_latency_ms: np.ndarray = field(default_factory=lambda: np.empty(0))
+    params_repeated: int = 0
 
     def percentile_ms(self, q: float) -> float:
         """A latency percentile, ms (NaN without poses)."""
@@ -182,6 +187,41 @@ def echo() -> int:
     return 0
 
 
+class ParamsAges:
+    """The age of each ``/beam_params`` message that brings a newer frame than the last.
+
+    The identifier publishes on a timer, so while no pose comes in (the stream has ended, the
+    camera stalled) it repeats the same window, and that message's age grows with the pause,
+    not with the chain's latency: such messages are counted, not timed.
+
+    Attributes:
+        latencies_ms: Per timed message, its publication stamp minus the stamp of the newest
+            frame in its window, ms.
+        repeated: Messages whose newest frame was not newer than the last timed one's.
+    """
+
+    def __init__(self) -> None:
+        self.latencies_ms: list[float] = []
+        self.repeated = 0
+        self._newest_s = -math.inf
+
+    def add(self, published_ns: int, window_end_s: float) -> None:
+        """Takes one message.
+
+        Args:
+            published_ns: Its header stamp, ns.
+            window_end_s: The stamp of the newest frame in its window (``window_end_s``), s;
+                a message without one (NaN: no window yet) is ignored.
+        """
+        if not math.isfinite(window_end_s):
+            return
+        if window_end_s <= self._newest_s:
+            self.repeated += 1
+            return
+        self._newest_s = window_end_s
+        self.latencies_ms.append(published_ns * 1e-6 - window_end_s * 1e3)
+
+
 def measure(
     consumer: Sequence[str],
     width: int,
@@ -229,18 +269,16 @@ def measure(
         stamp_ns = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
         latencies.append((time.time_ns() - stamp_ns) * 1e-6)
 
-    params_latencies: list[float] = []
+    params = ParamsAges()
 
     def on_params(msg: DiagnosticArray) -> None:
         published_ns = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
         for status in msg.status:
             values = {kv.key: kv.value for kv in status.values}
             try:
-                newest_s = float(values['window_end_s'])
+                params.add(published_ns, float(values['window_end_s']))
             except (KeyError, ValueError):
                 continue
-            if np.isfinite(newest_s):
-                params_latencies.append(published_ns * 1e-6 - newest_s * 1e3)
 
     subscription(node, PoseStamped, TIP_POSE, on_pose)
     subscription(node, DiagnosticArray, BEAM_PARAMS, on_params)
@@ -294,7 +332,8 @@ def measure(
         len(latencies),
         float(result['duration_s']),
         np.array(latencies),
-        np.array(params_latencies),
+        np.array(params.latencies_ms),
+        params.repeated,
     )
 
 

@@ -5,9 +5,12 @@ clock (:mod:`lumpbeam_ros.bench.camera_stream`), the camera node tracking them i
 ``/tip_pose``, and the identifier node (on wall time) publishing ``/beam_params``. Each
 ``/beam_params`` message names the newest pose it used (``window_end_s``, the stamp of that
 frame); its header stamp is when it was published. Their difference is the latency of the
-whole chain. The baseline, measured in the same run, is the first hop alone: frame stamp to
-the arrival of its ``/tip_pose`` at the bench process. The ratio (baseline over value) is
-the part of the end-to-end latency that the camera hop accounts for.
+whole chain, timed for the messages that bring a newer frame than the one before
+(:class:`~lumpbeam_ros.bench.camera_stream.ParamsAges`: a repeated window only measures a
+pause in the poses, such as the end of the stream). The baseline, measured in the same
+run, is the first hop alone: frame stamp to the arrival of its ``/tip_pose`` at the bench
+process. The ratio (baseline over value) is the part of the end-to-end latency that the
+camera hop accounts for.
 """
 
 from __future__ import annotations
@@ -51,7 +54,8 @@ def end_to_end(width: int, height: int, rate_hz: float, duration_s: float) -> Be
         'offered_fps': rate_hz,
         'frames_published': figures.published,
         'poses_received': figures.received,
-        'beam_params_received': int(params.size),
+        'beam_params_received': int(params.size) + figures.params_repeated,
+        'beam_params_timed': int(params.size),
         'beam_params_latency_p50_ms': value if params.size else math.nan,
         'beam_params_latency_p99_ms': _percentile(params, 99),
         'tip_pose_latency_p50_ms': baseline,
