@@ -452,12 +452,20 @@ class DampedSinusoidFit:
         else:
             x0 = self._start(tau, y, list(initial or []))
         decay = _Decay(tau, self.n_modes, self.drift, self.nonlinear)
-        found = _gauss_newton(decay, y, x0) if start is not None else None
-        if found is None:
-            solution = least_squares(
-                lambda x: decay.value(x) - y, x0, jac=decay.jacobian, method='lm', x_scale='jac'
-            )
-            found = solution.x, int(solution.nfev)
+        # A trial step can give a mode a growing envelope that overflows to inf: both solvers
+        # reject such a step (its residual is not smaller), and a non-finite solution is
+        # refused below, so numpy's warnings would only alarm a reader of the node's log.
+        with np.errstate(over='ignore', invalid='ignore'):
+            found = _gauss_newton(decay, y, x0) if start is not None else None
+            if found is None:
+                solution = least_squares(
+                    lambda x: decay.value(x) - y,
+                    x0,
+                    jac=decay.jacobian,
+                    method='lm',
+                    x_scale='jac',
+                )
+                found = solution.x, int(solution.nfev)
         x, evaluations = found
         if not np.all(np.isfinite(x)):
             raise LumpbeamError('damped-sinusoid fit did not converge')

@@ -1,4 +1,6 @@
 import math
+import warnings
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -135,3 +137,25 @@ def test_warm_start_converges_quickly_to_the_cold_solution():
     assert not DampedSinusoidFit().fit(T, y, start=warm).nonlinear
     with pytest.raises(LumpbeamError, match='other modes'):
         DampedSinusoidFit(n_modes=2).fit(T, y, start=linear)
+
+
+#: A live identifier's last solution, 0.094 s before the window it starts (the synthetic drop
+#: test replayed without /tip_load): its second mode is a fast decay with no amplitude left.
+_LIVE_START_X = [-0.028921, 0.0099800, -0.039365, 0.045495, 19.217572, -0.049506, -0.050303,
+                 31.891904, 23.498564, -2.7660e-05, 0.0020493]  # fmt: skip
+
+
+def test_trial_steps_that_overflow_are_rejected_without_numpy_warnings():
+    rng = np.random.default_rng(0)
+    tau = np.arange(1801) / 180.0
+    envelope = np.exp(-0.0455 * tau)
+    y = -0.0289 + envelope * (-0.0404 * np.cos(19.2187 * tau) - 1e-4 * np.sin(19.2187 * tau))
+    y += rng.normal(0.0, 20e-6, tau.size)
+    fit = DampedSinusoidFit(n_modes=2, nonlinear=True, min_frequency_hz=0.05)
+    first = fit.fit(tau, y)
+    start = replace(first, t0=-0.094444444, x=np.array(_LIVE_START_X))
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')  # the solver's far trial steps once printed two
+        params = fit.fit(tau, y, start=start)
+    assert np.all(np.isfinite(params.x))
+    assert params.x[4] == pytest.approx(19.2187, rel=1e-4)
