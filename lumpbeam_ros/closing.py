@@ -7,16 +7,20 @@ be freed and child processes stopped either way.
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from types import TracebackType
 from typing import Self
 
 
-class ClosedOnExit:
-    """A context manager that is itself, and calls its :meth:`close` on exit."""
+class ClosedOnExit(ABC):
+    """A context manager that is itself, and calls its :meth:`close` on exit.
 
+    A subclass says how it closes; one that does not cannot be made (``TypeError``).
+    """
+
+    @abstractmethod
     def close(self) -> None:
         """Releases what the object holds; a second call does nothing."""
-        raise NotImplementedError
 
     def __enter__(self) -> Self:
         return self

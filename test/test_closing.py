@@ -24,6 +24,9 @@ def test_it_is_closed_when_the_block_raises_and_the_error_goes_on():
     assert held.closed == 1
 
 
-def test_a_class_that_does_not_say_how_to_close_cannot_be_used():
-    with pytest.raises(NotImplementedError), ClosedOnExit():
+def test_a_class_that_does_not_say_how_to_close_cannot_be_made():
+    class _Forgetful(ClosedOnExit):
         pass
+
+    with pytest.raises(TypeError, match='close'):
+        _Forgetful()  # type: ignore[abstract]
