@@ -8,9 +8,10 @@ from pathlib import Path
 import numpy as np
 
 from lumpbeam_ros.bagio import BagReader, open_bag, read_load_events, read_points, read_tip_poses
+from lumpbeam_ros.bagio.tipseries import LoadSeries
 from lumpbeam_ros.compare.streams import Track, clean_track
 from lumpbeam_ros.errors import BagError, LumpbeamError
-from lumpbeam_ros.ident.samples import LoadReadings, clean_loads
+from lumpbeam_ros.ident.samples import clean_loads
 from lumpbeam_ros.interface import BASE_FRAME, TIP_LOAD, TIP_POSE, TRACKER_POINT
 
 CAMERA_TOPIC = TIP_POSE
@@ -31,7 +32,7 @@ class ComparisonInput:
 
     camera: Track
     reference: Track
-    loads: LoadReadings | None
+    loads: LoadSeries | None
 
 
 def read_comparison_input(

@@ -14,6 +14,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from lumpbeam_ros.bagio.tipseries import MAX_DROPPED_FRACTION, SampleCounts
 from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident import stiffness
@@ -26,7 +27,6 @@ from lumpbeam_ros.ident.identification import (
     FitQuality,
     Identification,
     ReleaseFigures,
-    SampleTally,
     Status,
 )
 from lumpbeam_ros.ident.logdec import LogDecrement, LogDecrementResult, difference_noise_std
@@ -146,7 +146,8 @@ def _identify(
     previous: FitState | None,
 ) -> tuple[Identification, FitState | None]:
     span = AnalysedWindow(window.start_s, window.end_s)
-    tally = SampleTally(len(window), window.counts.non_finite + window.counts.duplicates)
+    dropped = window.counts.dropped
+    tally = replace(window.counts, received=len(window) + dropped)
 
     def fail(
         message: str, unusable: bool = False, release: ReleaseFigures | None = None
@@ -359,7 +360,7 @@ def _assemble(
     state: FitState,
     mode: ModeEstimate,
     span: AnalysedWindow,
-    tally: SampleTally,
+    tally: SampleCounts,
 ) -> Identification:
     params, checks = state.params, state.checks
     warnings: list[str] = []
@@ -396,6 +397,11 @@ def _assemble(
         warnings.append(f'the static tip level did not rise at the release ({deflection:.3g} m)')
     if cycles < config.min_cycles:
         warnings.append(f'only {cycles:.1f} cycles fitted')
+    if tally.untrusted:
+        warnings.append(
+            f'{tally.note()} in the window, more than {MAX_DROPPED_FRACTION:.0%}: '
+            'the poses may mix two streams'
+        )
     _check_rel(
         warnings,
         'frequency',
