@@ -82,6 +82,16 @@ class TipBuffer:
         return float(self._columns['t'][(self._head - self._size) % self._capacity])
 
     @property
+    def t(self) -> np.ndarray:
+        """Stamps of the newest ``keep_s`` seconds, oldest first (a copy), s."""
+        return self.latest()[0].t
+
+    @property
+    def z(self) -> np.ndarray:
+        """Vertical tip positions of the newest ``keep_s`` seconds, oldest first, m."""
+        return self.latest()[0].z
+
+    @property
     def counts(self) -> SampleCounts:
         """Every pose pushed since the buffer was made, and what became of it."""
         return SampleCounts(
