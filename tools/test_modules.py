@@ -18,6 +18,7 @@ CORE_PACKAGES = (
     'diagnose',
     'ident',
     'model',
+    'motion',
     'params',
     'plots',
     'report',
