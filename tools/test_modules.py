@@ -22,6 +22,7 @@ CORE_PACKAGES = (
     'params',
     'plots',
     'report',
+    'shaping',
     'synthetic',
     'vision',
     'viz',
