@@ -31,7 +31,6 @@ from geometry_msgs.msg import PoseStamped
 from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio.convert import pose_values
-from lumpbeam_ros.bagio.tipseries import SampleCounts
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.identification import Identification, Status
 from lumpbeam_ros.ident.identify import FitState, identify_from
@@ -137,9 +136,7 @@ class IdentifierNode(SchemaNode):
         """
         counts = self.window.counts
         message = result.message
-        repeated = counts.out_of_order + counts.duplicates
-        received = counts.accepted + counts.non_finite + repeated
-        dropped = SampleCounts(received, counts.non_finite, repeated).note()
+        dropped = counts.note()
         if dropped:
             # The counts are also published as values; the message says it to a reader.
             message = f'{message}; /tip_pose: {dropped}'
