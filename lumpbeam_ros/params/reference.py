@@ -85,6 +85,16 @@ def node_table(schema: ParameterSchema) -> str:
         '|---|---|---|---|---|---|---|',
         *(_row(spec) for spec in schema),
     ]
+    if schema.file_only:
+        lines += [
+            '',
+            f'Also in `config/{schema.config_file}`, read by other commands, not declared by '
+            'the node:',
+            '',
+            '| name | type | default | range | unit | description |',
+            '|---|---|---|---|---|---|',
+            *(_row(spec).replace(' | yes | ', ' | ', 1) for spec in schema.file_only),
+        ]
     return '\n'.join(lines) + '\n'
 
 
