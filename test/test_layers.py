@@ -46,7 +46,9 @@ REFUSED: dict[str, frozenset[str]] = {
     'diagnose': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'ident': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'model': frozenset({ROS, OPENCV, MATPLOTLIB}),
+    'motion': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'params': frozenset({ROS, OPENCV, MATPLOTLIB}),
+    'shaping': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'viz': frozenset({ROS, OPENCV, MATPLOTLIB}),
     '': frozenset({ROS, OPENCV, MATPLOTLIB}),  # the top-level modules (errors, paramfile, ...)
     'synthetic': frozenset({ROS, OPENCV, MATPLOTLIB}),

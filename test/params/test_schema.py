@@ -4,7 +4,7 @@ import math
 import pytest
 
 from lumpbeam_ros.errors import ConfigError
-from lumpbeam_ros.ident.settings import PARAMETER_KEYS, config_from_parameters
+from lumpbeam_ros.ident.settings import IDENTIFIER_SETTINGS, config_from_parameters
 from lumpbeam_ros.paramfile import read_parameter_file
 from lumpbeam_ros.params import schema as schema_module
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
@@ -140,7 +140,11 @@ _CORE_CASES = [
     (loader, spec, value)
     for loader, schema, keys in [
         (lambda p: camera_config_from_parameters(p, 'probe'), CAMERA_SCHEMA, CONFIG_KEYS),
-        (lambda p: config_from_parameters(p, 'probe'), IDENTIFIER_SCHEMA, PARAMETER_KEYS.values()),
+        (
+            lambda p: config_from_parameters(p, 'probe'),
+            IDENTIFIER_SCHEMA,
+            [s.name for s in IDENTIFIER_SETTINGS],
+        ),
     ]
     for spec in schema
     if spec.name in keys and spec.bounds is not None and spec.name not in _NODE_ONLY_BOUNDS
