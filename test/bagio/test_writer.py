@@ -127,3 +127,26 @@ def test_a_message_older_than_what_was_flushed_is_kept_with_a_warning(tmp_path, 
         bag.write_float('/a', 1.0, 0.0)
     assert 'logged at 1000000000 ns comes after one logged at 2000000000 ns' in caplog.text
     assert BagReader(tmp_path / 'b').topics['/a'].count == 3
+
+
+def test_chunks_the_data_section_and_the_summary_carry_their_crcs(tmp_path):
+    # A CRC of 0 means 'not computed': damage inside a message would then go unnoticed.
+    import zlib
+
+    from mcap.records import Chunk, DataEnd, Footer
+    from mcap.stream_reader import StreamReader
+
+    write_drop_bag(tmp_path / 'drop', images=3)
+    data = (tmp_path / 'drop' / 'drop.mcap').read_bytes()
+    with (tmp_path / 'drop' / 'drop.mcap').open('rb') as stream:
+        records = list(StreamReader(stream, skip_magic=False, emit_chunks=True).records)
+    chunks = [r for r in records if isinstance(r, Chunk)]
+    assert len(chunks) >= 20 and all(c.compression == '' for c in chunks)
+    assert [c.uncompressed_crc for c in chunks] == [zlib.crc32(c.data) for c in chunks]
+    assert all(c.uncompressed_crc != 0 for c in chunks)
+    [data_end] = [r for r in records if isinstance(r, DataEnd)]
+    [footer] = [r for r in records if isinstance(r, Footer)]
+    data_end_at = footer.summary_start - 13  # opcode, length, crc
+    assert data_end.data_section_crc == zlib.crc32(data[:data_end_at]) != 0
+    summary_crc_at = len(data) - 8 - 4  # the CRC precedes the closing magic
+    assert footer.summary_crc == zlib.crc32(data[footer.summary_start : summary_crc_at]) != 0
