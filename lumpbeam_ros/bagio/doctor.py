@@ -59,7 +59,7 @@ from mcap.records import (
 from mcap.stream_reader import get_chunk_data_stream
 
 from lumpbeam_ros.bagio import metadata
-from lumpbeam_ros.bagio.fastscan import MAGIC
+from lumpbeam_ros.bagio.reader import MAGIC
 from lumpbeam_ros.errors import BagError
 
 #: Profiles of the MCAP registry; ``''`` is a file without one.

@@ -56,6 +56,10 @@ _log = logging.getLogger(__name__)
 
 #: Bytes of pending messages that trigger a flush (a chunk of about 1 MiB, as rosbag2 writes).
 PENDING_LIMIT_BYTES = 1 << 20
+#: Log time a chunk spans at most, ns (but for messages that arrive later than this): a
+#: damaged chunk fails its CRC whole, so this bounds what one damaged spot costs a reader,
+#: whether the bag is recorded live (flushed every ``flush_period_s``) or written offline.
+CHUNK_SPAN_NS = 500_000_000
 
 
 @dataclass(frozen=True)
@@ -219,6 +223,12 @@ class BagWriter(ClosedOnExit):
             or time.monotonic() - self._last_flush >= self._flush_period
         ):
             self.flush()
+        elif log_time_ns - self._pending[0][0] >= 2 * CHUNK_SPAN_NS:
+            # An offline writer outpaces the flush period: a chunk per CHUNK_SPAN_NS of log
+            # time, keeping the newest span pending so that what comes late still sorts in.
+            self._guard(lambda: self._write_pending(before=log_time_ns - CHUNK_SPAN_NS))
+            self._guard(self._mcap.flush)
+            self._refresh_metadata()
 
     def write_message(self, topic: str, message: Any, log_time_ns: int) -> None:
         """Serializes and writes a rosbags message, declaring its topic on first use.
@@ -324,8 +334,7 @@ class BagWriter(ClosedOnExit):
             return
         self._guard(self._write_pending)
         self._guard(self._mcap.flush)
-        self._flushed_snapshot = self._metadata()
-        self._guard(lambda: metadata.write(self.path, self._flushed_snapshot))
+        self._refresh_metadata()
         self._last_flush = time.monotonic()
 
     def close(self) -> None:
@@ -348,17 +357,31 @@ class BagWriter(ClosedOnExit):
 
     # -- internals --------------------------------------------------------------------------
 
-    def _write_pending(self) -> None:
-        """Hands the pending messages to the MCAP writer in log-time order."""
-        pending, self._pending, self._pending_bytes = self._pending, [], 0
-        pending.sort(key=operator.itemgetter(0, 1))
+    def _write_pending(self, before: int | None = None) -> None:
+        """Hands the pending messages (logged before ``before`` ns) to the MCAP writer, sorted."""
+        self._pending.sort(key=operator.itemgetter(0, 1))
+        split = len(self._pending)
+        if before is not None:
+            split = next((i for i, m in enumerate(self._pending) if m[0] >= before), split)
+        pending, self._pending = self._pending[:split], self._pending[split:]
+        self._pending_bytes = sum(len(m[3]) for m in self._pending)
+        chunk_start = pending[0][0] if pending else 0
         for log_time, _, topic, data in pending:
+            if log_time - chunk_start >= CHUNK_SPAN_NS:
+                # Closes the chunk: none spans more than CHUNK_SPAN_NS of log time.
+                self._mcap.flush()  # type: ignore[no-untyped-call]
+                chunk_start = log_time
             self._mcap.add_message(topic.channel_id, log_time, bytes(data), log_time)
             self._counts[topic.name] += 1
             self._start_ns = min(self._start_ns, log_time)
             self._end_ns = max(self._end_ns, log_time)
         if pending:
             self._flushed_log_time = max(self._flushed_log_time, pending[-1][0])
+
+    def _refresh_metadata(self) -> None:
+        """Writes ``metadata.yaml`` for what the file holds now."""
+        self._flushed_snapshot = self._metadata()
+        self._guard(lambda: metadata.write(self.path, self._flushed_snapshot))
 
     def _metadata(self) -> dict[str, Any]:
         topics = [
