@@ -14,7 +14,7 @@ camera node's.
 
 A frame that does not decode is a lost frame (counted, and the first of each kind named in
 the summary); an image whose size is not the camera's stops the run with an error, and OUT,
-incomplete, is removed.
+incomplete, is removed; so is OUT when no frame gave a pose, or when the run is interrupted.
 """
 
 from __future__ import annotations
@@ -43,6 +43,7 @@ from lumpbeam_ros.interface import (
     TIP_POSE,
     TIP_POSE_TRUTH,
 )
+from lumpbeam_ros.vision.bag_frames import bag_frames
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import CameraConfig
 from lumpbeam_ros.vision.free_pose import rpy_quaternion
@@ -50,8 +51,6 @@ from lumpbeam_ros.vision.messages import (
     IMAGE_TYPES,
     camera_info_from_data,
     camera_info_to_data,
-    decode_camera_info,
-    decode_frame,
 )
 from lumpbeam_ros.vision.session import TrackingSession
 from lumpbeam_ros.vision.sources import FootageError, FootageFrame
@@ -284,11 +283,19 @@ class _Run:
         """Fills in the summary.
 
         Raises:
-            FootageError: Not one frame was read.
+            FootageError: Not one frame was read, or not one gave a pose (OUT would hold
+                no ``/tip_pose``).
         """
         stats, summary = self.session.stats, self.summary
         if stats.frames_in == 0:
             raise FootageError(f'{self.source}: no frames at all')
+        if stats.poses_out == 0:
+            lost = ', '.join(f'{k} {v}' for k, v in sorted(Counter(stats.lost).items()))
+            first = '; '.join(w for _, w in sorted(summary.first_problems.items()))
+            raise FootageError(
+                f'{self.source}: no pose in any of its {stats.frames_in} frames ({lost}); '
+                f'first: {first}'
+            )
         summary.frames, summary.poses = stats.frames_in, stats.poses_out
         summary.lost_by_reason = dict(Counter(stats.lost))
         summary.fps = stats.frames_in / self.tracking_s if self.tracking_s > 0 else float('nan')
@@ -304,10 +311,10 @@ class _Run:
 
 
 def _removing_on_error(out: Path, write: Callable[[], TrackSummary]) -> TrackSummary:
-    """Runs ``write``; when the input turns out unusable, removes the incomplete OUT."""
+    """Runs ``write``; removes the incomplete OUT when the input is unusable or on Ctrl-C."""
     try:
         return write()
-    except LumpbeamError:
+    except (LumpbeamError, KeyboardInterrupt):
         shutil.rmtree(out, ignore_errors=True)
         raise
 
@@ -383,27 +390,26 @@ def track_bag(
             name = str(reader.path)
             run = _Run(session, writer, name, camera_info_source, entry.count, progress)
             copied = _declare_copies(reader, writer, run.summary)
-            index = 0
-            for raw in reader.iter_raw():
+            items = bag_frames(
+                reader, session, image_topic, entry.msgtype, camera_info_topic,
+                follow_info=follow_info,
+            )  # fmt: skip
+            for item in items:
+                raw = item.raw
                 if raw.topic == POSE_TOPIC:
                     run.summary.replaced_poses += 1
                     continue
                 if raw.topic in copied:
                     writer.write_raw(raw.topic, raw.log_time_ns, raw.data)
-                if raw.topic == camera_info_topic and follow_info:
-                    try:
-                        session.set_camera_info(decode_camera_info(raw.data))
-                    except LumpbeamError:
-                        pass  # a bad calibration message: keep the one in use
-                elif raw.topic == image_topic:
-                    label = f'{reader.path} {image_topic} message {index}'
-                    index += 1
-                    try:
-                        frame = decode_frame(raw.data, entry.msgtype)
-                    except LumpbeamError as exc:
-                        run.reject(label, str(exc))
-                        continue
-                    run.track(label, frame.stamp_ns, frame.pixels, frame.encoding, raw.log_time_ns)
+                # A bad calibration message (item.problem) leaves the one in use.
+                if item.kind != 'image':
+                    continue
+                label = f'{reader.path} {image_topic} message {item.index}'
+                if item.frame is None:
+                    run.reject(label, item.problem)
+                    continue
+                frame = item.frame
+                run.track(label, frame.stamp_ns, frame.pixels, frame.encoding, raw.log_time_ns)
         return run.finish()
 
     summary = _removing_on_error(out, write)
