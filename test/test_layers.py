@@ -40,13 +40,16 @@ MATPLOTLIB = 'matplotlib'
 #: Everything else (models, identification, diagnosis, bags, parameters, markers) needs
 #: numpy and scipy only.
 REFUSED: dict[str, frozenset[str]] = {
+    'arm': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'bagio': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'campaign': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'compare': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'diagnose': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'ident': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'model': frozenset({ROS, OPENCV, MATPLOTLIB}),
+    'motion': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'params': frozenset({ROS, OPENCV, MATPLOTLIB}),
+    'shaping': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'viz': frozenset({ROS, OPENCV, MATPLOTLIB}),
     '': frozenset({ROS, OPENCV, MATPLOTLIB}),  # the top-level modules (errors, paramfile, ...)
     'synthetic': frozenset({ROS, OPENCV, MATPLOTLIB}),

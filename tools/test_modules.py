@@ -12,15 +12,18 @@ from pathlib import Path
 
 #: The ROS-free core: its packages, and the modules at the top of ``lumpbeam_ros``.
 CORE_PACKAGES = (
+    'arm',
     'bagio',
     'campaign',
     'compare',
     'diagnose',
     'ident',
     'model',
+    'motion',
     'params',
     'plots',
     'report',
+    'shaping',
     'synthetic',
     'vision',
     'viz',

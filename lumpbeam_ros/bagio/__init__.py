@@ -17,7 +17,6 @@ from lumpbeam_ros.bagio.reader import BagReader, RawMessage, open_bag
 from lumpbeam_ros.bagio.repair import RepairSummary, reindex, repair_bag
 from lumpbeam_ros.bagio.series import (
     ImageFrame,
-    LoadSeries,
     PointSeries,
     iter_images,
     read_camera_info,
@@ -27,7 +26,7 @@ from lumpbeam_ros.bagio.series import (
     read_points,
     read_tip_poses,
 )
-from lumpbeam_ros.bagio.tipseries import TipSeries
+from lumpbeam_ros.bagio.tipseries import LoadSeries, TipSeries
 from lumpbeam_ros.bagio.writer import BagWriter
 
 __all__ = [

@@ -15,7 +15,7 @@ import numpy as np
 
 from lumpbeam_ros.bagio import convert, fastscan
 from lumpbeam_ros.bagio.reader import BagReader, open_bag
-from lumpbeam_ros.bagio.tipseries import TipSeries
+from lumpbeam_ros.bagio.tipseries import LoadSeries, TipSeries
 from lumpbeam_ros.errors import BagError
 from lumpbeam_ros.interface import (
     BEAM_PARAMS,
@@ -29,20 +29,6 @@ from lumpbeam_ros.interface import (
 )
 
 Bag = str | Path | BagReader
-
-
-class LoadSeries(NamedTuple):
-    """``/tip_load`` samples: log time ``t`` (s) and the hanging mass ``kg``."""
-
-    t: np.ndarray
-    kg: np.ndarray
-
-    def changes(self) -> LoadSeries:
-        """Returns the first sample and every sample whose value differs from the previous."""
-        if self.t.size == 0:
-            return self
-        keep = np.concatenate([[True], self.kg[1:] != self.kg[:-1]])
-        return LoadSeries(self.t[keep], self.kg[keep])
 
 
 class PointSeries(NamedTuple):
@@ -179,7 +165,7 @@ def read_floats(bag: Bag, topic: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def read_load_events(bag: Bag, topic: str = TIP_LOAD) -> LoadSeries:
-    """Reads ``/tip_load`` (kg at the tip); ``.changes()`` keeps the drops and additions.
+    """Reads ``/tip_load`` (kg at the tip, by log time); ``.changes()`` keeps the changes.
 
     Raises:
         BagError: Missing topic, another type or corrupt messages.

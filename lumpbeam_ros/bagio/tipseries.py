@@ -129,41 +129,136 @@ class HoldsTipSeries:
         return self.poses.end_s
 
 
+#: A window with more than this fraction of its poses dropped (non-finite, repeated or out
+#: of order) is not trusted: its estimate is at best a WARN. Interleaved streams (two
+#: replays feeding one node) drop about half; a healthy camera drops none.
+MAX_DROPPED_FRACTION = 0.05
+
+
 @dataclass(frozen=True)
 class SampleCounts:
-    """What :func:`clean_tip_series` removed from the poses given.
+    """What became of the tip poses given: the one count of bad samples, offline and live.
+
+    :func:`clean_tip_series` fills it for a bag's poses (it sorts, so nothing is out of
+    order there); :class:`~lumpbeam_ros.bagio.tipbuffer.TipBuffer` for the poses a live node
+    received, which it cannot sort.
 
     Attributes:
         received: Samples given.
         non_finite: Samples dropped for a NaN or inf stamp, z or pitch.
         duplicates: Samples dropped because an earlier one had the same stamp.
         reordered: Whether the stamps had to be sorted.
+        out_of_order: Samples dropped for a stamp before the newest one (a live buffer).
+        resets: Times a live buffer was emptied because the clock jumped back.
+        loads_rejected: ``/tip_load`` readings rejected (non-finite, negative or stale).
     """
 
     received: int = 0
     non_finite: int = 0
     duplicates: int = 0
     reordered: bool = False
+    out_of_order: int = 0
+    resets: int = 0
+    loads_rejected: int = 0
+
+    @property
+    def dropped(self) -> int:
+        """Samples dropped, whatever the reason."""
+        return self.non_finite + self.duplicates + self.out_of_order
 
     @property
     def kept(self) -> int:
         """Samples left after validation."""
-        return self.received - self.non_finite - self.duplicates
+        return self.received - self.dropped
+
+    @property
+    def n_samples(self) -> int:
+        """Samples kept (the ``n_samples`` key of an identification)."""
+        return self.kept
+
+    @property
+    def n_rejected(self) -> int:
+        """Samples dropped (the ``n_rejected`` key of an identification)."""
+        return self.dropped
+
+    @property
+    def dropped_fraction(self) -> float:
+        """The share of the samples given that was dropped (0 for none given)."""
+        return self.dropped / self.received if self.received else 0.0
+
+    @property
+    def untrusted(self) -> bool:
+        """Whether more than :data:`MAX_DROPPED_FRACTION` of the samples was dropped."""
+        return self.dropped_fraction > MAX_DROPPED_FRACTION
+
+    def then(self, later: SampleCounts) -> SampleCounts:
+        """These counts followed by those of a validation of the samples these kept.
+
+        Args:
+            later: What a second validation (given ``self.kept`` samples) dropped.
+
+        Returns:
+            The drops of both, out of the samples first given.
+        """
+        return SampleCounts(
+            received=self.received,
+            non_finite=self.non_finite + later.non_finite,
+            duplicates=self.duplicates + later.duplicates,
+            reordered=self.reordered or later.reordered,
+            out_of_order=self.out_of_order + later.out_of_order,
+            resets=self.resets + later.resets,
+            loads_rejected=self.loads_rejected + later.loads_rejected,
+        )
 
     def note(self) -> str:
         """What validation did, in one line (``''`` when it changed nothing)."""
         parts = []
         if self.non_finite:
             parts.append(f'{self.non_finite} with a NaN or inf stamp, position or orientation')
-        if self.duplicates:
-            parts.append(f'{self.duplicates} with a repeated or out-of-order stamp')
+        repeated = self.duplicates + self.out_of_order
+        if repeated:
+            parts.append(f'{repeated} with a repeated or out-of-order stamp')
         notes = []
         if parts:
-            dropped = self.non_finite + self.duplicates
-            notes.append(f'dropped {dropped} of {self.received} poses ({"; ".join(parts)})')
+            notes.append(f'dropped {self.dropped} of {self.received} poses ({"; ".join(parts)})')
         if self.reordered:
             notes.append('stamps out of order: sorted')
         return '; '.join(notes)
+
+
+@dataclass(frozen=True)
+class LoadSeries:
+    """``/tip_load`` readings: the mass hanging at the tip from each stamp on.
+
+    A bag's topic (:func:`~lumpbeam_ros.bagio.series.read_load_events`, stamped by log
+    time), the readings of an identifier's window, a comparison's loads: one type.
+
+    Attributes:
+        t: Stamps, s, increasing.
+        kg: Mass at the tip from that stamp on, kg.
+    """
+
+    t: np.ndarray = field(default_factory=lambda: np.empty(0))
+    kg: np.ndarray = field(default_factory=lambda: np.empty(0))
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    def changes(self) -> LoadSeries:
+        """The first reading and every reading whose value differs from the one before."""
+        if self.t.size == 0:
+            return self
+        keep = np.concatenate([[True], self.kg[1:] != self.kg[:-1]])
+        return LoadSeries(self.t[keep], self.kg[keep])
+
+    def between(self, start: float, end: float) -> LoadSeries:
+        """The readings from ``start`` to ``end``, with the last one before ``start``.
+
+        That first reading gives the load at ``start``.
+        """
+        first = max(int(np.searchsorted(self.t, start, side='right')) - 1, 0)
+        last = int(np.searchsorted(self.t, end, side='right'))
+        return LoadSeries(self.t[first:last], self.kg[first:last])
 
 
 def clean_tip_series(

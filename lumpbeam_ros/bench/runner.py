@@ -20,6 +20,7 @@ SUITES = (
     'campaign',
     'cli',
     'live_graph',
+    'shaping',
 )
 
 

@@ -8,15 +8,15 @@ from pathlib import Path
 import numpy as np
 
 from lumpbeam_ros.bagio import BagReader, open_bag, read_load_events, read_points, read_tip_poses
+from lumpbeam_ros.bagio.tipseries import LoadSeries
 from lumpbeam_ros.compare.streams import Track, clean_track
 from lumpbeam_ros.errors import BagError, LumpbeamError
-from lumpbeam_ros.ident.samples import LoadReadings, clean_loads
+from lumpbeam_ros.ident.samples import clean_loads
 from lumpbeam_ros.interface import BASE_FRAME, TIP_LOAD, TIP_POSE, TRACKER_POINT
 
 CAMERA_TOPIC = TIP_POSE
 REFERENCE_TOPIC = TRACKER_POINT
 LOAD_TOPIC = TIP_LOAD
-CAMERA_FRAME = BASE_FRAME
 
 
 @dataclass(frozen=True)
@@ -31,7 +31,7 @@ class ComparisonInput:
 
     camera: Track
     reference: Track
-    loads: LoadReadings | None
+    loads: LoadSeries | None
 
 
 def read_comparison_input(
@@ -67,12 +67,14 @@ def read_comparison_input(
             f'{reference_topic} recorded together'
         )
     poses = read_tip_poses(reader, camera_topic)
-    if poses.t.size and poses.frame_id != CAMERA_FRAME:
+    # The camera's tip poses are in the beam's base frame (not interface.CAMERA_FRAME, the
+    # frame of its images): the tracker has already placed them on the beam.
+    if poses.t.size and poses.frame_id != BASE_FRAME:
         raise BagError(
-            f'{reader.path}: {camera_topic} is in frame {poses.frame_id!r}, not {CAMERA_FRAME!r}'
+            f'{reader.path}: {camera_topic} is in frame {poses.frame_id!r}, not {BASE_FRAME!r}'
         )
     camera_points = np.column_stack([poses.x, np.zeros_like(poses.x), poses.z])
-    camera = _track(reader, poses.t, camera_points, CAMERA_FRAME, camera_topic, pitch=poses.pitch)
+    camera = _track(reader, poses.t, camera_points, BASE_FRAME, camera_topic, pitch=poses.pitch)
     points = read_points(reader, reference_topic)
     reference = _track(
         reader,

@@ -12,11 +12,12 @@ from typing import Any
 
 import numpy as np
 
+from lumpbeam_ros.bagio.tipseries import LoadSeries
 from lumpbeam_ros.compare.align import AlignedStreams, AlignOptions, align_streams
 from lumpbeam_ros.compare.streams import Track
 from lumpbeam_ros.ident.identification import Identification
 from lumpbeam_ros.ident.identify import identify
-from lumpbeam_ros.ident.samples import LoadReadings, clean_window
+from lumpbeam_ros.ident.samples import clean_window
 from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.interface import BASE_FRAME
 from lumpbeam_ros.model.parameters import BeamParameters
@@ -104,7 +105,7 @@ def compare_sensors(
     camera: Track,
     reference: Track,
     beam: BeamParameters,
-    loads: LoadReadings | None = None,
+    loads: LoadSeries | None = None,
     options: AlignOptions | None = None,
     config: IdentifierConfig | None = None,
 ) -> Comparison:

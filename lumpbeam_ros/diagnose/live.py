@@ -16,14 +16,14 @@ into the status level, message and key-value pairs of ``doc/interfaces.md``
 from __future__ import annotations
 
 import math
-from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
 
-from lumpbeam_ros.bagio.tipseries import TipSeries
+from lumpbeam_ros.bagio.tipbuffer import TipBuffer
+from lumpbeam_ros.bagio.tipseries import SampleCounts
 from lumpbeam_ros.diagnose.record import MIN_SAMPLES_AFTER_EVENT, Record, record_from_series
 from lumpbeam_ros.diagnose.workflow import diagnose
 from lumpbeam_ros.errors import LumpbeamError
@@ -50,7 +50,10 @@ class LiveSettings:
         min_amplitude_m: ... or earlier, once the peak-to-peak tip z over the last
             ``AMPLITUDE_SPAN_S`` falls below twice this (0: never).
         window_s: Length of a fixed window, s.
-        keep_s: The buffers hold this much of the latest data, s.
+        keep_s: The buffers hold this much of the latest data, s; a stamp this far before
+            the newest one is the clock going back (a looping bag): everything starts over.
+        max_rate_hz: Highest pose rate the buffers are sized for; faster input shortens
+            what they hold.
     """
 
     trigger: Trigger = 'ring_down'
@@ -59,6 +62,7 @@ class LiveSettings:
     min_amplitude_m: float = 0.0
     window_s: float = 10.0
     keep_s: float = 60.0
+    max_rate_hz: float = 400.0
 
 
 @dataclass(frozen=True)
@@ -88,6 +92,7 @@ class LiveDiagnosis:
         reason: The workflow's reason for its verdict.
         stretch: What was diagnosed.
         seconds: Wall time of the diagnosis, s.
+        samples: The stretch's poses kept and dropped.
     """
 
     missing_effect: str
@@ -97,6 +102,7 @@ class LiveDiagnosis:
     reason: str
     stretch: Stretch
     seconds: float = 0.0
+    samples: SampleCounts = field(default_factory=SampleCounts)
 
     @property
     def effect_parameters(self) -> dict[str, float]:
@@ -169,6 +175,7 @@ def diagnose_live(record: Record, beam: BeamParameters, stretch: Stretch) -> Liv
         reason=result.decision.reason,
         stretch=stretch,
         seconds=time.perf_counter() - start,
+        samples=record.counts,
     )
 
 
@@ -176,7 +183,9 @@ def status_values(result: LiveDiagnosis) -> tuple[int, str, list[tuple[str, str]
     """The ``lumpbeam/diagnosis`` status of a diagnosis (``doc/interfaces.md``).
 
     OK when the nominal model explains the data, WARN when effects are named, ERROR for
-    ``unexplained``. Numbers are written as Python ``repr`` of floats, as on ``/beam_params``.
+    ``unexplained``; never OK for a stretch with many of its poses dropped
+    (:attr:`~lumpbeam_ros.bagio.tipseries.SampleCounts.untrusted`): WARN, saying so.
+    Numbers are written as Python ``repr`` of floats, as on ``/beam_params``.
 
     Args:
         result: The diagnosis.
@@ -192,6 +201,9 @@ def status_values(result: LiveDiagnosis) -> tuple[int, str, list[tuple[str, str]
         level, message = WARN, f'missing {", ".join(names)} ({shown})'
     else:
         level, message = OK, 'the model explains the data'
+    if result.samples.untrusted:
+        level = max(level, WARN)
+        message = f'{message}; /tip_pose: {result.samples.note()} in the stretch'
     pairs = [
         ('missing_effect', result.missing_effect),
         ('missing_effects', ','.join(names) or result.missing_effect),
@@ -206,31 +218,6 @@ def status_values(result: LiveDiagnosis) -> tuple[int, str, list[tuple[str, str]
     return level, message, pairs
 
 
-@dataclass
-class _Series:
-    t: deque[float] = field(default_factory=deque)
-    z: deque[float] = field(default_factory=deque)
-    pitch: deque[float] = field(default_factory=deque)
-
-    def push(self, t: float, z: float, pitch: float) -> None:
-        self.t.append(t)
-        self.z.append(z)
-        self.pitch.append(pitch)
-
-    def trim(self, before: float) -> None:
-        while self.t and self.t[0] < before:
-            self.t.popleft()
-            self.z.popleft()
-            self.pitch.popleft()
-
-    def between(self, start: float, end: float) -> TipSeries:
-        """The buffered poses with ``start <= t <= end``."""
-        t = np.fromiter(self.t, float, len(self.t))
-        z = np.fromiter(self.z, float, len(self.z))
-        pitch = np.fromiter(self.pitch, float, len(self.pitch))
-        return TipSeries.vertical(t, z, pitch).select((t >= start) & (t <= end))
-
-
 class LiveBuffer:
     """The latest measured and predicted tip poses and load changes, and complete stretches.
 
@@ -240,38 +227,46 @@ class LiveBuffer:
 
     def __init__(self, settings: LiveSettings):
         self.settings = settings
-        self.measured = _Series()
-        self.predicted = _Series()
+        self.measured = self._buffer()
+        self.predicted = self._buffer()
         self.loads: list[tuple[float, float]] = []  # (time, kg) in arrival order
         self.predicted_count = 0
         self.measured_count = 0
         self._done_until = -math.inf  # stretches ending here or before were handed out
 
+    def _buffer(self) -> TipBuffer:
+        """A buffer of ``keep_s``; a stamp that far back is the clock going back."""
+        s = self.settings
+        return TipBuffer(s.keep_s, s.max_rate_hz, s.keep_s)
+
     @property
     def latest_s(self) -> float:
         """The newest measured stamp (NaN before the first)."""
-        return self.measured.t[-1] if self.measured.t else math.nan
+        return self.measured.newest_s if len(self.measured) else math.nan
 
-    def push_measured(self, t: float, z: float, pitch: float) -> None:
-        """Adds a measured pose (finite values, as the node checked them)."""
-        if self.measured.t and t < self.measured.t[-1] - self.settings.keep_s:
-            self.clear()  # the clock jumped back far (a looping bag): start over
-        if self.measured.t and t <= self.measured.t[-1]:
-            return  # a repeated or out-of-order stamp
-        self.measured.push(t, z, pitch)
-        self.measured_count += 1
-        self.measured.trim(t - self.settings.keep_s)
+    def push_measured(self, t: float, z: float, pitch: float) -> bool:
+        """Adds a measured pose, or counts why not (:class:`~.tipbuffer.TipBuffer`).
 
-    def push_predicted(self, t: float, z: float, pitch: float) -> None:
-        """Adds a predicted pose of the simulator."""
-        if self.predicted.t and t <= self.predicted.t[-1]:
-            if t < self.predicted.t[-1] - self.settings.keep_s:
-                self.predicted = _Series()
-            else:
-                return
-        self.predicted.push(t, z, pitch)
-        self.predicted_count += 1
-        self.predicted.trim(t - self.settings.keep_s)
+        A clock that jumped back by ``keep_s`` or more (a looping bag) starts everything
+        over: the prediction and the loads belong to the old time line.
+
+        Returns:
+            Whether the pose was stored.
+        """
+        resets = self.measured.counts.resets
+        stored = self.measured.push(t, z, pitch)
+        if self.measured.counts.resets != resets:
+            self.predicted = self._buffer()
+            self.loads.clear()
+            self._done_until = -math.inf
+        self.measured_count += stored
+        return stored
+
+    def push_predicted(self, t: float, z: float, pitch: float) -> bool:
+        """Adds a predicted pose of the simulator (the same rule as the measured ones)."""
+        stored = self.predicted.push(t, z, pitch)
+        self.predicted_count += stored
+        return stored
 
     def push_load(self, t: float, kg: float) -> None:
         """Adds a ``/tip_load`` reading at its arrival time (Float64 has no stamp)."""
@@ -281,8 +276,9 @@ class LiveBuffer:
             self.loads.append((t, kg))
 
     def clear(self) -> None:
-        """Forgets everything (the clock went back)."""
-        self.measured, self.predicted = _Series(), _Series()
+        """Forgets everything (the clock went back); the counts are kept."""
+        self.measured.clear()
+        self.predicted = self._buffer()
         self.loads.clear()
         self._done_until = -math.inf
 
@@ -310,7 +306,8 @@ class LiveBuffer:
             return None
         s = self.settings
         if s.trigger == 'window':
-            start = self.measured.t[0] if self._done_until == -math.inf else self._done_until
+            oldest = self.measured.latest()[0].start_s
+            start = oldest if self._done_until == -math.inf else self._done_until
             if latest - start < s.window_s:
                 return None
             end = start + s.window_s
@@ -331,9 +328,9 @@ class LiveBuffer:
         s = self.settings
         if latest >= release + s.decay_s:
             return release + s.decay_s
-        recent = self.measured.between(latest - AMPLITUDE_SPAN_S, latest)
+        recent = self.measured.between(latest - AMPLITUDE_SPAN_S, latest)[0]
         t, z = recent.t, recent.z
-        after = self.measured.between(release, latest).t > release
+        after = self.measured.between(release, latest)[0].t > release
         enough = np.count_nonzero(after) >= MIN_SAMPLES_AFTER_EVENT  # what a record needs
         if s.min_amplitude_m > 0.0 and enough and t.size > 2:
             if float(np.ptp(z)) < 2.0 * s.min_amplitude_m:
@@ -357,7 +354,7 @@ class LiveBuffer:
         Raises:
             LumpbeamError: No load change inside the stretch, too few poses after it.
         """
-        poses = self.measured.between(stretch.start_s, stretch.end_s)
+        poses, counts = self.measured.between(stretch.start_s, stretch.end_s)
         initial = self.loads[0][1]
         events = []
         for time, kg in self.loads[1:]:
@@ -370,7 +367,7 @@ class LiveBuffer:
                 f'no load change between {stretch.start_s:.3f} and {stretch.end_s:.3f} s: '
                 'a diagnosis needs a release to compare against'
             )
-        return record_from_series(poses, initial, events, TIP_POSE)
+        return record_from_series(poses, initial, events, TIP_POSE, dropped=counts)
 
     def prediction_gap(self, start_s: float, end_s: float) -> float:
         """RMS of measured minus predicted tip z over a stretch (the running model's gap).
@@ -382,8 +379,8 @@ class LiveBuffer:
         Returns:
             The RMS in m, NaN when the prediction does not cover the measured stamps.
         """
-        measured = self.measured.between(start_s, end_s)
-        predicted = self.predicted.between(start_s - 1.0, end_s + 1.0)
+        measured = self.measured.between(start_s, end_s)[0]
+        predicted = self.predicted.between(start_s - 1.0, end_s + 1.0)[0]
         t, z, tp, zp = measured.t, measured.z, predicted.t, predicted.z
         covered = (t >= tp[0]) & (t <= tp[-1]) if tp.size > 1 else np.zeros(t.size, bool)
         if np.count_nonzero(covered) < 0.9 * max(t.size, 1) or t.size == 0:

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from lumpbeam_ros.bagio import TipSeries, read_load_events, read_tip_poses
-from lumpbeam_ros.bagio.tipseries import HoldsTipSeries, clean_tip_series
+from lumpbeam_ros.bagio.tipseries import HoldsTipSeries, SampleCounts, clean_tip_series
 from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.interface import BASE_FRAME
 from lumpbeam_ros.model.trajectory import TipTrajectory
@@ -37,13 +37,16 @@ class Record(HoldsTipSeries):
         poses: The tip series, stamps increasing.
         initial_load_kg: The load hanging at the start; the beam is at rest with it.
         load_events: ``(time, kg)`` load changes after the start, in time order.
-        notes: What was trimmed from the poses given (stamp jumps), for the user.
+        notes: What was dropped or trimmed from the poses given (bad or repeated samples,
+            stamp jumps), one line each, for the user.
+        counts: The poses given, kept and dropped (before the stamp jumps' trim).
     """
 
     poses: TipSeries
     initial_load_kg: float
     load_events: tuple[tuple[float, float], ...]
     notes: tuple[str, ...] = ()
+    counts: SampleCounts = field(default_factory=SampleCounts)
 
     @property
     def event_time_s(self) -> float:
@@ -130,14 +133,17 @@ def record_from_series(
     initial_load_kg: float,
     load_events: list[tuple[float, float]] | tuple[tuple[float, float], ...],
     source: str = 'record',
+    *,
+    dropped: SampleCounts | None = None,
 ) -> Record:
-    """Checks and assembles a record; non-finite poses are dropped.
+    """Checks and assembles a record; non-finite and repeated poses are dropped and counted.
 
     Args:
         poses: The tip series (``x`` is carried along, not checked).
         initial_load_kg: Load at the start, kg.
         load_events: ``(time, kg)`` load changes; at least one must fall inside the poses.
         source: Name for error messages (a bag path).
+        dropped: What was dropped before ``poses`` (a live buffer's counts of them).
 
     Returns:
         The record, sorted by time, with events before the first pose folded into the
@@ -145,13 +151,17 @@ def record_from_series(
 
     Raises:
         LumpbeamError: A negative or non-finite load, no load change inside the record, or
-            fewer than ``MIN_SAMPLES_AFTER_EVENT`` poses after it.
+            fewer than ``MIN_SAMPLES_AFTER_EVENT`` poses after it; the message says what
+            was dropped.
     """
-    poses, _ = clean_tip_series(poses)
-    poses, note = _stretch_with_event(poses, load_events)
+    poses, cleaned = clean_tip_series(poses)
+    counts = cleaned if dropped is None else dropped.then(cleaned)
+    poses, split = _stretch_with_event(poses, load_events)
+    notes = tuple(note for note in (counts.note(), split) if note)
+    why = f' ({"; ".join(notes)})' if notes else ''
     t = poses.t
     if t.size < MIN_SAMPLES_AFTER_EVENT:
-        raise LumpbeamError(f'{source}: {t.size} valid tip poses, need a longer record')
+        raise LumpbeamError(f'{source}: {t.size} valid tip poses, need a longer record{why}')
     load = float(initial_load_kg)
     events: list[tuple[float, float]] = []
     for time, kg in sorted((float(a), float(b)) for a, b in load_events):
@@ -172,9 +182,9 @@ def record_from_series(
     if after < MIN_SAMPLES_AFTER_EVENT:
         raise LumpbeamError(
             f'{source}: {after} poses after the last load change at {events[-1][0]:.3f} s, '
-            f'need at least {MIN_SAMPLES_AFTER_EVENT}'
+            f'need at least {MIN_SAMPLES_AFTER_EVENT}{why}'
         )
-    return Record(poses, load, tuple(events), (note,) if note else ())
+    return Record(poses, load, tuple(events), notes, counts)
 
 
 def _stretch_with_event(

@@ -343,30 +343,10 @@ def select(
     Returns:
         The selection.
     """
-    nominal_model = Model()
-    base_fit = Fit(
-        nominal_model,
-        nominal.x,
-        nominal.beam,
-        nominal.chi2,
-        nominal.n_residuals,
-        nominal.evaluations,
-        nominal.physical,
+    base, fitted = _first_round(selector, nominal, candidates, start_strength)
+    combinations = (
+        _every_combination(selector, nominal, candidates, max_effects) if exhaustive else None
     )
-    base = selector.evaluate(base_fit)
-    singles = [
-        selector.fit(Model((c,)), c.start_x(nominal.x, start_strength(c))) for c in candidates
-    ]
-    combinations: dict[frozenset[str], Evaluated] = {}
-    if exhaustive:
-        for size in range(2, max_effects + 1):
-            for group in itertools.combinations(candidates, size):
-                x0 = np.r_[nominal.x, [c.start / c.scale for c in group]]
-                combinations[frozenset(c.name for c in group)] = selector.fit(Model(group), x0)
-    best_train = min([base, *singles], key=lambda e: e.fit.chi2)
-    selector.phi = inflation(best_train.residuals[selector._both(selector.train)])
-    base = selector.rescore(base)
-    fitted = [selector.rescore(e) for e in singles]
     nominal_evaluated = base
     singles_scores = [e.score for e in fitted]
     rounds: list[Round] = []
@@ -387,49 +367,105 @@ def select(
         if len(base.model.effects) >= max_effects:
             break
         remaining = [c for c in candidates if c.name not in base.model.names]
-        if exhaustive:
+        if combinations is not None:
             names = set(base.model.names)
             fitted = [
                 selector.rescore(combinations[frozenset(names | {c.name})]) for c in remaining
             ]
             screened = {}
             continue
-        predictions = selector.screen(base, remaining)
-        k = base.model.n_parameters + 1
-        ranked = sorted(predictions, key=lambda name: predictions[name][0])
-        promising = [
-            name
-            for name in ranked[:FULL_FITS]
-            if base.score.bic - selector.predicted_bic(predictions[name][0], k) >= SCREEN_BIC
-        ]
-        screened = {
-            name: selector.predicted_bic(predictions[name][0], k)
-            for name in ranked
-            if name not in promising
-        }
-        fitted = []
-        for name in promising:
-            c = next(c for c in remaining if c.name == name)
-            # The linear step's strength, kept inside the plausible range: a far step is a
-            # poor start, and an extreme one may not even simulate.
-            limit = c.plausible_max / c.scale
-            strength = float(np.clip(predictions[name][1], -limit, limit)) or c.start / c.scale
-            fitted.append(selector.fit(base.model.plus(c), np.r_[base.fit.x, strength]))
-        if not fitted:
-            stop = RoundDecision(
-                False, ranked[0] if ranked else '', 'no further effect is predicted to matter'
-            )
-            rounds.append(
-                Round(
-                    base,
-                    [],
-                    screened,
-                    stop,
-                    posterior(base.score.bic, [base.score.bic, *screened.values()]),
-                )
-            )
+        fitted, screened, stop = _screened_round(selector, base, remaining)
+        if stop is not None:
+            rounds.append(stop)
             break
     confidence = math.prod(r.posterior for r in rounds)
     return Selection(
         base, rounds, singles_scores, nominal_evaluated, unphysical, confidence, path=path
     )
+
+
+def _first_round(
+    selector: Selector,
+    nominal: Fit,
+    candidates: Sequence[Candidate],
+    start_strength: Callable[[Candidate], float | None],
+) -> tuple[Evaluated, list[Evaluated]]:
+    """Round 1: the nominal model and every single effect, fitted and scored.
+
+    The residuals' inflation ``phi`` (correlated noise) is estimated on the best training
+    fit of them, and every score is given with it.
+
+    Returns:
+        The nominal model and the single effects, evaluated with that ``phi``.
+    """
+    base_fit = Fit(
+        Model(),
+        nominal.x,
+        nominal.beam,
+        nominal.chi2,
+        nominal.n_residuals,
+        nominal.evaluations,
+        nominal.physical,
+    )
+    base = selector.evaluate(base_fit)
+    singles = [
+        selector.fit(Model((c,)), c.start_x(nominal.x, start_strength(c))) for c in candidates
+    ]
+    best_train = min([base, *singles], key=lambda e: e.fit.chi2)
+    selector.phi = inflation(best_train.residuals[selector._both(selector.train)])
+    return selector.rescore(base), [selector.rescore(e) for e in singles]
+
+
+def _every_combination(
+    selector: Selector, nominal: Fit, candidates: Sequence[Candidate], max_effects: int
+) -> dict[frozenset[str], Evaluated]:
+    """The exhaustive baseline: every group of 2 to ``max_effects`` effects, fitted.
+
+    Each starts from the nominal fit; its score holds the ``phi`` of the moment, so a round
+    rescores it.
+    """
+    combinations: dict[frozenset[str], Evaluated] = {}
+    for size in range(2, max_effects + 1):
+        for group in itertools.combinations(candidates, size):
+            x0 = np.r_[nominal.x, [c.start / c.scale for c in group]]
+            combinations[frozenset(c.name for c in group)] = selector.fit(Model(group), x0)
+    return combinations
+
+
+def _screened_round(
+    selector: Selector, base: Evaluated, remaining: Sequence[Candidate]
+) -> tuple[list[Evaluated], dict[str, float], Round | None]:
+    """A round after the first: screen every remaining effect, fit the promising ones.
+
+    Returns:
+        The candidates fitted in full, the predicted BIC of the others, and the closing
+        round when none is predicted to matter (``None`` otherwise).
+    """
+    predictions = selector.screen(base, remaining)
+    k = base.model.n_parameters + 1
+    ranked = sorted(predictions, key=lambda name: predictions[name][0])
+    promising = [
+        name
+        for name in ranked[:FULL_FITS]
+        if base.score.bic - selector.predicted_bic(predictions[name][0], k) >= SCREEN_BIC
+    ]
+    screened = {
+        name: selector.predicted_bic(predictions[name][0], k)
+        for name in ranked
+        if name not in promising
+    }
+    fitted = []
+    for name in promising:
+        c = next(c for c in remaining if c.name == name)
+        # The linear step's strength, kept inside the plausible range: a far step is a
+        # poor start, and an extreme one may not even simulate.
+        limit = c.plausible_max / c.scale
+        strength = float(np.clip(predictions[name][1], -limit, limit)) or c.start / c.scale
+        fitted.append(selector.fit(base.model.plus(c), np.r_[base.fit.x, strength]))
+    if fitted:
+        return fitted, screened, None
+    stop = RoundDecision(
+        False, ranked[0] if ranked else '', 'no further effect is predicted to matter'
+    )
+    chance = posterior(base.score.bic, [base.score.bic, *screened.values()])
+    return fitted, screened, Round(base, [], screened, stop, chance)

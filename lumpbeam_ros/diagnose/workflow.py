@@ -155,6 +155,8 @@ class Diagnosis:
             ],
             'missing_effects': [e.as_dict() for e in self.missing_effects],
             'confidence': self.confidence,
+            'n_samples': len(self.record),
+            'n_rejected': self.record.counts.n_rejected,
             'details': {
                 'reason': self.decision.reason,
                 'rounds': [dict(r) for r in self.rounds],

@@ -13,10 +13,11 @@ from pathlib import Path
 from typing import Any
 
 from lumpbeam_ros.bagio import BagReader, read_load_events, read_tip_poses
+from lumpbeam_ros.bagio.tipseries import LoadSeries
 from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.ident.identification import Identification
 from lumpbeam_ros.ident.identify import FitState, identify_from
-from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow, clean_loads, clean_window
+from lumpbeam_ros.ident.samples import PoseWindow, clean_loads, clean_window
 from lumpbeam_ros.ident.segments import keep_release_segment
 from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.interface import BASE_FRAME, TIP_LOAD, TIP_POSE
@@ -80,7 +81,7 @@ def read_window(bag: str | Path, show_progress: bool = True) -> PoseWindow:
         raise BagError(
             f'{bag}: {POSE_TOPIC} is in frame {poses.frame_id!r}, expected {BASE_FRAME!r}'
         )
-    loads = LoadReadings()
+    loads = LoadSeries()
     if LOAD_TOPIC in reader.topics:
         series = read_load_events(reader, LOAD_TOPIC)
         loads = clean_loads(series.t, series.kg)

@@ -12,6 +12,8 @@ from dataclasses import dataclass, field, fields, is_dataclass
 from enum import IntEnum
 from typing import Any
 
+from lumpbeam_ros.bagio.tipseries import SampleCounts
+
 NAN = float('nan')
 
 
@@ -156,25 +158,15 @@ class FitQuality:
     solver_evaluations: int = 0
 
 
-@dataclass(frozen=True)
-class SampleTally:
-    """The window's samples.
-
-    Attributes:
-        n_samples: Valid samples in the window.
-        n_rejected: Samples dropped as non-finite or duplicate.
-    """
-
-    n_samples: int = 0
-    n_rejected: int = 0
-
-
 def _flat(group: Any) -> Iterator[tuple[str, Any]]:
     """A group's ``(key, value)`` pairs in field order; an estimate gives two."""
     for f in fields(group):
         value = getattr(group, f.name)
         key = f.metadata.get('key', f.name)
-        if isinstance(value, Estimate):
+        if isinstance(value, SampleCounts):
+            yield 'n_samples', value.n_samples
+            yield 'n_rejected', value.n_rejected
+        elif isinstance(value, Estimate):
             yield key, value.value
             yield f'{key}_std', value.std
         elif is_dataclass(value):
@@ -202,7 +194,8 @@ class Identification:
         release: The release and the static levels.
         cross_checks: The figures by other estimators.
         quality: The fit's quality.
-        samples: The window's samples.
+        samples: The window's samples: its poses kept and those dropped (published as
+            ``n_samples`` and ``n_rejected``).
     """
 
     status: Status
@@ -213,7 +206,7 @@ class Identification:
     release: ReleaseFigures = ReleaseFigures()
     cross_checks: CrossCheckFigures = CrossCheckFigures()
     quality: FitQuality = FitQuality()
-    samples: SampleTally = SampleTally()
+    samples: SampleCounts = SampleCounts()
 
     @property
     def ok(self) -> bool:

@@ -14,6 +14,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from lumpbeam_ros.bagio.tipseries import MAX_DROPPED_FRACTION, SampleCounts
 from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident import stiffness
@@ -26,7 +27,6 @@ from lumpbeam_ros.ident.identification import (
     FitQuality,
     Identification,
     ReleaseFigures,
-    SampleTally,
     Status,
 )
 from lumpbeam_ros.ident.logdec import LogDecrement, LogDecrementResult, difference_noise_std
@@ -146,7 +146,8 @@ def _identify(
     previous: FitState | None,
 ) -> tuple[Identification, FitState | None]:
     span = AnalysedWindow(window.start_s, window.end_s)
-    tally = SampleTally(len(window), window.counts.non_finite + window.counts.duplicates)
+    dropped = window.counts.dropped
+    tally = replace(window.counts, received=len(window) + dropped)
 
     def fail(
         message: str, unusable: bool = False, release: ReleaseFigures | None = None
@@ -351,6 +352,29 @@ def _damping_total(params: DampedSinusoidParams, mode: ModeEstimate) -> tuple[fl
     return value, float(math.sqrt(max(grad @ cov @ grad, 0.0)))
 
 
+@dataclass(frozen=True)
+class _Figures:
+    """What the physics derives from a fitted decay and the release (B.12, B.22).
+
+    Attributes:
+        cycles: Cycles of the first mode fitted.
+        damping_total: c_tE and its std (B.22).
+        load_kg: The released mass.
+        level_after: Static tip level after the release (the fit's offset) and its std.
+        deflection: Rise of the static level at the release and its std.
+        static: k_tE (B.12) and the vertical stiffness from that rise.
+        stiffness_from_frequency: ``m_eff (2 pi f_n)^2`` and its std (a cross-check).
+    """
+
+    cycles: float
+    damping_total: tuple[float, float]
+    load_kg: float
+    level_after: tuple[float, float]
+    deflection: tuple[float, float]
+    static: stiffness.StaticStiffness
+    stiffness_from_frequency: tuple[float, float]
+
+
 def _assemble(
     beam: BeamParameters,
     config: IdentifierConfig,
@@ -359,17 +383,37 @@ def _assemble(
     state: FitState,
     mode: ModeEstimate,
     span: AnalysedWindow,
-    tally: SampleTally,
+    tally: SampleCounts,
 ) -> Identification:
-    params, checks = state.params, state.checks
-    warnings: list[str] = []
-    cycles = float((t[-1] - t[0]) * mode.damped_frequency_hz)
-    damping_total, damping_total_std = _damping_total(params, mode)
+    """The identification of a fitted window: its figures, graded, in the result's form."""
+    figures = _derive(beam, config, release, t, state.params, mode)
+    warnings = _grade(config, release, mode, figures, state.checks, tally)
+    if warnings:
+        status, message = Status.WARN, '; '.join(warnings)
+    else:
+        status = Status.OK
+        message = (
+            f'f_n {mode.natural_frequency_hz:.4f} Hz, zeta {mode.damping_ratio:.4g}, '
+            f'k_tE {figures.static.total_nm_per_rad:.1f} N m/rad over {figures.cycles:.1f} '
+            'cycles'
+        )
+    return _report(status, message, release, state, mode, figures, span, tally)
+
+
+def _derive(
+    beam: BeamParameters,
+    config: IdentifierConfig,
+    release: Release,
+    t: np.ndarray,
+    params: DampedSinusoidParams,
+    mode: ModeEstimate,
+) -> _Figures:
+    """The physics: damping (B.22) and stiffness (B.12, and from the frequency)."""
     load = _load(release, config)
     tip_mass = beam.tip_mass_kg + (
         release.load_after_kg if math.isfinite(release.load_after_kg) else 0.0
     )
-    k_freq, k_freq_std = stiffness.from_frequency(
+    k_freq = stiffness.from_frequency(
         mode.natural_frequency_hz,
         mode.natural_frequency_hz_std,
         tip_mass,
@@ -382,10 +426,28 @@ def _assemble(
     static = stiffness.from_static_change(
         deflection, deflection_std, load, beam.length_m, beam.gravity_mps2
     )
-    k_pitch, k_pitch_std = checks.pitch_stiffness
-    logdec = checks.logdec
-    pencil = checks.pencil
+    return _Figures(
+        cycles=float((t[-1] - t[0]) * mode.damped_frequency_hz),
+        damping_total=_damping_total(params, mode),
+        load_kg=load,
+        level_after=(level_after, level_after_std),
+        deflection=(deflection, deflection_std),
+        static=static,
+        stiffness_from_frequency=k_freq,
+    )
 
+
+def _grade(
+    config: IdentifierConfig,
+    release: Release,
+    mode: ModeEstimate,
+    figures: _Figures,
+    checks: CrossChecks,
+    tally: SampleCounts,
+) -> list[str]:
+    """The policy: why the estimate is of low confidence (empty: it is OK)."""
+    warnings: list[str] = []
+    deflection = figures.deflection[0]
     if not release.found:
         warnings.append(f'{release.message}; stiffness needs a release in the window')
     elif release.confidence < config.min_release_confidence:
@@ -394,30 +456,24 @@ def _assemble(
         warnings.append(release.message)
     if release.found and math.isfinite(release.level_before_m) and not deflection > 0.0:
         warnings.append(f'the static tip level did not rise at the release ({deflection:.3g} m)')
-    if cycles < config.min_cycles:
-        warnings.append(f'only {cycles:.1f} cycles fitted')
-    _check_rel(
-        warnings,
-        'frequency',
-        mode.natural_frequency_hz,
-        mode.natural_frequency_hz_std,
-        config.warn_rel_std_frequency,
-    )
-    _check_rel(
-        warnings,
-        'damping ratio',
-        mode.damping_ratio,
-        mode.damping_ratio_std,
-        config.warn_rel_std_damping,
-    )
-    _check_rel(
-        warnings,
-        'stiffness',
-        static.total_nm_per_rad,
-        static.total_nm_per_rad_std,
-        config.warn_rel_std_stiffness,
-    )
-    pencil_zeta = pencil[1]
+    if figures.cycles < config.min_cycles:
+        warnings.append(f'only {figures.cycles:.1f} cycles fitted')
+    if tally.untrusted:
+        warnings.append(
+            f'{tally.note()} in the window, more than {MAX_DROPPED_FRACTION:.0%}: '
+            'the poses may mix two streams'
+        )
+    relative = (
+        ('frequency', mode.natural_frequency_hz, mode.natural_frequency_hz_std,
+         config.warn_rel_std_frequency),
+        ('damping ratio', mode.damping_ratio, mode.damping_ratio_std,
+         config.warn_rel_std_damping),
+        ('stiffness', figures.static.total_nm_per_rad, figures.static.total_nm_per_rad_std,
+         config.warn_rel_std_stiffness),
+    )  # fmt: skip
+    for name, value, std, limit in relative:
+        _check_rel(warnings, name, value, std, limit)
+    pencil_zeta = checks.pencil[1]
     if math.isfinite(pencil_zeta):
         gap = abs(pencil_zeta - mode.damping_ratio) / mode.damping_ratio
         if gap > config.warn_cross_check_damping:
@@ -425,21 +481,33 @@ def _assemble(
                 f'matrix pencil damping ratio {pencil_zeta:.3g} disagrees with the fit '
                 f'{mode.damping_ratio:.3g}'
             )
+    return warnings
+
+
+def _method(params: DampedSinusoidParams) -> str:
+    """The estimator's name: the fit, its modes and whether it was nonlinear."""
     method = METHOD if params.n_modes == 1 else f'{METHOD}_{params.n_modes}modes'
-    if params.nonlinear:
-        method += '_nonlinear'
-    if warnings:
-        status, message = Status.WARN, '; '.join(warnings)
-    else:
-        status = Status.OK
-        message = (
-            f'f_n {mode.natural_frequency_hz:.4f} Hz, zeta {mode.damping_ratio:.4g}, '
-            f'k_tE {static.total_nm_per_rad:.1f} N m/rad over {cycles:.1f} cycles'
-        )
+    return method + '_nonlinear' if params.nonlinear else method
+
+
+def _report(
+    status: Status,
+    message: str,
+    release: Release,
+    state: FitState,
+    mode: ModeEstimate,
+    figures: _Figures,
+    span: AnalysedWindow,
+    tally: SampleCounts,
+) -> Identification:
+    """The reporting: the figures in the groups of doc/interfaces.md."""
+    params, checks = state.params, state.checks
+    static = figures.static
+    logdec = checks.logdec
     return Identification(
         status=status,
         message=message,
-        method=method,
+        method=_method(params),
         estimates=Estimates(
             natural_frequency_hz=Estimate(
                 mode.natural_frequency_hz, mode.natural_frequency_hz_std
@@ -453,17 +521,17 @@ def _assemble(
             stiffness_vertical_n_per_m=Estimate(
                 static.vertical_n_per_m, static.vertical_n_per_m_std
             ),
-            damping_total=Estimate(damping_total, damping_total_std),
+            damping_total=Estimate(*figures.damping_total),
         ),
-        window=replace(span, cycles=cycles),
+        window=replace(span, cycles=figures.cycles),
         release=ReleaseFigures(
             time_s=Estimate(release.time_s, release.time_std_s),
-            static_deflection_m=Estimate(deflection, deflection_std),
+            static_deflection_m=Estimate(*figures.deflection),
             confidence=release.confidence,
             source=release.source,
-            released_load_kg=load,
+            released_load_kg=figures.load_kg,
             level_before_m=Estimate(release.level_before_m, release.level_before_std_m),
-            level_after_m=Estimate(level_after, level_after_std),
+            level_after_m=Estimate(*figures.level_after),
         ),
         cross_checks=CrossCheckFigures(
             log_decrement_b20=Estimate(logdec.log_decrement, logdec.log_decrement_std)
@@ -477,10 +545,10 @@ def _assemble(
             )
             if logdec
             else UNKNOWN,
-            natural_frequency_pencil_hz=pencil[0],
-            damping_ratio_pencil=pencil_zeta,
-            stiffness_vertical_from_frequency_n_per_m=Estimate(k_freq, k_freq_std),
-            stiffness_total_from_pitch_nm_per_rad=Estimate(k_pitch, k_pitch_std),
+            natural_frequency_pencil_hz=checks.pencil[0],
+            damping_ratio_pencil=checks.pencil[1],
+            stiffness_vertical_from_frequency_n_per_m=Estimate(*figures.stiffness_from_frequency),
+            stiffness_total_from_pitch_nm_per_rad=Estimate(*checks.pitch_stiffness),
         ),
         quality=FitQuality(
             amplitude_m=mode.amplitude,

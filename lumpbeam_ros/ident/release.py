@@ -17,10 +17,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from lumpbeam_ros.bagio.tipseries import LoadSeries
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.covariance import mean_with_std
 from lumpbeam_ros.ident.onset import fit_onset
-from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow
+from lumpbeam_ros.ident.samples import PoseWindow
 from lumpbeam_ros.ident.settings import IdentifierConfig
 
 # Load changes smaller than this (kg) are reading noise, not a drop.
@@ -113,7 +114,7 @@ class _Step:
     rising: bool
 
 
-def load_changes(loads: LoadReadings) -> list[LoadChange]:
+def load_changes(loads: LoadSeries) -> list[LoadChange]:
     """The changes in a series of ``/tip_load`` readings, oldest first."""
     kg = loads.kg
     changed = np.flatnonzero(np.abs(np.diff(kg)) > _LOAD_TOLERANCE_KG) + 1
@@ -204,7 +205,7 @@ def _unanswered(
     )
 
 
-def _unannounced(release: Release, loads: LoadReadings) -> Release:
+def _unannounced(release: Release, loads: LoadSeries) -> Release:
     """A release in the data while ``/tip_load`` shows none: the mass that left is unknown."""
     before = loads.kg[loads.t <= release.time_s]
     reading = float(before[-1]) if before.size else float(loads.kg[0])

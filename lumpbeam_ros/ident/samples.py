@@ -16,27 +16,12 @@ import numpy as np
 
 from lumpbeam_ros.bagio.tipseries import (
     HoldsTipSeries,
+    LoadSeries,
     SampleCounts,
     TipSeries,
     clean_tip_series,
 )
 from lumpbeam_ros.errors import LumpbeamError
-
-
-@dataclass(frozen=True)
-class LoadReadings:
-    """``/tip_load`` readings: the mass hanging at the tip from each stamp on.
-
-    Attributes:
-        t: Stamps, s, increasing.
-        kg: Mass at the tip from that stamp on, kg.
-    """
-
-    t: np.ndarray = field(default_factory=lambda: np.empty(0))
-    kg: np.ndarray = field(default_factory=lambda: np.empty(0))
-
-    def __len__(self) -> int:
-        return int(self.t.size)
 
 
 @dataclass(frozen=True)
@@ -50,7 +35,7 @@ class PoseWindow(HoldsTipSeries):
     """
 
     poses: TipSeries
-    loads: LoadReadings = field(default_factory=LoadReadings)
+    loads: LoadSeries = field(default_factory=LoadSeries)
     counts: SampleCounts = field(default_factory=SampleCounts)
 
 
@@ -64,7 +49,7 @@ def _as_1d(name: str, values: object) -> np.ndarray:
     return array
 
 
-def clean_loads(t: object, kg: object) -> LoadReadings:
+def clean_loads(t: object, kg: object) -> LoadSeries:
     """Validates ``/tip_load`` readings: drops non-finite ones, sorts, keeps the last per stamp.
 
     Args:
@@ -87,14 +72,14 @@ def clean_loads(t: object, kg: object) -> LoadReadings:
     # The later reading of a stamp wins: it is the one the experiment published last.
     last = np.ones(t_arr.size, dtype=bool)
     last[:-1] = np.diff(t_arr) > 0.0
-    return LoadReadings(t_arr[last], kg_arr[last])
+    return LoadSeries(t_arr[last], kg_arr[last])
 
 
 def clean_window(
     t: object,
     z: object,
     pitch: object | None = None,
-    loads: LoadReadings | None = None,
+    loads: LoadSeries | None = None,
     *,
     x: object | None = None,
 ) -> PoseWindow:
@@ -129,4 +114,4 @@ def clean_window(
     poses, counts = clean_tip_series(
         TipSeries(t_arr, x_arr, z_arr, p_arr), pitch_required=pitch is not None
     )
-    return PoseWindow(poses, loads or LoadReadings(), counts)
+    return PoseWindow(poses, loads or LoadSeries(), counts)

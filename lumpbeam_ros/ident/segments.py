@@ -12,15 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from lumpbeam_ros.ident.release import detect_release
-from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow
+from lumpbeam_ros.ident.samples import PoseWindow
 from lumpbeam_ros.ident.settings import IdentifierConfig
-
-
-def _loads_within(loads: LoadReadings, start: float, end: float) -> LoadReadings:
-    """Readings from ``start`` to ``end``, with the last one before ``start``."""
-    first = max(int(np.searchsorted(loads.t, start, side='right')) - 1, 0)
-    last = int(np.searchsorted(loads.t, end, side='right'))
-    return LoadReadings(loads.t[first:last], loads.kg[first:last])
 
 
 def keep_release_segment(window: PoseWindow, config: IdentifierConfig) -> tuple[PoseWindow, str]:
@@ -42,7 +35,7 @@ def keep_release_segment(window: PoseWindow, config: IdentifierConfig) -> tuple[
     parts = [
         PoseWindow(
             window.poses.select(slice(a, b)),
-            _loads_within(window.loads, t[a], t[b - 1]),
+            window.loads.between(t[a], t[b - 1]),
             window.counts,
         )
         for a, b in zip(bounds[:-1], bounds[1:], strict=True)

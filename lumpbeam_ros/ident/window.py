@@ -1,42 +1,23 @@
 """The live identifier's sliding window of tip poses and ``/tip_load`` readings.
 
-Poses go into preallocated ring buffers, so a push is a few array stores and a snapshot two
-slices; nothing grows while the node runs. A sample that would break the window's order is
-rejected and counted, never raised: a live node logs the counts instead.
+The poses are kept in a :class:`~lumpbeam_ros.bagio.tipbuffer.TipBuffer` (the one live
+buffer, with its one rule for bad samples), the readings in two short lists. A sample that
+would break the window's order is dropped and counted, never raised: a live node logs the
+counts instead, and an identification of a window with many drops is at best a WARN.
 """
 
 from __future__ import annotations
 
 import bisect
 import math
-from dataclasses import dataclass
+from dataclasses import replace
 
 import numpy as np
 
-from lumpbeam_ros.bagio.tipseries import SampleCounts, TipSeries
-from lumpbeam_ros.ident.samples import LoadReadings, PoseWindow
+from lumpbeam_ros.bagio.tipbuffer import TipBuffer
+from lumpbeam_ros.bagio.tipseries import LoadSeries, SampleCounts
+from lumpbeam_ros.ident.samples import PoseWindow
 from lumpbeam_ros.ident.settings import IdentifierConfig
-
-
-@dataclass(frozen=True)
-class WindowCounts:
-    """What the window did with the samples pushed since it was made.
-
-    Attributes:
-        accepted: Poses stored.
-        non_finite: Poses rejected for a NaN or inf stamp, z or pitch.
-        out_of_order: Poses rejected for a stamp before the newest one (within the jump).
-        duplicates: Poses rejected for repeating the newest stamp.
-        resets: Times the window was emptied because the clock jumped back.
-        loads_rejected: ``/tip_load`` readings rejected (non-finite, negative or stale).
-    """
-
-    accepted: int = 0
-    non_finite: int = 0
-    out_of_order: int = 0
-    duplicates: int = 0
-    resets: int = 0
-    loads_rejected: int = 0
 
 
 class SlidingWindow:
@@ -67,17 +48,10 @@ class SlidingWindow:
             raise ValueError('window length, rate and jump must be positive')
         self.length_s = float(length_s)
         self.reset_jump_back_s = float(reset_jump_back_s)
-        self._capacity = int(math.ceil(length_s * max_rate_hz)) + 1
-        self._t = np.empty(self._capacity)
-        self._x = np.empty(self._capacity)
-        self._z = np.empty(self._capacity)
-        self._pitch = np.empty(self._capacity)
-        self._head = 0
-        self._size = 0
-        self._last = -math.inf
+        self.poses = TipBuffer(length_s, max_rate_hz, reset_jump_back_s)
         self._load_t: list[float] = []
         self._load_kg: list[float] = []
-        self._counts = {name: 0 for name in WindowCounts.__dataclass_fields__}
+        self._loads_rejected = 0
 
     @classmethod
     def from_config(cls, config: IdentifierConfig) -> SlidingWindow:
@@ -85,66 +59,46 @@ class SlidingWindow:
         return cls(config.window_s, config.max_rate_hz, config.reset_jump_back_s)
 
     def __len__(self) -> int:
-        return self._size
+        return len(self.poses)
 
     @property
-    def counts(self) -> WindowCounts:
-        """What happened to the samples pushed so far."""
-        return WindowCounts(**self._counts)
+    def counts(self) -> SampleCounts:
+        """Every sample pushed since the window was made, and what became of it."""
+        return replace(self.poses.counts, loads_rejected=self._loads_rejected)
 
     @property
     def newest_s(self) -> float:
         """Stamp of the newest pose (-inf when empty)."""
-        return self._last
+        return self.poses.newest_s
 
     def clear(self) -> None:
         """Empties the window (poses and loads); the counts are kept."""
-        self._head = 0
-        self._size = 0
-        self._last = -math.inf
+        self.poses.clear()
         self._load_t.clear()
         self._load_kg.clear()
 
     def push(self, stamp: float, z: float, pitch: float = 0.0, x: float = math.nan) -> bool:
-        """Adds one tip pose.
+        """Adds one tip pose (:meth:`~lumpbeam_ros.bagio.tipbuffer.TipBuffer.push`).
+
+        A clock that jumps back empties the window, but the mass hanging does not change
+        because the clock jumped: the last ``/tip_load`` reading is kept, restamped.
 
         Args:
             stamp: Header stamp, s.
             z: Vertical tip position, m.
             pitch: Tip pitch, rad.
-            x: Tip position along the beam, m (NaN when not measured). The estimators do not
-                use it, so a non-finite x does not reject the pose.
+            x: Tip position along the beam, m (NaN when not measured).
 
         Returns:
             Whether the sample was stored.
         """
-        if not (math.isfinite(stamp) and math.isfinite(z) and math.isfinite(pitch)):
-            self._counts['non_finite'] += 1
-            return False
-        if stamp <= self._last:
-            if stamp < self._last - self.reset_jump_back_s:
-                self._counts['resets'] += 1
-                # The mass hanging does not change because the clock jumped: keep it.
-                kept = self._load_kg[-1:] if self._load_kg else []
-                self.clear()
-                self._load_t.extend(stamp for _ in kept)
-                self._load_kg.extend(kept)
-            elif stamp == self._last:
-                self._counts['duplicates'] += 1
-                return False
-            else:
-                self._counts['out_of_order'] += 1
-                return False
-        i = self._head
-        self._t[i] = stamp
-        self._x[i] = x
-        self._z[i] = z
-        self._pitch[i] = pitch
-        self._head = (i + 1) % self._capacity
-        self._size = min(self._size + 1, self._capacity)
-        self._last = stamp
-        self._counts['accepted'] += 1
-        return True
+        resets = self.poses.counts.resets
+        stored = self.poses.push(stamp, z, pitch, x)
+        if self.poses.counts.resets != resets:
+            kept = self._load_kg[-1:]
+            self._load_t[:] = [stamp for _ in kept]
+            self._load_kg[:] = kept
+        return stored
 
     def push_load(self, stamp: float, kg: float) -> bool:
         """Adds one ``/tip_load`` reading (mass hanging at the tip from ``stamp`` on).
@@ -158,7 +112,7 @@ class SlidingWindow:
         """
         latest = self._load_t[-1] if self._load_t else -math.inf
         if not (math.isfinite(stamp) and math.isfinite(kg) and kg >= 0.0):
-            self._counts['loads_rejected'] += 1
+            self._loads_rejected += 1
             return False
         if stamp < latest - self.reset_jump_back_s:
             self._load_t.clear()
@@ -168,11 +122,11 @@ class SlidingWindow:
             self._load_kg[-1] = float(kg)
             return True
         elif stamp < latest:
-            self._counts['loads_rejected'] += 1
+            self._loads_rejected += 1
             return False
         self._load_t.append(float(stamp))
         self._load_kg.append(float(kg))
-        self._prune_loads(max(stamp, self._last) - self.length_s)
+        self._prune_loads(max(stamp, self.newest_s) - self.length_s)
         return True
 
     def push_load_on_arrival(self, kg: float, clock_s: float) -> tuple[bool, float]:
@@ -190,7 +144,8 @@ class SlidingWindow:
         Returns:
             Whether the reading was stored, and the stamp it was given.
         """
-        stamp = self._last if math.isfinite(self._last) else clock_s
+        newest = self.newest_s
+        stamp = newest if math.isfinite(newest) else clock_s
         return self.push_load(stamp, kg), stamp
 
     def snapshot(self) -> PoseWindow:
@@ -198,29 +153,11 @@ class SlidingWindow:
 
         Returns:
             A :class:`~lumpbeam_ros.ident.samples.PoseWindow` holding copies; its counts
-            are the window's rejections since it was made.
+            are the poses dropped while the window's poses arrived.
         """
-        n = self._size
-        start = (self._head - n) % self._capacity
-        if start + n <= self._capacity:
-            part = slice(start, start + n)
-            t, x, z, pitch = (a[part].copy() for a in (self._t, self._x, self._z, self._pitch))
-        else:
-            first, second = slice(start, self._capacity), slice(0, self._head)
-            t, x, z, pitch = (
-                np.concatenate([a[first], a[second]])
-                for a in (self._t, self._x, self._z, self._pitch)
-            )
-        cut = int(np.searchsorted(t, self._last - self.length_s, side='left')) if n else 0
-        poses = TipSeries(t, x, z, pitch).select(slice(cut, None))
-        self._prune_loads(self._last - self.length_s)
-        loads = LoadReadings(np.asarray(self._load_t), np.asarray(self._load_kg))
-        c = self._counts
-        counts = SampleCounts(
-            received=len(poses) + c['non_finite'] + c['out_of_order'] + c['duplicates'],
-            non_finite=c['non_finite'],
-            duplicates=c['out_of_order'] + c['duplicates'],
-        )
+        poses, counts = self.poses.latest()
+        self._prune_loads(self.newest_s - self.length_s)
+        loads = LoadSeries(np.asarray(self._load_t), np.asarray(self._load_kg))
         return PoseWindow(poses, loads, counts)
 
     def _prune_loads(self, start: float) -> None:

@@ -65,6 +65,7 @@ from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
+from lumpbeam_ros.vision.bag_frames import bag_frames
 from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
 from lumpbeam_ros.vision.config import camera_config_from_parameters
 from lumpbeam_ros.vision.free_pose import rpy_quaternion
@@ -148,13 +149,21 @@ class CameraNode(SchemaNode):
     def on_camera_info(self, data: bytes) -> None:
         """Takes the camera's intrinsics (published beside every frame)."""
         try:
-            if self.session.set_camera_info(decode_camera_info(data)):
-                info = self.session.camera_info
-                self.get_logger().info(f'camera info: {info.width} x {info.height} px')
+            changed = self.session.set_camera_info(decode_camera_info(data))
         except LumpbeamError as exc:
+            self._took_camera_info(False, str(exc))
+        else:
+            self._took_camera_info(changed)
+
+    def _took_camera_info(self, changed: bool, problem: str = '') -> None:
+        if problem:
             self.get_logger().warning(
-                f'camera_info ignored: {exc}', throttle_duration_sec=self._warning_period
+                f'camera_info ignored: {problem}', throttle_duration_sec=self._warning_period
             )
+        elif changed:
+            info = self.session.camera_info
+            assert info is not None  # a change sets it
+            self.get_logger().info(f'camera info: {info.width} x {info.height} px')
 
     def on_image(self, data: bytes, msgtype: str = IMAGE_TYPE) -> None:
         """Tracks one serialized image (``Image`` or ``CompressedImage``), publishes its pose."""
@@ -186,13 +195,24 @@ class CameraNode(SchemaNode):
         msgtype = reader.require(image_topic).msgtype
         if msgtype not in IMAGE_TYPES:
             raise BagError(f'{reader.path}: topic {image_topic} has type {msgtype}, not an image')
-        for raw in reader.iter_raw([image_topic, info_topic]):
-            if should_stop():
-                break
-            if raw.topic == info_topic:
-                self.on_camera_info(raw.data)
+        items = bag_frames(
+            reader,
+            self.session,
+            image_topic,
+            msgtype,
+            info_topic,
+            topics=[image_topic, info_topic],
+            should_stop=should_stop,
+        )
+        for item in items:
+            if item.kind == 'camera_info':
+                self._took_camera_info(item.info_changed, item.problem)
+            elif item.frame is None:
+                self._publish_or_warn(None, self.session.reject(item.problem))
             else:
-                self.on_image(raw.data, msgtype)
+                frame = item.frame
+                result = self.session.process(frame.pixels, frame.stamp, frame.encoding)
+                self._publish_or_warn(frame.stamp_ns, result)
 
     def open_source(self) -> VideoSource | FolderSource | DeviceSource:
         """Opens ``footage_path`` with its stamps, or ``video_device``.

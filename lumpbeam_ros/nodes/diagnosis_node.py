@@ -173,8 +173,13 @@ class DiagnosisNode(SchemaNode):
     def _on_pose(self, msg: PoseStamped) -> None:
         self._heard = True
         pose = self._pose(msg, TIP_POSE)
-        if pose is not None:
-            self.buffer.push_measured(*pose)
+        if pose is not None and not self.buffer.push_measured(*pose):
+            late = self.buffer.measured.counts
+            self.get_logger().warning(
+                f'/tip_pose with a repeated or out-of-order stamp: dropped '
+                f'({late.duplicates + late.out_of_order} so far)',
+                throttle_duration_sec=WARN_PERIOD_S,
+            )
 
     def _on_predicted(self, msg: PoseStamped) -> None:
         self._heard = True
@@ -306,6 +311,11 @@ class DiagnosisNode(SchemaNode):
 
     # -- output -------------------------------------------------------------------------------
 
+    def _late(self) -> int:
+        """Measured poses dropped for a repeated stamp or one before the newest."""
+        counts = self.buffer.measured.counts
+        return counts.duplicates + counts.out_of_order
+
     def status(self) -> DiagnosticStatus:
         """The current ``lumpbeam/diagnosis`` status.
 
@@ -318,6 +328,7 @@ class DiagnosisNode(SchemaNode):
             ('diagnoses', str(self.diagnoses)),
             ('samples_wrong_frame', str(self.wrong_frame)),
             ('samples_non_finite', str(self.non_finite)),
+            ('samples_out_of_order', str(self._late())),
         ]
         if missing is not None:
             if self.buffer.predicted_count:

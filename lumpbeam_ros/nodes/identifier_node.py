@@ -31,11 +31,14 @@ from geometry_msgs.msg import PoseStamped
 from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio.convert import pose_values
-from lumpbeam_ros.bagio.tipseries import SampleCounts
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.identification import Identification, Status
 from lumpbeam_ros.ident.identify import FitState, identify_from
-from lumpbeam_ros.ident.settings import PARAMETER_KEYS, IdentifierConfig, config_from_parameters
+from lumpbeam_ros.ident.settings import (
+    IDENTIFIER_SETTINGS,
+    IdentifierConfig,
+    config_from_parameters,
+)
 from lumpbeam_ros.ident.window import SlidingWindow
 from lumpbeam_ros.interface import BASE_FRAME, BEAM_PARAMS, IDENTIFIER_STATUS, TIP_LOAD, TIP_POSE
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
@@ -61,7 +64,7 @@ class IdentifierNode(SchemaNode):
     def __init__(self, **options: Unpack[NodeOptions]):
         super().__init__(IDENTIFIER_SCHEMA, **options)
         values = self.parameter_values
-        settings = {key: values[key] for key in PARAMETER_KEYS.values()}
+        settings = {spec.name: values[spec.name] for spec in IDENTIFIER_SETTINGS}
         self.config: IdentifierConfig = config_from_parameters(
             settings, f'{self.get_name()} parameters'
         )
@@ -137,9 +140,7 @@ class IdentifierNode(SchemaNode):
         """
         counts = self.window.counts
         message = result.message
-        repeated = counts.out_of_order + counts.duplicates
-        received = counts.accepted + counts.non_finite + repeated
-        dropped = SampleCounts(received, counts.non_finite, repeated).note()
+        dropped = counts.note()
         if dropped:
             # The counts are also published as values; the message says it to a reader.
             message = f'{message}; /tip_pose: {dropped}'

@@ -85,7 +85,7 @@ def parse_effect(text: str) -> tuple[str, float]:
 
     Raises:
         LumpbeamError: Not ``NAME=VALUE``, an unknown name, or a value outside the effect's
-            physical limits (:data:`~lumpbeam_ros.model.parameters.EFFECT_LIMITS`).
+            limits (:data:`~lumpbeam_ros.model.parameters.EFFECTS`).
     """
     name, sep, value_text = text.partition('=')
     name = name.strip()

@@ -43,6 +43,7 @@ from lumpbeam_ros.interface import (
     TIP_POSE,
     TIP_POSE_TRUTH,
 )
+from lumpbeam_ros.vision.bag_frames import bag_frames
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import CameraConfig
 from lumpbeam_ros.vision.free_pose import rpy_quaternion
@@ -50,8 +51,6 @@ from lumpbeam_ros.vision.messages import (
     IMAGE_TYPES,
     camera_info_from_data,
     camera_info_to_data,
-    decode_camera_info,
-    decode_frame,
 )
 from lumpbeam_ros.vision.session import TrackingSession
 from lumpbeam_ros.vision.sources import FootageError, FootageFrame
@@ -382,27 +381,26 @@ def track_bag(
             name = str(reader.path)
             run = _Run(session, writer, name, camera_info_source, entry.count, progress)
             copied = _declare_copies(reader, writer, run.summary)
-            index = 0
-            for raw in reader.iter_raw():
+            items = bag_frames(
+                reader, session, image_topic, entry.msgtype, camera_info_topic,
+                follow_info=follow_info,
+            )  # fmt: skip
+            for item in items:
+                raw = item.raw
                 if raw.topic == POSE_TOPIC:
                     run.summary.replaced_poses += 1
                     continue
                 if raw.topic in copied:
                     writer.write_raw(raw.topic, raw.log_time_ns, raw.data)
-                if raw.topic == camera_info_topic and follow_info:
-                    try:
-                        session.set_camera_info(decode_camera_info(raw.data))
-                    except LumpbeamError:
-                        pass  # a bad calibration message: keep the one in use
-                elif raw.topic == image_topic:
-                    label = f'{reader.path} {image_topic} message {index}'
-                    index += 1
-                    try:
-                        frame = decode_frame(raw.data, entry.msgtype)
-                    except LumpbeamError as exc:
-                        run.reject(label, str(exc))
-                        continue
-                    run.track(label, frame.stamp_ns, frame.pixels, frame.encoding, raw.log_time_ns)
+                # A bad calibration message (item.problem) leaves the one in use.
+                if item.kind != 'image':
+                    continue
+                label = f'{reader.path} {image_topic} message {item.index}'
+                if item.frame is None:
+                    run.reject(label, item.problem)
+                    continue
+                frame = item.frame
+                run.track(label, frame.stamp_ns, frame.pixels, frame.encoding, raw.log_time_ns)
         return run.finish()
 
     summary = _removing_on_error(out, write)

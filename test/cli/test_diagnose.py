@@ -2,7 +2,7 @@ import json
 
 import pytest
 
-from lumpbeam_ros.bagio import BagWriter
+from lumpbeam_ros.bagio import BagWriter, read_load_events, read_tip_poses
 from lumpbeam_ros.cli.main import main
 from lumpbeam_ros.model.parameters import DropTestConfig, load_beam_config
 from lumpbeam_ros.plots.diagnosis import FIGURES
@@ -75,3 +75,50 @@ def test_a_bad_config_value_is_reported(tmp_path, late_bag, capsys):
     config.write_text('/**:\n  ros__parameters:\n    beam:\n      length_m: -1.0\n')
     assert main(['diagnose', str(late_bag), '--config', str(config)]) == 2
     assert 'length_m' in capsys.readouterr().err
+
+
+def _rewritten(bag, out, edit):
+    """The bag's /tip_pose and /tip_load, the poses' (t, x, z, pitch) rows edited."""
+    poses, loads = read_tip_poses(bag), read_load_events(bag)
+    rows = edit([list(r) for r in zip(poses.t, poses.x, poses.z, poses.pitch, strict=True)])
+    with BagWriter(out) as writer:
+        for t, x, z, pitch in rows:
+            writer.write_pose('/tip_pose', t, x, z, pitch)
+        writer.add_topic('/tip_load', 'std_msgs/msg/Float64')
+        for t, kg in zip(loads.t, loads.kg, strict=True):
+            writer.write_float('/tip_load', float(t), float(kg))
+    return out
+
+
+def _damaged(rows):
+    for row in rows[100:110]:
+        row[2] = float('nan')
+    rows[200][0] = rows[199][0]  # a repeated stamp
+    return rows
+
+
+def test_dropped_poses_are_counted_on_stderr_and_in_the_json(late_bag, tmp_path, capsys):
+    bag = _rewritten(late_bag, tmp_path / 'damaged', _damaged)
+    json_path = tmp_path / 'd.json'
+    assert main(['diagnose', str(bag), '--json', str(json_path)]) == 0
+    received = len(read_tip_poses(late_bag))
+    warning = (
+        f'lumpbeam diagnose: warning: {bag}: dropped 11 of {received} poses (10 with a NaN or '
+        'inf stamp, position or orientation; 1 with a repeated or out-of-order stamp)'
+    )
+    assert warning in capsys.readouterr().err.splitlines()
+    result = json.loads(json_path.read_text())
+    assert (result['n_samples'], result['n_rejected']) == (received - 11, 11)
+
+
+def test_a_bag_too_short_after_dropping_poses_says_why(late_bag, tmp_path, capsys):
+    def mostly_nan(rows):
+        for row in rows[:-300]:
+            row[2] = float('nan')
+        return rows
+
+    bag = _rewritten(late_bag, tmp_path / 'lost', mostly_nan)
+    assert main(['diagnose', str(bag)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert 'need a longer record (dropped ' in err and 'with a NaN or inf stamp' in err

@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lumpbeam_ros.bagio.tipseries import LoadSeries
 from lumpbeam_ros.compare.streams import Track, clean_track
-from lumpbeam_ros.ident.samples import LoadReadings
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, simulate_experiment, with_effects
 from lumpbeam_ros.synthetic.reference_sensor import (
@@ -25,7 +25,7 @@ DURATION = 6.0
 class Pair:
     camera: Track
     reference: Track
-    loads: LoadReadings
+    loads: LoadSeries
     tracker: ReferenceSensorOptions
     samples: ReferenceSamples
 
@@ -52,7 +52,7 @@ def make_pair(
         with_effects(beam, options.effects), drop, duration, tracker
     )
     reference = clean_track(samples.stamps, samples.points, tracker.frame_id, '/tracker/point')
-    loads = LoadReadings(np.array([0.0, drop.release_time_s]), np.array([drop.load_kg, 0.0]))
+    loads = LoadSeries(np.array([0.0, drop.release_time_s]), np.array([drop.load_kg, 0.0]))
     return Pair(camera, reference, loads, tracker, samples)
 
 

@@ -1,11 +1,13 @@
 """The live workflow's core: stretches from a stream, the record, the published status."""
 
+import dataclasses
 import math
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+from lumpbeam_ros.bagio.tipseries import SampleCounts
 from lumpbeam_ros.diagnose.live import (
     ERROR,
     OK,
@@ -174,3 +176,27 @@ def test_diagnose_live_names_a_hidden_latency_on_a_short_ring_down():
     assert result.missing_effect == 'sensor_latency'
     assert result.effect_parameters['latency_s'] == pytest.approx(0.015, rel=0.05)
     assert result.gap_after_rms_m < 0.05 * result.gap_before_rms_m
+
+
+@pytest.mark.parametrize(('name', 'level'), [('none', WARN), ('unexplained', ERROR)])
+def test_a_stretch_with_many_poses_dropped_is_never_ok(name, level):
+    dropped = SampleCounts(received=2000, duplicates=900)
+    result = dataclasses.replace(_result(name), samples=dropped)
+    got, message, _ = status_values(result)
+    assert got == level
+    assert message.endswith('; /tip_pose: dropped 900 of 2000 poses (900 with a repeated or '
+                            'out-of-order stamp) in the stretch')  # fmt: skip
+
+
+def test_late_and_repeated_poses_are_counted_in_the_stretch_record():
+    _, _, t, z, pitch = _stream()
+    buffer = LiveBuffer(LiveSettings(pre_release_s=1.0, decay_s=2.3))
+    buffer.push_load(0.0, 4.5)
+    for ti, zi, pi in zip(t, z, pitch, strict=True):
+        if ti >= RELEASE_S and buffer.loads[-1][1] != 0.0:
+            buffer.push_load(float(ti), 0.0)
+        assert buffer.push_measured(float(ti), float(zi), float(pi))
+        assert not buffer.push_measured(float(ti) - 0.1, float(zi), float(pi))  # a late stream
+    record = buffer.record(buffer.next_stretch())
+    assert record.counts.duplicates == len(record) and record.counts.untrusted
+    assert buffer.measured.counts.out_of_order == t.size

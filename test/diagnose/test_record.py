@@ -115,3 +115,29 @@ def test_a_stamp_jump_keeps_the_stretch_with_the_drop(jump_s):
     (note,) = record.notes
     assert note.startswith(f'/tip_pose stamps jump by {jump_s:+.3g}')
     assert 'kept 0.000 to 9.000 s (1621 poses), dropped 539' in note
+
+
+def test_dropped_poses_are_counted_and_said():
+    z = np.zeros(T.size)
+    z[5:8] = np.nan
+    t = T.copy()
+    t[20] = t[19]  # a repeated stamp
+    record = _record(t=t, z=z)
+    assert (record.counts.non_finite, record.counts.duplicates) == (3, 1)
+    assert record.counts.received == T.size and len(record) == T.size - 4
+    assert record.notes == (
+        f'dropped 4 of {T.size} poses (3 with a NaN or inf stamp, position or orientation; '
+        '1 with a repeated or out-of-order stamp)',
+    )
+    assert _record().counts.dropped == 0 and _record().notes == ()
+
+
+def test_a_record_too_short_after_dropping_poses_says_why():
+    z = np.zeros(T.size)
+    z[::2] = np.nan  # half the poses lost: too few left after the drop
+    with pytest.raises(LumpbeamError, match=r'poses after the last load change') as caught:
+        _record(z=z, load_events=[(3.5, 0.0)])
+    assert f'(dropped {(T.size + 1) // 2} of {T.size} poses (' in str(caught.value)
+    z[: T.size - 100] = np.nan
+    with pytest.raises(LumpbeamError, match=r'valid tip poses, need a longer record \(dropped'):
+        _record(z=z)

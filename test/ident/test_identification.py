@@ -5,13 +5,13 @@ from pathlib import Path
 
 import pytest
 
+from lumpbeam_ros.bagio.tipseries import SampleCounts
 from lumpbeam_ros.cli.analyze import CONTRACT_KEYS
 from lumpbeam_ros.ident.identification import (
     Estimate,
     Estimates,
     Identification,
     ReleaseFigures,
-    SampleTally,
     Status,
 )
 
@@ -35,7 +35,7 @@ def test_an_estimate_gives_its_key_and_its_std():
         'ok',
         estimates=Estimates(damping_ratio=Estimate(0.002, 1e-6)),
         release=ReleaseFigures(time_s=Estimate(2.0, 0.001), source='tip_load'),
-        samples=SampleTally(10, 2),
+        samples=SampleCounts(received=12, non_finite=2),
     )
     data = result.as_dict()
     assert (data['damping_ratio'], data['damping_ratio_std']) == (0.002, 1e-6)

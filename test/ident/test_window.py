@@ -19,7 +19,7 @@ def test_rejections_are_counted_not_raised():
     assert not w.push(math.inf, 0.1, 0.0)
     assert w.push(1.1, 0.3, 0.0)
     c = w.counts
-    assert (c.accepted, c.duplicates, c.out_of_order, c.non_finite) == (2, 1, 1, 2)
+    assert (c.kept, c.duplicates, c.out_of_order, c.non_finite) == (2, 1, 1, 2)
     snap = w.snapshot()
     np.testing.assert_array_equal(snap.z, [0.1, 0.3])
     assert snap.counts.non_finite == 2 and snap.counts.duplicates == 2
@@ -123,3 +123,54 @@ def test_the_tip_x_is_carried_through_the_ring_and_nan_when_not_given():
     np.testing.assert_allclose(snap.poses.x[:-1], 2.3 + snap.t[:-1])
     np.testing.assert_allclose(snap.t[:-1], t[t >= 2.0 - 1e-9])
     assert math.isnan(snap.poses.x[-1])
+
+
+def _two_streams(window, trajectory, behind_s=0.5, other_kg=9.0):
+    """Two replays feeding one window: this drop test, and another bag ``behind_s`` behind.
+
+    The other bag's poses arrive late (dropped as out of order), but its /tip_load readings
+    count as much as this bag's: the window pairs one bag's poses with the other's load.
+    """
+    window.push_load_on_arrival(4.5, 0.0)
+    window.push_load_on_arrival(other_kg, 0.0)  # the other bag's load, taken as the last one
+    released = False
+    for t, z, p, kg in zip(
+        trajectory.t, trajectory.z, trajectory.pitch, trajectory.load_kg, strict=True
+    ):
+        if kg == 0.0 and not released:
+            window.push_load_on_arrival(0.0, t)
+            released = True
+        window.push(t, z, p)
+        window.push(t - behind_s, z, p)
+
+
+def test_two_streams_feeding_one_window_are_never_ok(drop_case):
+    trajectory, truth = drop_case()
+    window = SlidingWindow(length_s=12.5)
+    _two_streams(window, trajectory)
+    snap = window.snapshot()
+    assert snap.counts.duplicates == len(snap)  # every late pose dropped
+    result = identify(snap, BeamParameters())
+    # The released mass is the other bag's: k_tE is twice the truth, and that must show.
+    k = result.estimates.stiffness_total_nm_per_rad.value
+    assert k == pytest.approx(2.0 * truth.stiffness_total_nm_per_rad, rel=0.02)
+    assert result.status == Status.WARN, result.message
+    assert f'dropped {len(snap)} of {2 * len(snap)} poses' in result.message
+    assert 'more than 5%: the poses may mix two streams' in result.message
+
+
+def test_a_window_with_a_few_drops_stays_ok(drop_case):
+    trajectory, truth = drop_case()
+    window = SlidingWindow(length_s=12.5)
+    window.push_load_on_arrival(4.5, 0.0)
+    for i, (t, z, p, kg) in enumerate(
+        zip(trajectory.t, trajectory.z, trajectory.pitch, trajectory.load_kg, strict=True)
+    ):
+        if kg == 0.0 and window.snapshot().loads.kg[-1] != 0.0:
+            window.push_load_on_arrival(0.0, t)
+        window.push(t, z if i % 50 else math.nan, p)  # 2 % dropped
+    snap = window.snapshot()
+    assert 0.0 < snap.counts.dropped_fraction < 0.05
+    result = identify(snap, BeamParameters())
+    assert result.status == Status.OK, result.message
+    assert result.samples.n_rejected == snap.counts.non_finite > 0

@@ -339,3 +339,33 @@ def test_beam_params_keep_the_keys_their_order_and_values(ros_graph, tmp_path):
     ]
     assert differ == []
     assert status.level == bytes([0]) and status.message == result.message
+
+
+def test_two_replays_feeding_the_node_are_never_ok(ros_graph, drop_record):
+    """A bag and another one 0.5 s behind with its own (double) load: WARN, never OK.
+
+    The callbacks are called as the executor would, in order, so no message is lost.
+    """
+    poses, _, truth = drop_record
+    node = IdentifierNode(context=ros_graph.context, parameter_overrides={'publish_rate_hz': 1.0})
+    ros_graph.add_node(node)
+    params = ros_graph.collect('/beam_params', DiagnosticArray, 10)
+    node._on_pose(_pose(float(poses.t[0]), float(poses.z[0])))
+    node._on_load(Float64(data=4.5))
+    node._on_load(Float64(data=9.0))  # the other bag's load arrives after this one's
+    released = False
+    for t, x, z, pitch in zip(poses.t[1:], poses.x[1:], poses.z[1:], poses.pitch[1:], strict=True):
+        if t >= RELEASE_S + 0.1 and not released:
+            node._on_load(Float64(data=0.0))
+            released = True
+        node._on_pose(_pose(float(t), float(z), pitch=float(pitch), x=x))
+        node._on_pose(_pose(float(t) - 0.5, float(z), pitch=float(pitch), x=x))
+    node._on_timer()
+    assert ros_graph.spin_until(lambda: bool(params), 10.0)
+    level, message, values = _statuses(params)[-1]
+    k = float(values['stiffness_total_nm_per_rad'])
+    assert k == pytest.approx(2.0 * truth['stiffness_total_nm_per_rad'], rel=0.05)  # wrong
+    assert level == 1, message  # and said to be
+    assert 'the poses may mix two streams' in message
+    assert int(values['samples_out_of_order']) == len(poses) - 1
+    assert float(values['n_rejected']) > 0.4 * float(values['n_samples'])

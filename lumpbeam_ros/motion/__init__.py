@@ -1,0 +1,1 @@
+"""Joint motion commanded to an arm: the joint trajectory and its file."""

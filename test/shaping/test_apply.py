@@ -1,0 +1,105 @@
+"""Shaped trajectories: exact sums of shifted commands, sampling, and the vibration removed.
+
+The vibration is that of an independent model: one or two damped modes driven by the
+commanded angle, integrated by scipy.signal.lsim; the residual is the RMS distance from rest
+from the end of the move to 3 s after.
+"""
+
+import math
+
+import numpy as np
+import pytest
+from scipy import signal
+
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
+from lumpbeam_ros.shaping.apply import MAX_SAMPLES, shape_trajectory, shaped_times
+from lumpbeam_ros.shaping.impulses import Impulses, Mode
+from lumpbeam_ros.shaping.shapers import design_shaper
+
+
+def _move(duration_s=0.1, rate_hz=1000.0, joints=1):
+    """A rest-to-rest move of 0.5 rad per joint, smooth (cycloidal), sampled at rate_hz."""
+    t = np.arange(int(round(duration_s * rate_hz)) + 1) / rate_hz
+    s = t / duration_s
+    angle = 0.5 * (s - np.sin(2 * np.pi * s) / (2 * np.pi))
+    return JointTrajectory(t, np.column_stack([angle * (j + 1) for j in range(joints)]))
+
+
+def test_shaped_angles_are_the_weighted_sum_of_the_delayed_command():
+    move = _move(joints=2)
+    impulses = Impulses([0.0, 0.0371, 0.09], [0.2, 0.5, 0.3])
+    shaped = shape_trajectory(move, impulses)
+    expected = sum(
+        a * move.at(shaped.time_s - t)
+        for t, a in zip([0.0, 0.0371, 0.09], [0.2, 0.5, 0.3], strict=True)
+    )
+    assert np.allclose(shaped.angles_rad, expected, rtol=0, atol=1e-15)
+    assert shaped.joint_names == move.joint_names
+
+
+def test_shaped_move_ends_later_at_rest_at_the_same_angles():
+    move = _move(joints=3)
+    impulses = design_shaper('zvd', [Mode(2.0, 0.05)])
+    shaped = shape_trajectory(move, impulses)
+    assert shaped.time_s[0] == move.time_s[0]
+    assert shaped.time_s[-1] == pytest.approx(move.time_s[-1] + impulses.duration_s, abs=1e-12)
+    assert np.allclose(shaped.angles_rad[-1], move.angles_rad[-1], rtol=0, atol=1e-14)
+    assert np.max(np.diff(shaped.time_s)) <= 1e-3 + 1e-15
+
+
+@pytest.mark.parametrize(('rate_hz', 'step_s'), [(100.0, 1e-3), (1000.0, 1e-3), (4000.0, 2.5e-4)])
+def test_sampling_is_1_khz_or_the_input_rate_if_finer(rate_hz, step_s):
+    move = _move(rate_hz=rate_hz)
+    times = shaped_times(move, design_shaper('zv', [Mode(3.0, 0.0)]))
+    steps = np.diff(times)
+    # Evenly spaced, the step shrunk just enough to end on the last time.
+    assert np.ptp(steps) < 1e-12
+    assert step_s * 0.99 < steps[0] <= step_s * (1 + 1e-12)
+
+
+def test_too_low_a_frequency_is_refused_before_allocating():
+    with pytest.raises(LumpbeamError) as caught:
+        shape_trajectory(_move(), design_shaper('zv', [Mode(1e-5, 0.0)]))
+    assert f'more than {MAX_SAMPLES}: is the frequency too low?' in str(caught.value)
+
+
+def _residual_rms(command, modes, weights):
+    """RMS tip vibration from the end of the command to 3 s after, of weighted modes."""
+    end = command.time_s[-1]
+    t = np.arange(0.0, end + 3.0, 2e-4)
+    u = command.at(t)[:, 0]
+    x = np.zeros_like(t)
+    for mode, weight in zip(modes, weights, strict=True):
+        omega = 2 * math.pi * mode.frequency_hz
+        lti = signal.lti([omega**2], [1.0, 2 * mode.damping_ratio * omega, omega**2])
+        x += weight * signal.lsim(lti, u, t)[1]
+    after = t >= end
+    return float(np.sqrt(np.mean((x[after] - command.angles_rad[-1, 0]) ** 2)))
+
+
+ONE = [Mode(2.0, 0.02)]
+TWO = [Mode(2.0, 0.02), Mode(7.3, 0.03)]
+
+
+@pytest.mark.parametrize(
+    ('kind', 'designed', 'actual', 'weights', 'least_reduction'),
+    [
+        ('zv', ONE, ONE, [1.0], 0.90),
+        ('zvd', ONE, ONE, [1.0], 0.95),
+        ('ei', ONE, ONE, [1.0], 0.90),
+        ('zvd', ONE, [Mode(2.3, 0.02)], [1.0], 0.85),
+        ('zvd', ONE, [Mode(1.7, 0.02)], [1.0], 0.85),
+        ('ei', ONE, [Mode(2.3, 0.02)], [1.0], 0.85),
+        ('ei', ONE, [Mode(1.7, 0.02)], [1.0], 0.85),
+        ('zv', TWO, TWO, [0.7, 0.3], 0.90),
+        ('zvd', TWO, TWO, [0.7, 0.3], 0.95),
+    ],
+)
+def test_residual_vibration_drops(kind, designed, actual, weights, least_reduction):
+    move = _move()
+    shaped = shape_trajectory(move, design_shaper(kind, designed))
+    before = _residual_rms(move, actual, weights)
+    after = _residual_rms(shaped, actual, weights)
+    assert before > 0.05  # the unshaped move rings
+    assert 1 - after / before >= least_reduction
