@@ -56,9 +56,27 @@ def api_pages() -> dict[str, str]:
     return pages
 
 
+def _listed(nav: Any) -> set[str]:
+    """The page paths a navigation (nested lists and one-key mappings) names."""
+    if isinstance(nav, str):
+        return {nav}
+    if isinstance(nav, dict):
+        return set().union(*(_listed(value) for value in nav.values()))
+    if isinstance(nav, list):
+        return set().union(*(_listed(item) for item in nav))
+    return set()
+
+
 def on_config(config: MkDocsConfig, **_: Any) -> MkDocsConfig:
-    """Appends the API pages to the navigation, after the pages ``mkdocs.yml`` lists."""
+    """Completes the navigation ``mkdocs.yml`` starts.
+
+    A page under ``doc/`` that it does not list comes next, titled by its first heading (a
+    new page is on the site without an edit to ``mkdocs.yml``), then the API pages.
+    """
     nav = list(config.nav or [])
+    listed = _listed(nav)
+    docs = Path(config.docs_dir)
+    nav += sorted(p.name for p in docs.glob('*.md') if p.name not in listed | {HOME})
     nav.append({API_SECTION: [{Path(path).stem: path} for path in api_pages()]})
     config.nav = nav
     return config
