@@ -39,6 +39,8 @@ demo: venv
 PYTEST_WORKERS ?= auto
 PYTEST_PARALLEL := -n $(PYTEST_WORKERS) --maxprocesses=4 --dist loadscope
 
+# pytest also builds the documentation site (mkdocs build --strict) and checks its links
+# (test/test_docs.py).
 test: venv
 	$(BIN)/ruff check .
 	$(BIN)/mypy
