@@ -18,7 +18,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from lumpbeam_ros.diagnose.gap import SETTLE_S, decay_mode
-from lumpbeam_ros.diagnose.record import Record
+from lumpbeam_ros.diagnose.measurement import Record
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.logdec import difference_noise_std
 from lumpbeam_ros.ident.peaks import lobe_peaks, vertices
