@@ -37,6 +37,33 @@ def flatten(tree: Mapping[str, Any], prefix: str = '') -> dict[str, Any]:
     return flat
 
 
+def read_yaml_document(path: str | Path) -> Any:
+    """Reads and parses a YAML file.
+
+    Args:
+        path: The file.
+
+    Returns:
+        The parsed document (any YAML value).
+
+    Raises:
+        ConfigError: The file is missing, unreadable or not YAML.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding='utf-8')
+    except FileNotFoundError:
+        raise ConfigError(path, '', 'no such file') from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(path, '', f'cannot read: {exc}') from None
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, 'problem_mark', None)
+        where = f' at line {mark.line + 1}' if mark is not None else ''
+        raise ConfigError(path, '', f'not valid YAML{where}') from None
+
+
 def read_parameter_file(path: str | Path) -> dict[str, Any]:
     """Reads the ``ros__parameters`` of every node section of a parameter file.
 
@@ -51,18 +78,7 @@ def read_parameter_file(path: str | Path) -> dict[str, Any]:
         ConfigError: The file is missing, is not YAML, or is not a ROS 2 parameter file.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding='utf-8')
-    except FileNotFoundError:
-        raise ConfigError(path, '', 'no such file') from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(path, '', f'cannot read: {exc}') from None
-    try:
-        document = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, 'problem_mark', None)
-        where = f' at line {mark.line + 1}' if mark is not None else ''
-        raise ConfigError(path, '', f'not valid YAML{where}') from None
+    document = read_yaml_document(path)
     if not isinstance(document, Mapping) or not document:
         raise ConfigError(path, '', 'expected a mapping of node names to ros__parameters')
     merged: dict[str, Any] = {}

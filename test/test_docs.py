@@ -149,6 +149,9 @@ def json_keys() -> dict[str, set[str]]:
         'bench': dict_keys('cli/bench.py', 'run') | field_names(BenchResult),
         'demo': dict_keys('demo/steps.py', 'summarize'),
         'campaign': set(ID_COLUMNS),
+        'shape': dict_keys('cli/shape.py', 'run')
+        | dict_keys('shaping/vibration.py', 'vibration_summary')
+        | dict_keys('shaping/impulses.py', 'Impulses.as_list'),
     }
 
 

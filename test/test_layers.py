@@ -40,6 +40,7 @@ MATPLOTLIB = 'matplotlib'
 #: Everything else (models, identification, diagnosis, bags, parameters, markers) needs
 #: numpy and scipy only.
 REFUSED: dict[str, frozenset[str]] = {
+    'arm': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'bagio': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'campaign': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'compare': frozenset({ROS, OPENCV, MATPLOTLIB}),

@@ -11,7 +11,12 @@ Usage: ``python tools/design_counts.py [REPO]``. Prints, one line each:
 - tip-series types: classes that hold their own ``z: np.ndarray`` column;
 - readers that decode ``/tip_pose`` from a bag (``pose_values(`` calls outside the node
   callbacks);
-- core modules without a test module (``tools/test_modules.py``).
+- core modules without a test module (``tools/test_modules.py``);
+- node parameters whose literal default or bound is written in more than one place;
+- node parameters declared but never read by what the node runs;
+- places that must change to add an effect, besides its physics;
+- lab modules (benchmarks, synthetic data, validation and scoring against truth, the bag
+  doctor, the demo) imported by the core.
 
 mypy's count is its own command: ``mypy`` (the configuration is ``mypy.ini``).
 """
@@ -19,12 +24,14 @@ mypy's count is its own command: ``mypy`` (the configuration is ``mypy.ini``).
 from __future__ import annotations
 
 import ast
+import importlib
 import importlib.util
 import io
 import re
 import sys
 import tokenize
 from pathlib import Path
+from typing import Any
 
 
 def _load(path: Path, name: str) -> object:
@@ -92,6 +99,386 @@ def _grep(repo: Path, pattern: str, exclude: tuple[str, ...] = ()) -> list[str]:
     return hits
 
 
+# --- One home for every concept: parameters, effects, the lab ---------------------------------
+
+#: Where node parameters are declared and merely carried (not a reader of any of them).
+PLUMBING = (
+    'lumpbeam_ros/params/',
+    'lumpbeam_ros/paramfile.py',
+    'lumpbeam_ros/nodes/ros_parameters.py',
+)
+
+#: Modules of the lab: what proves the product (benchmarks, synthetic data and renderers,
+#: the validation and accuracy scoring against truth, the doctor of our own bags, the demo).
+LAB = (
+    'lumpbeam_ros/bench/',
+    'lumpbeam_ros/demo/',
+    'lumpbeam_ros/synthetic/',
+    'lumpbeam_ros/vision/validation.py',
+    'lumpbeam_ros/vision/accuracy.py',
+    'lumpbeam_ros/bagio/doctor.py',
+)
+
+#: What the product runs: the nodes and the command line import the lab by design (``lumpbeam
+#: synth``, ``bench``, ``demo``); the rest is the core.
+_NOT_CORE = ('lumpbeam_ros/nodes/', 'lumpbeam_ros/cli/', *LAB)
+
+_NODE_MODULES = {
+    'camera_node': 'camera_node',
+    'identifier_node': 'identifier_node',
+    'simulator_node': 'simulator_node',
+    'diagnosis_node': 'diagnosis_node',
+}
+
+
+def _sources(repo: Path) -> dict[str, ast.Module]:
+    """Every module of the package, parsed, by its path relative to ``repo``."""
+    return {
+        path.relative_to(repo).as_posix(): ast.parse(path.read_text())
+        for path in sorted((repo / 'lumpbeam_ros').rglob('*.py'))
+    }
+
+
+def _schemas(repo: Path) -> list[Any]:
+    """The nodes' parameter schemas (``lumpbeam_ros.params.reference.SCHEMAS``)."""
+    sys.path.insert(0, str(repo))
+    try:
+        for name in [
+            m for m in sys.modules if m == 'lumpbeam_ros' or m.startswith('lumpbeam_ros.')
+        ]:
+            del sys.modules[name]
+        reference = importlib.import_module('lumpbeam_ros.params.reference')
+        return list(reference.SCHEMAS)
+    finally:
+        sys.path.remove(str(repo))
+
+
+def _field_names(sources: dict[str, ast.Module]) -> dict[str, str]:
+    """Dotted parameter name -> the core field that holds it under another name.
+
+    A configuration field renamed from its key is declared by a ``PARAMETER_KEYS`` table
+    (``{'window_s': 'window.length_s'}``) or by a field whose declaration names its key
+    (``window_s: float = setting('window.length_s', ...)``).
+    """
+    renamed: dict[str, str] = {}
+    for tree in sources.values():
+        for node in ast.walk(tree):
+            if (
+                isinstance(node, ast.Assign | ast.AnnAssign)
+                and isinstance(node.value, ast.Dict)
+                and 'PARAMETER_KEYS' in ast.unparse(node).split('=')[0]
+            ):
+                for key, value in zip(node.value.keys, node.value.values, strict=True):
+                    if isinstance(key, ast.Constant) and isinstance(value, ast.Constant):
+                        renamed[str(value.value)] = str(key.value)
+            if (
+                isinstance(node, ast.AnnAssign)
+                and isinstance(node.target, ast.Name)
+                and isinstance(node.value, ast.Call)
+                and node.value.args
+                and isinstance(node.value.args[0], ast.Constant)
+                and isinstance(node.value.args[0].value, str)
+            ):
+                renamed.setdefault(str(node.value.args[0].value), node.target.id)
+    return renamed
+
+
+def _numbers(value: Any) -> set[float]:
+    if isinstance(value, bool) or isinstance(value, str):
+        return set()
+    if isinstance(value, int | float):
+        return {float(value)}
+    if isinstance(value, tuple | list):
+        return {float(v) for v in value}
+    return set()
+
+
+def _literal_numbers(node: ast.AST) -> set[float]:
+    """The numbers written as literals in an expression (``-1.5`` and ``(0.0, 0.05)`` too)."""
+    out = set()
+    for sub in ast.walk(node):
+        if isinstance(sub, ast.Constant) and isinstance(sub.value, int | float):
+            if not isinstance(sub.value, bool):
+                out.add(float(sub.value))
+        if (
+            isinstance(sub, ast.UnaryOp)
+            and isinstance(sub.op, ast.USub)
+            and isinstance(sub.operand, ast.Constant)
+            and isinstance(sub.operand.value, int | float)
+        ):
+            out.add(-float(sub.operand.value))
+    return out
+
+
+def _literal_places(
+    sources: dict[str, ast.Module],
+) -> tuple[list[tuple[str, ast.Call]], list[tuple[str, str, int, set[float]]]]:
+    """Calls naming a string, and names given a literal number (fields, arguments)."""
+    calls, named = [], []
+    for rel, tree in sources.items():
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Call) and any(
+                isinstance(a, ast.Constant) and isinstance(a.value, str) for a in node.args
+            ):
+                calls.append((rel, node))
+            elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
+                if isinstance(node.value, ast.Constant | ast.Tuple | ast.UnaryOp):
+                    numbers = _literal_numbers(node.value)
+                    if numbers:
+                        named.append((rel, node.target.id, node.lineno, numbers))
+            elif isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                args = node.args.args[len(node.args.args) - len(node.args.defaults) :]
+                for arg, default in zip(args, node.args.defaults, strict=True):
+                    if isinstance(default, ast.Constant | ast.Tuple | ast.UnaryOp):
+                        numbers = _literal_numbers(default)
+                        if numbers:
+                            named.append((rel, arg.arg, default.lineno, numbers))
+    return calls, named
+
+
+def repeated_parameter_literals(repo: Path) -> list[str]:
+    """Node parameters whose default or bound is written as a literal in more than one place.
+
+    A place is a call that names the parameter's key and writes a number of its default or
+    bounds (a schema declaration, a loader's ``get_float(params, key, source, 2400.0)``), or a
+    class attribute or function argument named after the parameter (its last dotted part or
+    its core field) whose literal default is the parameter's. The parameter files under
+    ``config/`` are not counted: a test holds each equal to its schema. Nor are the effects'
+    parameters (``effects.*``): their defaults are the effects' "off" values, which the count
+    of places to add an effect covers.
+
+    Returns:
+        ``node key: place, place, ...`` for each such parameter.
+    """
+    sources = _sources(repo)
+    fields = _field_names(sources)
+    calls, named = _literal_places(sources)
+    found = []
+    for schema in _schemas(repo):
+        for spec in schema:
+            if spec.name.startswith('effects.'):
+                continue
+            values = _numbers(spec.default)
+            bounds = spec.bounds
+            ends = (
+                [] if bounds is None else [b for b in (bounds.low, bounds.high) if b is not None]
+            )
+            limits = _numbers(ends)
+            names = {spec.name.rpartition('.')[2], fields.get(spec.name, '')} - {''}
+            places = set()
+            for rel, call in calls:
+                if not any(
+                    isinstance(a, ast.Constant) and a.value == spec.name for a in call.args
+                ):
+                    continue
+                written: set[float] = set()
+                for arg in [*call.args, *(k.value for k in call.keywords)]:
+                    written |= _literal_numbers(arg)
+                flags = {k.arg for k in call.keywords} & {'positive', 'non_negative', 'minimum'}
+                if written & (values | limits) or flags:
+                    places.add(f'{rel}:{call.lineno}')
+            for rel, name, line, numbers in named:
+                if name in names and values and numbers <= values:
+                    places.add(f'{rel}:{line}')
+            if len(places) > 1:
+                found.append(f'{schema.node} {spec.name}: {", ".join(sorted(places))}')
+    return found
+
+
+def _imported(tree: ast.Module) -> set[str]:
+    """The package's modules a module imports (``lumpbeam_ros/x/y.py`` paths, or packages)."""
+    out = set()
+    for node in ast.walk(tree):
+        names: list[str] = []
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names = [node.module, *(f'{node.module}.{a.name}' for a in node.names)]
+        elif isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        for name in names:
+            if name.startswith('lumpbeam_ros'):
+                out.add(name.replace('.', '/'))
+    return out
+
+
+def _closure(sources: dict[str, ast.Module], start: str) -> set[str]:
+    """The modules ``start`` imports, directly or not (itself included)."""
+    seen, todo = set(), [start]
+    while todo:
+        rel = todo.pop()
+        if rel in seen or rel not in sources:
+            continue
+        seen.add(rel)
+        for name in _imported(sources[rel]):
+            for candidate in (f'{name}.py', f'{name}/__init__.py'):
+                if candidate in sources:
+                    todo.append(candidate)
+    return seen
+
+
+def _loaders(tree: ast.Module) -> set[int]:
+    """Lines of the functions that only carry parameters into a configuration object."""
+    lines: set[int] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.FunctionDef) and (
+            node.name.endswith(('_from_parameters', '_to_parameters'))
+            or node.name.startswith('load_')
+        ):
+            lines.update(range(node.lineno, (node.end_lineno or node.lineno) + 1))
+    return lines
+
+
+def unread_parameters(repo: Path) -> list[str]:
+    """Node parameters that nothing the node runs reads.
+
+    A parameter is read when code the node imports (directly or not; the parameter plumbing
+    and the loaders that only carry values into a configuration object left out) names its
+    key, or reads the configuration field that holds it (``config.window_s``). A parameter
+    under a section that is a configuration object's field (``synthetic.*`` fills
+    ``CameraConfig.synthetic``) is read only when that section is read.
+
+    Returns:
+        ``node parameter`` for each one never read.
+    """
+    sources = _sources(repo)
+    fields = _field_names(sources)
+    sections = {
+        node.target.id
+        for tree in sources.values()
+        for node in ast.walk(tree)
+        if isinstance(node, ast.ClassDef) and node.name.endswith('Config')
+        for node in node.body
+        if isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name)
+    }
+    found = []
+    for schema in _schemas(repo):
+        node_module = f'lumpbeam_ros/nodes/{schema.node}.py'
+        closure = {rel for rel in _closure(sources, node_module) if not rel.startswith(PLUMBING)}
+        strings: set[str] = set()
+        attributes: set[str] = set()
+        for rel in closure:
+            skip = _loaders(sources[rel])
+            for node in ast.walk(sources[rel]):
+                if getattr(node, 'lineno', 0) in skip:
+                    continue
+                if isinstance(node, ast.Constant) and isinstance(node.value, str):
+                    strings.add(node.value)
+                elif isinstance(node, ast.Attribute):
+                    attributes.add(node.attr)
+        # A key read whole by its loader (its section carried, not named) counts with it.
+        for rel in closure:
+            skip = _loaders(sources[rel])
+            for node in ast.walk(sources[rel]):
+                if getattr(node, 'lineno', 0) in skip and isinstance(node, ast.Constant):
+                    if (
+                        isinstance(node.value, str)
+                        and node.value.partition('.')[0] not in sections
+                    ):
+                        strings.add(node.value)
+        for spec in schema:
+            section, _, rest = spec.name.partition('.')
+            field = fields.get(spec.name, spec.name.rpartition('.')[2])
+            in_section = bool(rest) and section in sections
+            if in_section and section not in attributes:
+                found.append(f'{schema.node} {spec.name}')
+            # A sub-section named by a table (``effects.<name>.*`` through the effect names).
+            elif not (
+                spec.name in strings
+                or field in attributes
+                or in_section
+                or (spec.name.count('.') > 1 and spec.name.split('.')[1] in strings)
+            ):
+                found.append(f'{schema.node} {spec.name}')
+    return found
+
+
+def _effect_names(repo: Path) -> tuple[set[str], set[str]]:
+    """The effect names and their parameters (the table of ``doc/interfaces.md``)."""
+    text = (repo / 'doc' / 'interfaces.md').read_text().partition('## Missing effects')[2]
+    rows = re.findall(r'^\| `([a-z_]+)` \| `([a-z0-9_]+)` \|', text.partition('\n## ')[0], re.M)
+    return {row[0] for row in rows}, {row[1] for row in rows}
+
+
+def effect_places(repo: Path) -> list[str]:
+    """Places that must change to add an effect, besides its physics.
+
+    A place is a statement of the core (the lab's example cases left out) whose literal
+    tables name effects or their parameters (a dict, set, tuple or list with one as a key or
+    an element), or a class with a plain field per effect; a sequence of effect records
+    (each a call naming its effect) is one place.
+
+    Returns:
+        ``file:line: what`` for each place.
+    """
+    effects, parameters = _effect_names(repo)
+    found = []
+    for rel, tree in _sources(repo).items():
+        if rel.startswith(LAB):
+            continue
+        for statement in ast.walk(tree):
+            if isinstance(statement, ast.ClassDef) and statement.name == 'Effects':
+                plain = [
+                    n.target.id
+                    for n in statement.body
+                    if isinstance(n, ast.AnnAssign)
+                    and isinstance(n.target, ast.Name)
+                    and n.target.id in effects | {'coulomb_torque_nm', 'drag_c_q', 'scale_excess'}
+                    and not (isinstance(n.value, ast.Call) and _names_effect(n.value, effects))
+                ]
+                if plain:
+                    found.append(f'{rel}:{statement.lineno}: class Effects, a field per effect')
+            if not isinstance(statement, ast.Assign | ast.AnnAssign | ast.Return | ast.Expr):
+                continue
+            named: set[str] = set()
+            for node in ast.walk(statement):
+                elements: list[ast.AST] = []
+                if isinstance(node, ast.Dict):
+                    elements = [k for k in node.keys if k is not None]
+                elif isinstance(node, ast.Set | ast.Tuple | ast.List):
+                    elements = list(node.elts)
+                    elements += [
+                        e.args[0] for e in node.elts if isinstance(e, ast.Call) and e.args
+                    ]
+                named |= {
+                    str(e.value)
+                    for e in elements
+                    if isinstance(e, ast.Constant) and e.value in effects | parameters
+                }
+            # A parameter's name alone (``mass_kg``) may be another key's; two are a table.
+            if named & effects or len(named & parameters) > 1:
+                found.append(f'{rel}:{statement.lineno}: a table naming {len(named)}')
+    return found
+
+
+def _names_effect(call: ast.Call, effects: set[str]) -> bool:
+    """Whether a call declares an effect record (its name among its literal arguments)."""
+    return any(isinstance(a, ast.Constant) and a.value in effects for a in call.args)
+
+
+def lab_imports(repo: Path) -> list[str]:
+    """Imports of a lab module (:data:`LAB`) by a core module (outside nodes, CLI and lab).
+
+    Returns:
+        ``file:line: module`` for each.
+    """
+    found = []
+    lab_names = tuple(p.removesuffix('.py').removesuffix('/').replace('/', '.') for p in LAB)
+    for rel, tree in _sources(repo).items():
+        if rel.startswith(_NOT_CORE):
+            continue
+        for node in ast.walk(tree):
+            modules: list[str] = []
+            if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                modules = [node.module, *(f'{node.module}.{a.name}' for a in node.names)]
+            elif isinstance(node, ast.Import):
+                modules = [a.name for a in node.names]
+            hits = sorted(
+                {m for m in modules if any(m == n or m.startswith(f'{n}.') for n in lab_names)}
+            )
+            if hits:
+                found.append(f'{rel}:{node.lineno}: {hits[0]}')
+    return found
+
+
 def main(argv: list[str]) -> int:
     """Prints the counts, each with the places that make it up."""
     repo = Path(argv[1]) if len(argv) > 1 else Path(__file__).resolve().parents[1]
@@ -104,6 +491,12 @@ def main(argv: list[str]) -> int:
         'places decoding /tip_pose (the bag reader; nodes on live messages)': _grep(
             repo, r'pose_values\(', ('lumpbeam_ros/bagio/convert.py',)
         ),
+        'node parameters whose literal default or bound is written in more than one place': (
+            repeated_parameter_literals(repo)
+        ),
+        'node parameters declared but never read': unread_parameters(repo),
+        'places to change to add an effect (besides its physics)': effect_places(repo),
+        'lab modules imported by the core': lab_imports(repo),
     }
     for title, hits in rows.items():
         print(f'{title}: {len(hits)}')

@@ -12,6 +12,7 @@ from pathlib import Path
 
 #: The ROS-free core: its packages, and the modules at the top of ``lumpbeam_ros``.
 CORE_PACKAGES = (
+    'arm',
     'bagio',
     'campaign',
     'compare',

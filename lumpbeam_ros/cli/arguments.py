@@ -24,6 +24,28 @@ Subparsers = argparse._SubParsersAction
 Declare = Callable[[Subparsers], argparse.ArgumentParser]
 
 
+class IntermixedParser(argparse.ArgumentParser):
+    """A subcommand's parser that takes positional arguments before, between and after options.
+
+    ``lumpbeam record OUT --duration 1 /tip_pose``: the plain parser assigns every positional
+    at its first run of them (``TOPIC...`` gets none) and then refuses ``/tip_pose``.
+    """
+
+    _intermixing = False
+
+    def parse_known_args(  # type: ignore[override]
+        self, args: Any = None, namespace: Any = None
+    ) -> tuple[argparse.Namespace, list[str]]:
+        """Parses as :meth:`argparse.ArgumentParser.parse_known_intermixed_args` does."""
+        if self._intermixing:  # its own passes call this method again
+            return super().parse_known_args(args, namespace)
+        self._intermixing = True
+        try:
+            return self.parse_known_intermixed_args(args, namespace)
+        finally:
+            self._intermixing = False
+
+
 def _subcommand(name: str, **options: Any) -> Callable[[Callable[..., None]], Declare]:
     """Makes a function that adds a subcommand's arguments the one that declares it.
 
@@ -58,6 +80,9 @@ TRACKER_RATE_HZ = 1000.0
 TRACKER_NOISE_M = 15e-6
 TRACKER_CLOCK_OFFSET_S = 7.3e-3
 TRACKER_POSE = (1.2, -3.0, 0.35, 4.0, -8.0, 100.0)
+
+#: The shapers of ``lumpbeam shape`` (``shaping.shapers.SHAPERS``).
+SHAPER_NAMES = ('zv', 'zvd', 'ei')
 
 TRACK_DESCRIPTION = """\
 Tracks the tip in camera footage and writes OUT, a rosbag2 bag (MCAP) with /tip_pose.
@@ -245,6 +270,52 @@ def add_analyze(parser: argparse.ArgumentParser) -> None:
         '--identifier-config', help='identifier parameter file (default: config/identifier.yaml)'
     )
     add_report(parser)
+
+
+@_subcommand(
+    'shape',
+    help='shape a joint trajectory so that it leaves no vibration (ZV, ZVD, EI)',
+    description='Convolves a joint trajectory file (time_s,joint_1,...,joint_n) with an '
+    'input shaper that cancels the given modes, and writes the shaped trajectory sampled at '
+    '1 kHz (or at the input rate if finer). The modes come from --frequency-hz and '
+    '--damping-ratio (repeat both for several modes) or from --params, the JSON of '
+    'lumpbeam analyze.',
+)
+def add_shape(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam shape IN OUT``."""
+    parser.add_argument('input', metavar='IN', help='joint trajectory file (CSV)')
+    parser.add_argument('output', metavar='OUT', help='shaped trajectory file to write (CSV)')
+    parser.add_argument(
+        '--shaper',
+        choices=SHAPER_NAMES,
+        default='zvd',
+        help='zv: shortest, exact frequency only; zvd: robust to some 15 %% frequency error; '
+        'ei: extra-insensitive, at most 5 %% vibration over a wider band (default: zvd)',
+    )
+    parser.add_argument(
+        '--frequency-hz',
+        type=float,
+        action='append',
+        metavar='F',
+        help="a mode's natural frequency, Hz (repeat for several modes)",
+    )
+    parser.add_argument(
+        '--damping-ratio',
+        type=float,
+        action='append',
+        metavar='Z',
+        help="that mode's damping ratio, in [0, 1) (repeat as --frequency-hz, or give it once "
+        'for every mode; default 0)',
+    )
+    parser.add_argument(
+        '--params',
+        metavar='FILE',
+        help='take the modes from this JSON of lumpbeam analyze (its modes list, else its '
+        'natural_frequency_hz and damping_ratio)',
+    )
+    parser.add_argument(
+        '--json', metavar='FILE', help='write the impulses and the time added as JSON'
+    )
 
 
 @_subcommand(

@@ -28,7 +28,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from lumpbeam_ros.model.chain import LumpedChain
-from lumpbeam_ros.model.parameters import EFFECT_OFF, EFFECT_PARAMETERS, BeamParameters, Effects
+from lumpbeam_ros.model.parameters import EFFECTS, BeamParameters, Effects
 from lumpbeam_ros.model.statics import static_equilibrium
 
 NOMINAL = 'nominal'
@@ -167,26 +167,15 @@ def nominal_candidate() -> Candidate:
     return Candidate(NOMINAL)
 
 
-#: The effects the diagnosis fits today, by their contract names.
-SEARCHED_EFFECTS = (
-    'base_compliance',
-    'coulomb_friction',
-    'quadratic_drag',
-    'added_mass',
-    'sensor_latency',
-    'cubic_stiffness',
-    'sensor_scale',
-    'mount_tilt',
-)
-
-#: Effects whose strength has a sign.
-SIGNED_EFFECTS = frozenset({'cubic_stiffness', 'sensor_scale', 'mount_tilt'})
+#: The effects the diagnosis fits, by their contract names: every effect of the model.
+SEARCHED_EFFECTS = tuple(EFFECTS)
 
 
 def effect_candidates(nominal: BeamParameters) -> list[Candidate]:
     """The effects the diagnosis searches, with ranges scaled to the beam.
 
-    All eight effects of :data:`SEARCHED_EFFECTS`.
+    Every effect of :data:`SEARCHED_EFFECTS`, each searched as its record says
+    (:class:`~lumpbeam_ros.model.parameters.SearchRange`).
 
     Args:
         nominal: The nominal beam; its clamp stiffness, masses and length set the scales.
@@ -197,43 +186,36 @@ def effect_candidates(nominal: BeamParameters) -> list[Candidate]:
     """
     k_clamp = float(nominal.joint_stiffness()[0])
     carried_kg = nominal.tip_mass_kg + nominal.mass_kg
-    clamp_moment = nominal.gravity_mps2 * carried_kg * nominal.length_m
     # A hardening of 1 % of the clamp's tangent stiffness at its unloaded rest angle.
     rest = static_equilibrium(LumpedChain.from_beam(replace(nominal, effects=Effects())))
-    k3_unit = 0.01 * k_clamp / (3.0 * max(float(rest[0]) ** 2, 1e-12))
-    # name: (scale, search_max, plausible_max, start)
-    table = {
-        # Compliance relative to the clamp joint; a mount 20 times softer than the beam's
-        # own root (k_base < k_clamp / 20) is not "a beam on a mount".
-        'base_compliance': (1.0, 1000.0, 20.0, 0.1),
-        # Dry friction beyond a tenth of the clamp's static moment would lock the beam.
-        'coulomb_friction': (1.0, clamp_moment, 0.1 * clamp_moment, 0.1),
-        # c_q = rho C_d A / 2: 20 N s^2/m^2 is a plate of ~30 m^2; a tip body is far less.
-        'quadratic_drag': (1.0, 1e3, 20.0, 0.05),
-        # More than twice what the beam already carries is not an unnoticed bracket.
-        'added_mass': (1.0, 20.0 * carried_kg, 2.0 * carried_kg, 0.03),
-        # Beyond a quarter of a second a camera pipeline is broken, not late.
-        'sensor_latency': (0.01, 2.0, 0.25, 0.002),
-        # Half the clamp's stiffness gained or lost over the swing is not a mild nonlinearity.
-        'cubic_stiffness': (k3_unit, 500.0 * k3_unit, 50.0 * k3_unit, k3_unit),
-        # A camera 30 % off in depth is a wrong calibration, not a small scale error.
-        'sensor_scale': (0.01, 0.9, 0.3, 0.002),
-        # A clamp tilted more than 10 degrees is a different setup, not an unnoticed tilt.
-        'mount_tilt': (0.01, 1.2, 0.175, 0.002),
+    references = {
+        '': 1.0,
+        'clamp_moment': nominal.gravity_mps2 * carried_kg * nominal.length_m,
+        'carried_kg': carried_kg,
+        'k3_unit': 0.01 * k_clamp / (3.0 * max(float(rest[0]) ** 2, 1e-12)),
     }
-    return [
-        Candidate(
-            name,
-            EFFECT_PARAMETERS[name],
-            scale,
-            search_max,
-            plausible,
-            start,
-            reciprocal=name == 'base_compliance',
-            reference=k_clamp,
-            signed=name in SIGNED_EFFECTS,
-            offset=EFFECT_OFF[name],
+    candidates = []
+    for name in SEARCHED_EFFECTS:
+        record = EFFECTS[name]
+        r = record.search
+        scale, search_max, plausible, start = (
+            value * references[per]
+            for value, per in zip(
+                (r.scale, r.search_max, r.plausible_max, r.start), r.per, strict=True
+            )
         )
-        for name in SEARCHED_EFFECTS
-        for scale, search_max, plausible, start in [table[name]]
-    ]
+        candidates.append(
+            Candidate(
+                name,
+                record.parameter,
+                scale,
+                search_max,
+                plausible,
+                start,
+                reciprocal=record.compliance,
+                reference=k_clamp,
+                signed=record.signed,
+                offset=record.off,
+            )
+        )
+    return candidates

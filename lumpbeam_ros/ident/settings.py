@@ -1,105 +1,237 @@
-"""The identifier's settings and their parameter file, ``config/identifier.yaml``."""
+"""The identifier's settings, each field a declared parameter (``config/identifier.yaml``).
+
+The node's parameters (:mod:`lumpbeam_ros.params.identifier_params`), the checks of a
+parameter file, the file itself (a test holds it equal) and ``doc/parameters.md`` all come from
+the fields below.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from lumpbeam_ros.errors import ConfigError
-from lumpbeam_ros.paramfile import (
-    check_known_keys,
-    get_choice,
-    get_float,
-    get_int,
-    read_parameter_file,
+from lumpbeam_ros.paramfile import check_known_keys, read_parameter_file
+from lumpbeam_ros.params.schema import (
+    Bounds,
+    setting,
+    settings_from_parameters,
+    settings_specs,
+    settings_to_parameters,
 )
 from lumpbeam_ros.resources import config_path
+
+_POSITIVE = Bounds(0.0, low_open=True)
+_NON_NEGATIVE = Bounds(0.0)
+_FRACTION = Bounds(0.0, 1.0, low_open=True)
+
+#: Choices of ``fit.nonlinear``.
+NONLINEAR_CHOICES = ('auto', 'always', 'never')
 
 
 @dataclass(frozen=True)
 class IdentifierConfig:
     """Settings of the window, the release detection, the fits and the quality checks.
 
-    Each field is documented at its key in ``config/identifier.yaml``; the key is the field's
-    entry in :data:`PARAMETER_KEYS`.
+    Each field is a parameter: its name, default, range, unit and description are written
+    where it is declared (and ``config/identifier.yaml`` says more at its key).
     """
 
-    window_s: float = 10.0
-    max_rate_hz: float = 400.0
-    reset_jump_back_s: float = 1.0
-    max_gap_s: float = 1.0
-    publish_rate_hz: float = 2.0
-    assumed_load_kg: float = 4.5
-    min_step_snr: float = 20.0
-    min_quiet_s: float = 0.2
-    hint_late_s: float = 1.0
-    hint_early_s: float = 1.0
-    skip_after_release_s: float = 0.02
-    max_modes: int = 2
-    drift: bool = False
-    nonlinear: str = 'auto'
-    nonlinear_min_decay: float = 0.3
-    recheck_every_s: float = 10.0
-    max_fit_s: float = 60.0
-    min_frequency_hz: float = 0.2
-    max_frequency_hz: float = 40.0
-    beam_mass_fraction: float = 0.2357
-    min_samples: int = 50
-    min_cycles: float = 3.0
-    min_amplitude_snr: float = 5.0
-    warn_rel_std_frequency: float = 0.01
-    warn_rel_std_damping: float = 0.25
-    warn_rel_std_stiffness: float = 0.05
-    warn_cross_check_damping: float = 0.5
-    min_release_confidence: float = 0.5
+    window_s: float = setting(
+        'window.length_s', 10.0, 'length of the sliding window analysed', 's', _POSITIVE
+    )
+    max_rate_hz: float = setting(
+        'window.max_rate_hz',
+        400.0,
+        'highest pose rate the window is sized for; faster input shortens the window',
+        'Hz',
+        _POSITIVE,
+    )
+    reset_jump_back_s: float = setting(
+        'window.reset_jump_back_s',
+        1.0,
+        'a stamp this far before the newest one empties the window (a bag looping)',
+        's',
+        _POSITIVE,
+    )
+    max_gap_s: float = setting(
+        'window.max_gap_s',
+        1.0,
+        'a record whose pose stamps pause or jump ahead by more than this is split there; '
+        'analysis keeps the stretch that holds the release and names the rest',
+        's',
+        _POSITIVE,
+    )
+    publish_rate_hz: float = setting(
+        'publish_rate_hz', 2.0, 'how often /beam_params is published', 'Hz', Bounds(0.01, 100.0)
+    )
+    assumed_load_kg: float = setting(
+        'release.assumed_load_kg',
+        4.5,
+        "load assumed to be dropped when /tip_load is absent (the paper's m_l, B.3)",
+        'kg',
+        _POSITIVE,
+    )
+    min_step_snr: float = setting(
+        'release.min_step_snr',
+        20.0,
+        'without /tip_load, a release is a rise of the static level of at least this '
+        'many times the noise of the quiet stretch before it',
+        bounds=_NON_NEGATIVE,
+    )
+    min_quiet_s: float = setting(
+        'release.min_quiet_s',
+        0.2,
+        'the quiet stretch before a release found in the data lasts at least this long',
+        's',
+        _POSITIVE,
+    )
+    hint_late_s: float = setting(
+        'release.hint_late_s',
+        1.0,
+        'a drop on /tip_load only hints that a release happened: the release is looked '
+        'for in the poses from this long before the reading (a late reading) ...',
+        's',
+        _POSITIVE,
+    )
+    hint_early_s: float = setting(
+        'release.hint_early_s',
+        1.0,
+        '... to this long after it (a reading sent before the load actually left)',
+        's',
+        _POSITIVE,
+    )
+    skip_after_release_s: float = setting(
+        'fit.skip_after_release_s',
+        0.02,
+        'samples this soon after the release are left out of the decay fit',
+        's',
+        _NON_NEGATIVE,
+    )
+    max_modes: int = setting(
+        'fit.max_modes',
+        2,
+        'damped modes the least-squares model may hold: 1, or 2 to also fit a second '
+        'mode the matrix pencil finds above the noise',
+        bounds=Bounds(1, 2),
+    )
+    drift: bool = setting(
+        'fit.drift', False, 'add a linear drift to the decay model (a creeping mount)'
+    )
+    nonlinear: str = setting(
+        'fit.nonlinear',
+        'auto',
+        "the first mode's level and frequency in proportion to the squared amplitude: "
+        'auto fits them when the squared amplitude decays by fit.nonlinear_min_decay over '
+        'the fit; always or never',
+        choices=NONLINEAR_CHOICES,
+    )
+    nonlinear_min_decay: float = setting(
+        'fit.nonlinear_min_decay',
+        0.3,
+        "auto's threshold: 2 sigma T, the decay exponent of the squared amplitude over the "
+        'fitted stretch T',
+        bounds=_POSITIVE,
+    )
+    recheck_every_s: float = setting(
+        'fit.recheck_every_s',
+        10.0,
+        'the whole identification is redone at least this often in data time; between, '
+        'each update restarts from the previous solution',
+        's',
+        _POSITIVE,
+    )
+    max_fit_s: float = setting(
+        'fit.max_duration_s',
+        60.0,
+        'the decay fit stops this long after the release',
+        's',
+        _POSITIVE,
+    )
+    min_frequency_hz: float = setting(
+        'fit.min_frequency_hz',
+        0.2,
+        "lowest frequency taken as the beam's first mode",
+        'Hz',
+        _POSITIVE,
+    )
+    max_frequency_hz: float = setting(
+        'fit.max_frequency_hz',
+        40.0,
+        "highest frequency taken as the beam's first mode (above fit.min_frequency_hz)",
+        'Hz',
+        _POSITIVE,
+    )
+    beam_mass_fraction: float = setting(
+        'effective_mass.beam_fraction',
+        0.2357,
+        "fraction of the beam's own mass moving with the tip in the first mode "
+        "(Rayleigh's 33/140), for the stiffness implied by the frequency",
+        bounds=_FRACTION,
+    )
+    min_samples: int = setting(
+        'quality.min_samples',
+        50,
+        'fewer valid samples: status ERROR, no estimate',
+        bounds=Bounds(1),
+    )
+    min_cycles: float = setting(
+        'quality.min_cycles', 3.0, 'fewer fitted cycles: status WARN', bounds=_POSITIVE
+    )
+    min_amplitude_snr: float = setting(
+        'quality.min_amplitude_snr',
+        5.0,
+        "the first mode's amplitude must be this many times the residual noise, else ERROR",
+        bounds=_NON_NEGATIVE,
+    )
+    warn_rel_std_frequency: float = setting(
+        'quality.warn_rel_std_frequency',
+        0.01,
+        "status WARN when the natural frequency's relative std exceeds this",
+        bounds=_POSITIVE,
+    )
+    warn_rel_std_damping: float = setting(
+        'quality.warn_rel_std_damping',
+        0.25,
+        "status WARN when the damping ratio's relative std exceeds this",
+        bounds=_POSITIVE,
+    )
+    warn_rel_std_stiffness: float = setting(
+        'quality.warn_rel_std_stiffness',
+        0.05,
+        "status WARN when k_tE's relative std exceeds this",
+        bounds=_POSITIVE,
+    )
+    warn_cross_check_damping: float = setting(
+        'quality.warn_cross_check_damping',
+        0.5,
+        'status WARN when the matrix-pencil damping ratio differs from the fitted one by '
+        'more than this fraction',
+        bounds=_POSITIVE,
+    )
+    min_release_confidence: float = setting(
+        'quality.min_release_confidence',
+        0.5,
+        'status WARN when the release found in the data has a lower confidence',
+        bounds=_FRACTION,
+    )
+
+    def relation_problem(self) -> tuple[str, str] | None:
+        """What the values break together: ``(key, problem)``, or ``None``."""
+        if self.min_frequency_hz >= self.max_frequency_hz:
+            return 'fit.max_frequency_hz', 'must exceed fit.min_frequency_hz'
+        return None
 
 
-#: Field name -> dotted ROS parameter name.
-PARAMETER_KEYS: dict[str, str] = {
-    'window_s': 'window.length_s',
-    'max_rate_hz': 'window.max_rate_hz',
-    'reset_jump_back_s': 'window.reset_jump_back_s',
-    'max_gap_s': 'window.max_gap_s',
-    'publish_rate_hz': 'publish_rate_hz',
-    'assumed_load_kg': 'release.assumed_load_kg',
-    'min_step_snr': 'release.min_step_snr',
-    'min_quiet_s': 'release.min_quiet_s',
-    'hint_late_s': 'release.hint_late_s',
-    'hint_early_s': 'release.hint_early_s',
-    'skip_after_release_s': 'fit.skip_after_release_s',
-    'max_modes': 'fit.max_modes',
-    'drift': 'fit.drift',
-    'nonlinear': 'fit.nonlinear',
-    'nonlinear_min_decay': 'fit.nonlinear_min_decay',
-    'recheck_every_s': 'fit.recheck_every_s',
-    'max_fit_s': 'fit.max_duration_s',
-    'min_frequency_hz': 'fit.min_frequency_hz',
-    'max_frequency_hz': 'fit.max_frequency_hz',
-    'beam_mass_fraction': 'effective_mass.beam_fraction',
-    'min_samples': 'quality.min_samples',
-    'min_cycles': 'quality.min_cycles',
-    'min_amplitude_snr': 'quality.min_amplitude_snr',
-    'warn_rel_std_frequency': 'quality.warn_rel_std_frequency',
-    'warn_rel_std_damping': 'quality.warn_rel_std_damping',
-    'warn_rel_std_stiffness': 'quality.warn_rel_std_stiffness',
-    'warn_cross_check_damping': 'quality.warn_cross_check_damping',
-    'min_release_confidence': 'quality.min_release_confidence',
-}
-
-#: Choices of ``fit.nonlinear``.
-NONLINEAR_CHOICES = ('auto', 'always', 'never')
-
-# Values that may be zero; every other float must be positive.
-_NON_NEGATIVE = frozenset({'skip_after_release_s', 'min_step_snr', 'min_amplitude_snr'})
-_FRACTIONS = frozenset({'beam_mass_fraction', 'min_release_confidence'})
+#: The parameters of ``config/identifier.yaml``, in the order of the fields.
+IDENTIFIER_SETTINGS = settings_specs(IdentifierConfig)
 
 
 def config_from_parameters(params: Mapping[str, Any], source: str | Path) -> IdentifierConfig:
     """Builds and validates the settings from flat (dotted) ROS parameters.
 
-    Missing keys take the defaults of :class:`IdentifierConfig`.
+    Missing keys take the fields' defaults.
 
     Args:
         params: Flat parameters, from a file or from a node's declared parameters.
@@ -111,45 +243,13 @@ def config_from_parameters(params: Mapping[str, Any], source: str | Path) -> Ide
     Raises:
         ConfigError: An unknown key, a wrong type or a value out of range, naming the key.
     """
-    check_known_keys(params, frozenset(PARAMETER_KEYS.values()), source)
-    defaults = IdentifierConfig()
-    values: dict[str, Any] = {}
-    for f in fields(IdentifierConfig):
-        key = PARAMETER_KEYS[f.name]
-        default = getattr(defaults, f.name)
-        value: str | bool | int | float
-        if isinstance(default, str):
-            value = get_choice(params, key, source, NONLINEAR_CHOICES, default)
-        elif isinstance(default, bool):
-            value = params.get(key, default)
-            if not isinstance(value, bool):
-                raise ConfigError(source, key, f'must be true or false, got {value!r}')
-        elif isinstance(default, int):
-            value = get_int(params, key, source, default, minimum=1)
-        else:
-            value = get_float(
-                params,
-                key,
-                source,
-                default,
-                positive=f.name not in _NON_NEGATIVE,
-                non_negative=f.name in _NON_NEGATIVE,
-            )
-            if f.name in _FRACTIONS and value > 1.0:
-                raise ConfigError(source, key, f'must be at most 1, got {value!r}')
-        values[f.name] = value
-    if values['max_modes'] > 2:
-        raise ConfigError(source, PARAMETER_KEYS['max_modes'], 'must be 1 or 2')
-    if values['min_frequency_hz'] >= values['max_frequency_hz']:
-        raise ConfigError(
-            source, PARAMETER_KEYS['max_frequency_hz'], 'must exceed fit.min_frequency_hz'
-        )
-    return IdentifierConfig(**values)
+    check_known_keys(params, frozenset(spec.name for spec in IDENTIFIER_SETTINGS), source)
+    return settings_from_parameters(IdentifierConfig, params, source)
 
 
 def config_to_parameters(config: IdentifierConfig) -> dict[str, Any]:
     """Returns the flat ROS parameters that read back as ``config`` (for declaring them)."""
-    return {PARAMETER_KEYS[f.name]: getattr(config, f.name) for f in fields(IdentifierConfig)}
+    return settings_to_parameters(config)
 
 
 def load_identifier_config(path: str | Path | None = None) -> IdentifierConfig:

@@ -15,6 +15,11 @@ effects of doc/interfaces.md ("Missing effects") that are forces: dry friction, 
 cubic term ``-k3 phi_1^3`` of joint 1's spring. ``tilt`` is the clamp's pitch below level
 (``mount_tilt``): the segments' angles stay relative to the clamp (``beam_base``), gravity
 acts at ``phi + tilt``.
+
+Segments may differ in length (a flexible arm's links). A spring whose clamp is turned by a
+motor (an arm's joint, doc/arm.md) stretches by ``(D phi)_j - o_j`` with the prescribed offset
+``o_j``; :meth:`LumpedChain.drive_forces` gives the generalized forces ``D^T (k o + c o')`` that
+the offsets add to the right-hand side. The clamped beam has no offsets.
 """
 
 from __future__ import annotations
@@ -41,7 +46,7 @@ class LumpedChain:
     Build one with :meth:`from_beam`; the arrays are not to be modified.
 
     Attributes:
-        segment_length: L_s, m.
+        segment_lengths: Length of each segment, m (L_s for a beam).
         masses: Point masses, kg (segment centres, then tip bodies).
         levers: ``levers[p, i]``: how far mass ``p`` sits along segment ``i`` beyond joint
             ``i`` (L_s for segments before its own, its offset on its own, 0 after).
@@ -55,7 +60,7 @@ class LumpedChain:
         tilt: The clamp's pitch below level, rad.
     """
 
-    segment_length: float
+    segment_lengths: np.ndarray
     masses: np.ndarray
     levers: np.ndarray
     inertia: np.ndarray
@@ -98,7 +103,7 @@ class LumpedChain:
         if k_base > 0.0:
             stiffness[0] = stiffness[0] * k_base / (stiffness[0] + k_base)
         return cls(
-            segment_length=ls,
+            segment_lengths=np.full(n, ls),
             masses=np.concatenate([np.full(n, seg_mass), [tip_mass]]),
             levers=np.vstack([levers, tip_row]),
             inertia=inertia,
@@ -150,6 +155,24 @@ class LumpedChain:
         d = _difference_matrix(self.n)
         return np.asarray(d.T @ (self.damping[:, None] * d))
 
+    def drive_forces(self, offsets: np.ndarray, offset_rates: np.ndarray) -> np.ndarray:
+        """``D^T (k o + c o')``: the generalized forces of springs whose clamps are turned.
+
+        A spring's torque is ``-k ((D phi)_j - o_j) - c ((D phi')_j - o'_j)``; the ``-K phi
+        - C phi'`` part is in :meth:`generalized_forces`, this is the rest. Through ``D^T``
+        the torque acts on the segment after the spring and, reversed, on the one before it
+        (an arm's motor reacting on the previous link).
+
+        Args:
+            offsets: Prescribed offset of each spring, rad, shape (..., n).
+            offset_rates: Their rates, rad/s, same shape.
+
+        Returns:
+            The generalized forces, same shape.
+        """
+        torque = self.stiffness * offsets + self.damping * offset_rates
+        return np.asarray(torque @ _difference_matrix(self.n))
+
     def mass_matrix(self, phi: np.ndarray) -> np.ndarray:
         """M(phi) of B.16 for one configuration (n,)."""
         return np.asarray(
@@ -165,20 +188,20 @@ class LumpedChain:
         Returns:
             x, z and pitch of the free end.
         """
-        ls = self.segment_length
+        ls = self.segment_lengths
         return (
-            ls * np.cos(phi).sum(axis=-1),
-            -ls * np.sin(phi).sum(axis=-1),
+            (ls * np.cos(phi)).sum(axis=-1),
+            -(ls * np.sin(phi)).sum(axis=-1),
             phi[..., -1].copy(),
         )
 
     def tip_velocity(self, phi: np.ndarray, phi_dot: np.ndarray) -> np.ndarray:
         """Velocity (vx, vz) of the free end, shape (..., 2)."""
-        ls = self.segment_length
+        ls = self.segment_lengths
         return np.stack(
             [
-                -ls * (np.sin(phi) * phi_dot).sum(axis=-1),
-                -ls * (np.cos(phi) * phi_dot).sum(axis=-1),
+                -(ls * np.sin(phi) * phi_dot).sum(axis=-1),
+                -(ls * np.cos(phi) * phi_dot).sum(axis=-1),
             ],
             axis=-1,
         )
@@ -206,8 +229,8 @@ class LumpedChain:
         if self.drag_c_q > 0.0:
             v = self.tip_velocity(phi, phi_dot)
             force = -self.drag_c_q * np.linalg.norm(v, axis=-1, keepdims=True) * v
-            # The free end moves by L_s (-sin phi_i, -cos phi_i) per unit of phi_i.
-            ls = self.segment_length
+            # The free end moves by L_i (-sin phi_i, -cos phi_i) per unit of phi_i.
+            ls = self.segment_lengths
             q += -ls * (np.sin(phi) * force[..., :1] + np.cos(phi) * force[..., 1:])
         return q
 

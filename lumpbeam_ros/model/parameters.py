@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any, Literal
 
@@ -20,103 +20,221 @@ from lumpbeam_ros.paramfile import (
     get_int,
     read_parameter_file,
 )
+from lumpbeam_ros.params.schema import Bounds
 from lumpbeam_ros.resources import config_path
 
 StiffnessSource = Literal['analytic', 'identified']
 TipPlacement = Literal['free_end', 'segment_com']
 
-#: doc/interfaces.md, 'Missing effects': each effect's name and its single parameter.
-EFFECT_PARAMETERS: dict[str, str] = {
-    'base_compliance': 'k_base_nm_per_rad',
-    'coulomb_friction': 'torque_nm',
-    'quadratic_drag': 'c_q',
-    'added_mass': 'mass_kg',
-    'sensor_latency': 'latency_s',
-    'cubic_stiffness': 'k3_nm_per_rad3',
-    'sensor_scale': 'scale',
-    'mount_tilt': 'tilt_rad',
-}
-
-#: Each effect's parameter when the effect is off (0 for all but ``sensor_scale``: 1).
-EFFECT_OFF: dict[str, float] = {name: 0.0 for name in EFFECT_PARAMETERS} | {'sensor_scale': 1.0}
-
-#: Physical limits of each effect's parameter: ``(low, high, low_included)``; the high end is
-#: excluded. A negative stiffness, mass, friction, drag or delay, a scale that is not
-#: positive, or a clamp tilted to the vertical or beyond describe no real rig.
-EFFECT_LIMITS: dict[str, tuple[float, float, bool]] = {
-    'base_compliance': (0.0, math.inf, True),
-    'coulomb_friction': (0.0, math.inf, True),
-    'quadratic_drag': (0.0, math.inf, True),
-    'added_mass': (0.0, math.inf, True),
-    'sensor_latency': (0.0, math.inf, True),
-    'cubic_stiffness': (-math.inf, math.inf, False),
-    'sensor_scale': (0.0, math.inf, False),
-    'mount_tilt': (-0.5 * math.pi, 0.5 * math.pi, False),
-}
+#: Where an effect enters the dynamics: the chain's masses, springs and forces
+#: (:meth:`~lumpbeam_ros.model.chain.LumpedChain.from_beam`), the stamps of the measurements
+#: (:func:`~lumpbeam_ros.model.simulate.simulate_loads`, the stream) or the measured position
+#: (:func:`~lumpbeam_ros.model.sensor.scaled_position`).
+EffectHook = Literal['chain', 'stamps', 'position']
 
 
-def effect_value_problem(name: str, value: float) -> str | None:
-    """Why a value is outside an effect's physical limits (:data:`EFFECT_LIMITS`).
+@dataclass(frozen=True)
+class SearchRange:
+    """How the diagnosis searches an effect's strength (:mod:`lumpbeam_ros.diagnose.candidates`).
 
-    Args:
-        name: An effect name of :data:`EFFECT_PARAMETERS`.
-        value: Its parameter, SI.
+    Each number is a multiple of the reference named at its place in :attr:`per` (``''``:
+    SI as it stands; ``'clamp_moment'``: the clamp's static moment of the carried masses, N m;
+    ``'carried_kg'``: the tip's and the beam's masses; ``'k3_unit'``: the cubic term that adds
+    1 % to the clamp's tangent stiffness at its rest angle).
 
-    Returns:
-        ``None`` when the value is physical, else what is wrong, e.g. ``'must be positive'``.
+    Attributes:
+        scale: Unit of the fitted strength.
+        search_max: Largest strength searched.
+        plausible_max: Largest strength a real setup can have.
+        start: Strength a fit starts from: small, but felt by the data.
+        per: The reference of each of the four.
     """
-    low, high, low_included = EFFECT_LIMITS[name]
-    inside = math.isfinite(value) and (value >= low if low_included else value > low)
-    if inside and value < high:
-        return None
-    if low == 0.0 and high == math.inf:
-        wanted = 'zero or positive' if low_included else 'positive'
-    elif math.isinf(low) and math.isinf(high):
-        wanted = 'finite'
-    else:
-        wanted = f'in ({low:.6g}, {high:.6g})'
-    return f'must be {wanted}, got {value!r}'
+
+    scale: float
+    search_max: float
+    plausible_max: float
+    start: float
+    per: tuple[str, str, str, str] = ('', '', '', '')
+
+
+@dataclass(frozen=True)
+class EffectRecord:
+    """One physical effect beyond the paper's model (doc/interfaces.md, "Missing effects").
+
+    Attributes:
+        name: The contract name (``base_compliance``).
+        parameter: Its one parameter's contract name (``k_base_nm_per_rad``).
+        unit: The parameter's unit (empty: none).
+        meaning: What the parameter is, one line.
+        limits: The values the model simulates: physical, and no stiffer, heavier or slower
+            than the integrator handles (a test runs the model at each end).
+        off: The parameter's value that switches the effect off.
+        hook: Where it enters the dynamics (:data:`EffectHook`).
+        search: How the diagnosis searches it.
+        signed: Its strength has a sign (searched on both sides of off).
+        compliance: The diagnosis fits ``k_clamp / value`` (0: off) instead of the value, for
+            an effect whose off value would be an infinite stiffness.
+    """
+
+    name: str
+    parameter: str
+    unit: str
+    meaning: str
+    limits: Bounds
+    off: float
+    hook: EffectHook
+    search: SearchRange
+    signed: bool = False
+    compliance: bool = False
+
+    def problem(self, value: float) -> str | None:
+        """Why ``value`` is outside :attr:`limits` (``None``: inside).
+
+        Returns:
+            ``None``, or e.g. ``'must be in [0, 1], got 1.5'``.
+        """
+        if math.isfinite(value) and self.limits.contains(value):
+            return None
+        return f'must be {self.limits.describe()}, got {value!r}'
+
+
+def _effect(record: EffectRecord) -> Any:
+    """The :class:`Effects` field of an effect: off by default, its record attached."""
+    return field(default=record.off, metadata={'effect': record})
 
 
 @dataclass(frozen=True)
 class Effects:
-    """Physical effects beyond the paper's model (doc/interfaces.md, "Missing effects").
+    """Physical effects beyond the paper's model, one field and record each.
 
-    Every field is 0 when its effect is off; ``sensor_scale`` is therefore stored as its
-    excess over 1 (:meth:`value` and :meth:`with_effect` speak the parameter itself).
-
-    Attributes:
-        k_base_nm_per_rad: Wall-mount rotational spring in series with joint 1 (0: rigid).
-        coulomb_torque_nm: Dry friction torque at joint 1.
-        drag_c_q: Quadratic aerodynamic drag on the tip, N s^2/m^2.
-        added_mass_kg: Unmodelled point mass at the tip.
-        latency_s: Constant delay of the measurement stamps.
-        k3_nm_per_rad3: Cubic term of joint 1's spring, torque ``k theta + k3 theta^3``
-            (hardening > 0, softening < 0), N m/rad^3.
-        scale_excess: ``scale - 1``: the measured tip displacement from rest is ``scale``
-            times the true one (a camera with a wrong depth).
-        tilt_rad: The clamp's pitch below level: gravity loads the beam at this angle.
+    A field is the effect's contract parameter, SI, and equals the record's ``off`` when the
+    effect is off (0 for all but ``sensor_scale``: 1). Adding an effect is one field here
+    plus its physics at its hook.
     """
 
-    k_base_nm_per_rad: float = 0.0
-    coulomb_torque_nm: float = 0.0
-    drag_c_q: float = 0.0
-    added_mass_kg: float = 0.0
-    latency_s: float = 0.0
-    k3_nm_per_rad3: float = 0.0
-    scale_excess: float = 0.0
-    tilt_rad: float = 0.0
+    k_base_nm_per_rad: float = _effect(
+        EffectRecord(
+            'base_compliance',
+            'k_base_nm_per_rad',
+            'N m/rad',
+            'the wall mount is a rotational spring in series with joint 1 (0: rigid)',
+            # A mount a million times stiffer than any joint of a lab beam is rigid.
+            Bounds(0.0, 1e10),
+            0.0,
+            'chain',
+            # Compliance relative to the clamp joint; a mount 20 times softer than the beam's
+            # own root (k_base < k_clamp / 20) is not "a beam on a mount".
+            SearchRange(1.0, 1000.0, 20.0, 0.1),
+            compliance=True,
+        )
+    )
+    coulomb_torque_nm: float = _effect(
+        EffectRecord(
+            'coulomb_friction',
+            'torque_nm',
+            'N m',
+            'dry friction torque at joint 1',
+            Bounds(0.0, 1000.0),
+            0.0,
+            'chain',
+            # Dry friction beyond a tenth of the clamp's static moment would lock the beam.
+            SearchRange(1.0, 1.0, 0.1, 0.1, ('', 'clamp_moment', 'clamp_moment', '')),
+        )
+    )
+    drag_c_q: float = _effect(
+        EffectRecord(
+            'quadratic_drag',
+            'c_q',
+            'N s^2/m^2',
+            'aerodynamic force -c_q abs(v) v on the tip',
+            Bounds(0.0, 20.0),
+            0.0,
+            'chain',
+            # c_q = rho C_d A / 2: 20 N s^2/m^2 is a plate of ~30 m^2; a tip body is far less.
+            SearchRange(1.0, 1e3, 20.0, 0.05),
+        )
+    )
+    added_mass_kg: float = _effect(
+        EffectRecord(
+            'added_mass',
+            'mass_kg',
+            'kg',
+            'an unmodelled point mass at the tip (a camera, a bracket)',
+            Bounds(0.0, 100.0),
+            0.0,
+            'chain',
+            # More than twice what the beam already carries is not an unnoticed bracket.
+            SearchRange(1.0, 20.0, 2.0, 0.03, ('', 'carried_kg', 'carried_kg', '')),
+        )
+    )
+    latency_s: float = _effect(
+        EffectRecord(
+            'sensor_latency',
+            'latency_s',
+            's',
+            'measurement stamps are late by a constant delay',
+            Bounds(0.0, 1.0),
+            0.0,
+            'stamps',
+            # Beyond a quarter of a second a camera pipeline is broken, not late.
+            SearchRange(0.01, 2.0, 0.25, 0.002),
+        )
+    )
+    k3_nm_per_rad3: float = _effect(
+        EffectRecord(
+            'cubic_stiffness',
+            'k3_nm_per_rad3',
+            'N m/rad^3',
+            "joint 1's torque is k theta + k3 theta^3 (hardening > 0, softening < 0)",
+            # Softening: the spring's torque peaks at (2/3) k theta* with theta* = sqrt(k / 3|k3|),
+            # so a clamp (k ~ 3.9e4 N m/rad on the paper's beam) carrying a static moment M
+            # snaps through beyond |k3| = 4 k^3 / (27 M^2), 2.7e8 with the paper's load (the
+            # integration then runs away). Hardening: beyond 1e9 the swing of a release
+            # (0.02 rad) multiplies the tangent stiffness thirty-fold and the integration
+            # stalls on its steps.
+            Bounds(-1e8, 1e9),
+            0.0,
+            'chain',
+            # Half the clamp's stiffness gained or lost over the swing is not a mild
+            # nonlinearity.
+            SearchRange(1.0, 500.0, 50.0, 1.0, ('k3_unit',) * 4),
+            signed=True,
+        )
+    )
+    scale: float = _effect(
+        EffectRecord(
+            'sensor_scale',
+            'scale',
+            '',
+            'the measured displacement from rest is scale times the true one (1: true)',
+            Bounds(0.0, 10.0, low_open=True),
+            1.0,
+            'position',
+            # A camera 30 % off in depth is a wrong calibration, not a small scale error.
+            SearchRange(0.01, 0.9, 0.3, 0.002),
+            signed=True,
+        )
+    )
+    tilt_rad: float = _effect(
+        EffectRecord(
+            'mount_tilt',
+            'tilt_rad',
+            'rad',
+            'the clamp is pitched this far below level: gravity loads the beam at phi + tilt',
+            # Short of vertical: a clamp at +-90 degrees is a hanging or standing beam.
+            Bounds(-1.5, 1.5),
+            0.0,
+            'chain',
+            # A clamp tilted more than 10 degrees is a different setup, not an unnoticed tilt.
+            SearchRange(0.01, 1.2, 0.175, 0.002),
+            signed=True,
+        )
+    )
 
-    _FIELDS = {
-        'base_compliance': 'k_base_nm_per_rad',
-        'coulomb_friction': 'coulomb_torque_nm',
-        'quadratic_drag': 'drag_c_q',
-        'added_mass': 'added_mass_kg',
-        'sensor_latency': 'latency_s',
-        'cubic_stiffness': 'k3_nm_per_rad3',
-        'sensor_scale': 'scale_excess',
-        'mount_tilt': 'tilt_rad',
-    }
+    @classmethod
+    def records(cls) -> tuple[EffectRecord, ...]:
+        """Every effect's record, in the order of doc/interfaces.md, "Missing effects"."""
+        return tuple(f.metadata['effect'] for f in fields(cls))
 
     def with_effect(self, name: str, value: float) -> Effects:
         """Returns a copy with one effect (by its name) set to ``value`` (its SI parameter).
@@ -124,28 +242,45 @@ class Effects:
         Raises:
             KeyError: ``name`` is not an effect of :data:`EFFECT_PARAMETERS`.
         """
-        return replace(self, **{self._FIELDS[name]: float(value) - EFFECT_OFF[name]})
+        return replace(self, **{_FIELD[name]: float(value)})
 
     def value(self, name: str) -> float:
         """Returns the parameter of one effect (SI), by its name."""
-        return float(getattr(self, self._FIELDS[name])) + EFFECT_OFF[name]
+        return float(getattr(self, _FIELD[name]))
 
     def active(self) -> dict[str, float]:
         """Returns the effects that are switched on, by name."""
-        return {
-            name: self.value(name)
-            for name, attr in self._FIELDS.items()
-            if float(getattr(self, attr)) != 0.0
-        }
-
-    @property
-    def scale(self) -> float:
-        """The ``sensor_scale`` parameter (1: a true sensor)."""
-        return 1.0 + self.scale_excess
+        return {r.name: self.value(r.name) for r in self.records() if self.value(r.name) != r.off}
 
     def physical(self) -> Effects:
-        """The effects on the beam itself: the sensor's (latency, scale) switched off."""
-        return replace(self, latency_s=0.0, scale_excess=0.0)
+        """The effects on the beam itself: the sensor's (at the stamps, the position) off."""
+        sensor = {_FIELD[r.name]: r.off for r in self.records() if r.hook != 'chain'}
+        return replace(self, **sensor)
+
+
+#: Every effect's record, by name.
+EFFECTS: dict[str, EffectRecord] = {r.name: r for r in Effects.records()}
+_FIELD: dict[str, str] = {f.metadata['effect'].name: f.name for f in fields(Effects)}
+
+#: Each effect's name and its single parameter.
+EFFECT_PARAMETERS: dict[str, str] = {name: r.parameter for name, r in EFFECTS.items()}
+
+#: Each effect's parameter when the effect is off.
+EFFECT_OFF: dict[str, float] = {name: r.off for name, r in EFFECTS.items()}
+
+
+def effect_value_problem(name: str, value: float) -> str | None:
+    """Why a value is outside an effect's limits (:attr:`EffectRecord.limits`).
+
+    Args:
+        name: An effect name of :data:`EFFECTS`.
+        value: Its parameter, SI.
+
+    Returns:
+        ``None`` when the model simulates it, else what is wrong, e.g.
+        ``'must be in [0, 1], got 1.5'``.
+    """
+    return EFFECTS[name].problem(value)
 
 
 @dataclass(frozen=True)

@@ -8,16 +8,24 @@ from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.parameters import BeamParameters
 
 
-def static_equilibrium(chain: LumpedChain, tol: float = 1e-13, max_iter: int = 50) -> np.ndarray:
-    """Solves ``K phi + k3 phi_1^3 e_1 = g G cos(phi + tilt)`` (B.16 at rest) by Newton.
+def static_equilibrium(
+    chain: LumpedChain,
+    tol: float = 1e-13,
+    max_iter: int = 50,
+    offsets: np.ndarray | None = None,
+) -> np.ndarray:
+    """Solves ``K phi + k3 phi_1^3 e_1 = g G cos(phi + tilt) + D^T k o`` (B.16 at rest) by Newton.
 
-    The beam's deflections are small against its stiffness, so Newton from the straight
-    beam converges in a few steps; large rotations converge too, only slower.
+    The deflections are small against the springs, so Newton from the undeflected chain (the
+    straight beam, or an arm's links straight at its joint offsets ``o``) converges in a few
+    steps; large rotations converge too, only slower.
 
     Args:
         chain: The chain, with its tip masses.
         tol: Convergence threshold on the angle update, rad.
         max_iter: Iteration limit.
+        offsets: Prescribed spring offsets (an arm's joint angles at its links' first
+            springs, see :meth:`LumpedChain.drive_forces`); ``None``: none.
 
     Returns:
         The segment angles at rest, shape (n,).
@@ -27,9 +35,14 @@ def static_equilibrium(chain: LumpedChain, tol: float = 1e-13, max_iter: int = 5
     """
     k = chain.stiffness_matrix
     k3 = chain.cubic_stiffness
-    phi = np.zeros(chain.n)
+    if offsets is None:
+        phi = np.zeros(chain.n)
+        drive = np.zeros(chain.n)
+    else:
+        phi = np.cumsum(offsets)
+        drive = chain.drive_forces(offsets, np.zeros(chain.n))
     for _ in range(max_iter):
-        residual = k @ phi - chain.gravity_forces(phi)
+        residual = k @ phi - chain.gravity_forces(phi) - drive
         residual[0] += k3 * phi[0] ** 3
         jacobian = k + np.diag(chain.gravity_stiffness(phi))
         jacobian[0, 0] += chain.cubic_tangent(phi)

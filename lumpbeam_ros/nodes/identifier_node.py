@@ -34,7 +34,11 @@ from lumpbeam_ros.bagio.convert import pose_values
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.identification import Identification, Status
 from lumpbeam_ros.ident.identify import FitState, identify_from
-from lumpbeam_ros.ident.settings import PARAMETER_KEYS, IdentifierConfig, config_from_parameters
+from lumpbeam_ros.ident.settings import (
+    IDENTIFIER_SETTINGS,
+    IdentifierConfig,
+    config_from_parameters,
+)
 from lumpbeam_ros.ident.window import SlidingWindow
 from lumpbeam_ros.interface import BASE_FRAME, BEAM_PARAMS, IDENTIFIER_STATUS, TIP_LOAD, TIP_POSE
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
@@ -60,7 +64,7 @@ class IdentifierNode(SchemaNode):
     def __init__(self, **options: Unpack[NodeOptions]):
         super().__init__(IDENTIFIER_SCHEMA, **options)
         values = self.parameter_values
-        settings = {key: values[key] for key in PARAMETER_KEYS.values()}
+        settings = {spec.name: values[spec.name] for spec in IDENTIFIER_SETTINGS}
         self.config: IdentifierConfig = config_from_parameters(
             settings, f'{self.get_name()} parameters'
         )

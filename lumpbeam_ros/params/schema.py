@@ -19,8 +19,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
-from typing import Literal, TypeAlias
+from dataclasses import Field, dataclass, field, fields
+from pathlib import Path
+from typing import Any, ClassVar, Literal, Protocol, TypeAlias, TypeVar, cast
+
+from lumpbeam_ros.errors import ConfigError
 
 #: The ROS parameter types a schema may declare.
 ParameterKind: TypeAlias = Literal['bool', 'int', 'double', 'string', 'double[]']
@@ -204,12 +207,15 @@ class ParameterSchema:
         parameters: The parameters, in the order they are documented.
         config_file: The package's parameter file under ``config/`` whose values are the
             defaults (empty: none); a test holds the two equal.
+        file_only: Parameters of ``config_file`` that the node does not declare, for the
+            commands that read the file (documented with the node).
     """
 
     node: str
     summary: str
     parameters: tuple[ParameterSpec, ...]
     config_file: str = ''
+    file_only: tuple[ParameterSpec, ...] = ()
     _by_name: dict[str, ParameterSpec] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -267,3 +273,113 @@ class ParameterSchema:
                 if problem is not None:
                     return problem
         return None
+
+
+# --- Settings: a configuration object whose fields are declared parameters ---------------------
+
+_T = TypeVar('_T', bound=ParameterValue)
+
+
+class Settings(Protocol):
+    """A dataclass whose every field is declared with :func:`setting`."""
+
+    __dataclass_fields__: ClassVar[dict[str, Field[Any]]]
+
+
+_S = TypeVar('_S', bound=Settings)
+
+
+def _kind(default: object) -> ParameterKind:
+    if isinstance(default, bool):
+        return 'bool'
+    if isinstance(default, int):
+        return 'int'
+    if isinstance(default, float):
+        return 'double'
+    if isinstance(default, str):
+        return 'string'
+    return 'double[]'
+
+
+def setting(
+    name: str,
+    default: _T,
+    description: str,
+    unit: str = '',
+    bounds: Bounds | None = None,
+    choices: tuple[str, ...] = (),
+) -> _T:
+    """Declares a configuration field as a node parameter: the one place it is written.
+
+    The field's type follows its default (``bool``, ``int``, ``float``, ``str`` or a tuple of
+    floats, a ``double[]`` of that length). Used as a dataclass field's default::
+
+        window_s: float = setting('window.length_s', 10.0, 'length of the window', 's', POSITIVE)
+
+    Args:
+        name: The dotted parameter name.
+        default: The default value.
+        description: One line (what ``ros2 param describe`` shows).
+        unit: The unit (empty: none).
+        bounds: The interval a number must lie in.
+        choices: The values a string may take.
+
+    Returns:
+        The dataclass field (typed as its value, for the type checker).
+    """
+    kind = _kind(default)
+    length = len(cast(tuple[float, ...], default)) if kind == 'double[]' else None
+    spec = ParameterSpec(name, kind, default, description, unit, bounds, choices, length)
+    return field(default=default, metadata={'parameter': spec})
+
+
+def settings_specs(cls: type[Settings]) -> tuple[ParameterSpec, ...]:
+    """The parameters a settings class declares, in field order."""
+    return tuple(f.metadata['parameter'] for f in fields(cls))
+
+
+def _typed(spec: ParameterSpec, value: object) -> object:
+    if spec.kind == 'double':
+        return float(cast(float, value))
+    if spec.kind == 'double[]':
+        return tuple(float(v) for v in cast(Sequence[float], value))
+    return value
+
+
+def settings_from_parameters(cls: type[_S], params: Mapping[str, Any], source: str | Path) -> _S:
+    """Builds a settings object from flat (dotted) parameters, checked against its fields.
+
+    A missing parameter takes its default. After each value is checked alone, a class that
+    relates its values has its ``relation_problem()`` asked (``(key, what is wrong)`` or
+    ``None``).
+
+    Args:
+        cls: The settings class.
+        params: Flat parameters (a parameter file's, a node's); others are ignored.
+        source: Where they came from, for error messages.
+
+    Returns:
+        The settings.
+
+    Raises:
+        ConfigError: A wrong type, a value out of range or a broken relation, naming the key.
+    """
+    values = {}
+    for f in fields(cls):
+        spec: ParameterSpec = f.metadata['parameter']
+        value = params.get(spec.name, spec.default)
+        problem = spec.problem(value)
+        if problem is not None:
+            raise ConfigError(source, spec.name, problem)
+        values[f.name] = _typed(spec, value)
+    settings = cls(**values)
+    relation = getattr(settings, 'relation_problem', None)
+    broken = relation() if relation is not None else None
+    if broken is not None:
+        raise ConfigError(source, broken[0], broken[1])
+    return settings
+
+
+def settings_to_parameters(settings: Settings) -> dict[str, Any]:
+    """The flat parameters that read back as ``settings``."""
+    return {f.metadata['parameter'].name: getattr(settings, f.name) for f in fields(settings)}

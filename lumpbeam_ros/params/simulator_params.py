@@ -3,38 +3,25 @@
 from __future__ import annotations
 
 from lumpbeam_ros.interface import SIMULATOR_NODE
-from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, Effects
+from lumpbeam_ros.model.parameters import EFFECTS, EffectRecord
 from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec
-
-#: Physical bounds and unit of each effect's parameter; an effect missing here is only
-#: checked to be finite.
-EFFECT_BOUNDS: dict[str, tuple[Bounds, str]] = {
-    'k_base_nm_per_rad': (Bounds(0.0), 'N m/rad'),  # 0: a rigid mount
-    'torque_nm': (Bounds(0.0, 1000.0), 'N m'),
-    'c_q': (Bounds(0.0, 1000.0), 'N s^2/m^2'),
-    'mass_kg': (Bounds(0.0, 1000.0), 'kg'),
-    'latency_s': (Bounds(0.0, 1.0), 's'),
-    'k3_nm_per_rad3': (Bounds(-1e12, 1e12), 'N m/rad^3'),  # hardening > 0, softening < 0
-    'scale': (Bounds(0.0, 10.0, low_open=True), ''),  # 1: a camera that measures true
-    'tilt_rad': (Bounds(-1.5, 1.5), 'rad'),
-}
 
 
 def effect_parameter_name(effect: str) -> str:
     """The simulator's parameter of an effect: ``effects.<effect>.<contract parameter>``."""
-    return f'effects.{effect}.{EFFECT_PARAMETERS[effect]}'
+    return f'effects.{effect}.{EFFECTS[effect].parameter}'
 
 
-def _effect_spec(effect: str, parameter: str) -> ParameterSpec:
-    bounds, unit = EFFECT_BOUNDS.get(parameter, (None, ''))
+def _effect_spec(record: EffectRecord) -> ParameterSpec:
     return ParameterSpec(
-        effect_parameter_name(effect),
+        effect_parameter_name(record.name),
         'double',
-        Effects().value(effect),
-        f'the {effect} effect the beam runs with (as in the beam file, whose value it takes '
-        'at start unless given); set at run time, the beam keeps its motion',
-        unit,
-        bounds,
+        record.off,
+        f'{record.meaning}: the {record.name} effect the beam runs with (as in the beam file, '
+        'whose value it takes at start unless given); set at run time, the beam keeps its '
+        'motion',
+        record.unit,
+        record.limits,
         read_only=False,
     )
 
@@ -125,6 +112,6 @@ SIMULATOR_SCHEMA = ParameterSchema(
             "package's camera.yaml",
             read_only=False,
         ),
-        *(_effect_spec(effect, parameter) for effect, parameter in EFFECT_PARAMETERS.items()),
+        *(_effect_spec(record) for record in EFFECTS.values()),
     ),
 )

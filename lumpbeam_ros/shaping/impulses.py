@@ -79,9 +79,9 @@ class Impulses:
         """
         times = np.add.outer(self.time_s, other.time_s).ravel()
         amplitudes = np.multiply.outer(self.amplitude, other.amplitude).ravel()
-        merged, index = np.unique(np.round(times, 12), return_inverse=True)
+        _, first, index = np.unique(np.round(times, 12), return_index=True, return_inverse=True)
         summed = np.bincount(index.ravel(), weights=amplitudes)
-        return Impulses(merged.astype(float), summed / summed.sum())
+        return Impulses(times[first], summed / summed.sum())
 
     def as_list(self) -> list[dict[str, float]]:
         """The JSON form: a list of ``{time_s, amplitude}``."""

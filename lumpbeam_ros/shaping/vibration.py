@@ -18,6 +18,7 @@ unshaped command taken as issued at the last impulse's time (at once, the ratio 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -86,3 +87,36 @@ def insensitivity_band(impulses: Impulses, mode: Mode, tolerance: float) -> tupl
         else _BAND_SCAN[-1]
     )
     return float(low_end * f), float(high_end * f)
+
+
+#: Relative frequency error at which :func:`vibration_summary` reports the vibration left.
+FREQUENCY_ERROR = 0.15
+
+
+def vibration_summary(impulses: Impulses, mode: Mode, tolerance: float = 0.05) -> dict[str, Any]:
+    """What a shaper leaves of a mode's vibration: at the mode, 15 % off, and the band.
+
+    Args:
+        impulses: The shaper.
+        mode: One of the modes it was designed for.
+        tolerance: The vibration accepted in the band, fraction.
+
+    Returns:
+        ``natural_frequency_hz``, ``damping_ratio``, ``vibration_left`` (fraction ``V`` at
+        the mode), ``vibration_left_15pct_low`` and ``_high`` (at 0.85 and 1.15 times its
+        frequency), ``band_hz`` (``[low, high]`` where ``V <= tolerance``) and
+        ``band_tolerance``.
+    """
+    f = mode.frequency_hz
+    left = residual_vibration(
+        impulses, [f, f * (1 - FREQUENCY_ERROR), f * (1 + FREQUENCY_ERROR)], mode.damping_ratio
+    )
+    return {
+        'natural_frequency_hz': f,
+        'damping_ratio': mode.damping_ratio,
+        'vibration_left': float(left[0]),
+        'vibration_left_15pct_low': float(left[1]),
+        'vibration_left_15pct_high': float(left[2]),
+        'band_hz': list(insensitivity_band(impulses, mode, tolerance)),
+        'band_tolerance': tolerance,
+    }

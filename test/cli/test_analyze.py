@@ -150,7 +150,7 @@ def test_bad_identifier_config_is_one_line(drop_bag, tmp_path, capsys):
     bad = tmp_path / 'ident.yaml'
     bad.write_text('/**:\n  ros__parameters:\n    fit:\n      max_modes: 7\n')
     assert main(['analyze', str(drop_bag), '--identifier-config', str(bad)]) == 2
-    assert 'fit.max_modes: must be 1 or 2' in _error_line(capsys)
+    assert 'fit.max_modes: must be in [1, 2], got 7' in _error_line(capsys)
 
 
 def _rewritten(drop_bag, out, edit):

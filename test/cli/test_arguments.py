@@ -60,3 +60,9 @@ def test_a_report_that_is_not_html_is_refused_before_any_work(command, name, cap
         build_parser().parse_args([*command, '--report', name])
     assert exit_.value.code == 2
     assert f"the report is an HTML file (FILE.html), not '{name}'" in capsys.readouterr().err
+
+
+def test_shaper_choices_are_the_cores():
+    from lumpbeam_ros.shaping.shapers import SHAPERS
+
+    assert arguments.SHAPER_NAMES == tuple(SHAPERS)

@@ -4,7 +4,7 @@ import pytest
 
 from lumpbeam_ros.errors import ConfigError
 from lumpbeam_ros.ident.settings import (
-    PARAMETER_KEYS,
+    IDENTIFIER_SETTINGS,
     IdentifierConfig,
     config_from_parameters,
     config_to_parameters,
@@ -17,7 +17,7 @@ from lumpbeam_ros.resources import config_path
 def test_default_file_matches_the_dataclass_and_documents_every_key():
     path = config_path('identifier.yaml')
     assert load_identifier_config() == IdentifierConfig()
-    assert set(read_parameter_file(path)) == set(PARAMETER_KEYS.values())
+    assert set(read_parameter_file(path)) == {spec.name for spec in IDENTIFIER_SETTINGS}
     lines = path.read_text().splitlines()
     for i, line in enumerate(lines):
         match = re.match(r'\s+(\w+): \S', line)
@@ -35,13 +35,13 @@ def test_round_trip_through_parameters():
     [
         ('window.length_s', -1.0, 'must be positive'),
         ('window.length_s', 'long', 'must be a number'),
-        ('fit.max_modes', 3, 'must be 1 or 2'),
-        ('fit.max_modes', 0, 'at least 1'),
+        ('fit.max_modes', 3, r'must be in \[1, 2\], got 3'),
+        ('fit.max_modes', 0, r'must be in \[1, 2\], got 0'),
         ('fit.drift', 'yes', 'true or false'),
         ('fit.nonlinear', 'sometimes', 'one of'),
         ('fit.nonlinear_min_decay', 0.0, 'must be positive'),
         ('fit.min_frequency_hz', 50.0, 'must exceed'),
-        ('quality.min_release_confidence', 2.0, 'at most 1'),
+        ('quality.min_release_confidence', 2.0, r'must be in \(0, 1\]'),
         ('window.lenght_s', 10.0, 'unknown key'),
     ],
 )

@@ -18,7 +18,7 @@ def _chain(n_segments: int, load_kg: float = 0.0, **chain_changes) -> LumpedChai
 
 def _mass_positions(chain: LumpedChain, phi: np.ndarray) -> np.ndarray:
     """(x, z) of every point mass, from the joints' positions (B.17), not from the levers."""
-    ls = chain.segment_length
+    ls = chain.segment_lengths[0]
     steps = ls * np.stack([np.cos(phi), -np.sin(phi)], axis=-1)
     joints = np.vstack([[0.0, 0.0], np.cumsum(steps, axis=0)])
     direction = steps / ls
@@ -97,7 +97,7 @@ def test_power_balance_along_the_motion(n_segments, damped):
 def test_straight_beam_tip_pose(angle):
     chain = _chain(5)
     x, z, pitch = chain.tip_pose(np.full(5, angle))
-    length = 5 * chain.segment_length
+    length = chain.segment_lengths.sum()
     assert length == pytest.approx(BEAM.length_m)
     assert (x, z, pitch) == pytest.approx((length * np.cos(angle), -length * np.sin(angle), angle))
 

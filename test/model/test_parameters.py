@@ -1,15 +1,22 @@
 from dataclasses import replace
+from pathlib import Path
 
+import numpy as np
 import pytest
 
 from lumpbeam_ros.cli.main import main
 from lumpbeam_ros.errors import ConfigError
 from lumpbeam_ros.model.parameters import (
+    EFFECT_PARAMETERS,
+    EFFECTS,
     BeamParameters,
     DropTestConfig,
+    Effects,
+    effect_value_problem,
     load_beam_config,
     write_beam_config,
 )
+from lumpbeam_ros.model.simulate import simulate_drop_test
 
 GOOD = """\
 /**:
@@ -63,17 +70,17 @@ def test_roundtrip(tmp_path):
         (
             'effects:\n      sensor_scale:\n        scale: 0.0',
             'effects.sensor_scale.scale',
-            'must be positive',
+            'must be in (0, 10]',
         ),
         (
             'effects:\n      mount_tilt:\n        tilt_rad: -2.0',
             'effects.mount_tilt.tilt_rad',
-            'must be in (-1.5708, 1.5708)',
+            'must be in [-1.5, 1.5]',
         ),
         (
             'effects:\n      added_mass:\n        mass_kg: -0.1',
             'effects.added_mass.mass_kg',
-            'must be zero or positive',
+            'must be in [0, 100]',
         ),
     ],
 )
@@ -111,3 +118,67 @@ def test_cli_reports_one_line_and_exit_2(tmp_path, capsys):
     assert err.count('\n') == 0
     assert 'beam.length_m' in err and str(path) in err
     assert 'Traceback' not in err
+
+
+def _ends(record):
+    """The ends of an effect's limits, an open end taken just inside."""
+    limits, ends = record.limits, []
+    if limits.low is not None:
+        ends.append(
+            limits.low + (1e-6 * max(abs(limits.high or 1.0), 1.0) if limits.low_open else 0.0)
+        )
+    if limits.high is not None:
+        ends.append(limits.high)
+    return ends
+
+
+_BOUND_CASES = [(r.name, v) for r in Effects.records() for v in _ends(r)]
+
+
+@pytest.mark.filterwarnings('error')
+@pytest.mark.parametrize(
+    ('name', 'value'), _BOUND_CASES, ids=[f'{n}={v:g}' for n, v in _BOUND_CASES]
+)
+def test_the_model_simulates_each_effect_at_each_end_of_its_limits(name, value):
+    # A value the limits take reaches the simulator node and the diagnosis's prediction: the
+    # drop test (loaded, released, ringing) must run to its end with a finite pose there.
+    beam, _ = load_beam_config()
+    beam = replace(beam, effects=beam.effects.with_effect(name, value))
+    assert effect_value_problem(name, value) is None
+    trajectory = simulate_drop_test(beam, DropTestConfig(4.5, 0.1, 1.0), rate_hz=100.0)
+    assert trajectory.t.size == 101
+    assert np.all(np.isfinite(trajectory.z)) and np.all(np.isfinite(trajectory.pitch))
+
+
+@pytest.mark.parametrize(
+    ('name', 'value'),
+    [
+        ('cubic_stiffness', -1e12),
+        ('cubic_stiffness', 1e12),
+        ('added_mass', 1e4),
+        ('mount_tilt', 1.6),
+    ],
+)
+def test_values_the_model_cannot_simulate_are_refused(name, value):
+    assert effect_value_problem(name, value) is not None
+
+
+def test_every_effect_is_one_record():
+    records = Effects.records()
+    assert [r.name for r in records] == list(EFFECTS) == list(EFFECT_PARAMETERS)
+    for record in records:
+        effects = Effects().with_effect(record.name, record.off)
+        assert effects == Effects() and effects.active() == {}
+        assert record.limits.contains(record.off)
+        assert record.hook in ('chain', 'stamps', 'position')
+
+
+def test_the_interface_documents_each_effects_limits():
+    text = (Path(__file__).resolve().parents[2] / 'doc' / 'interfaces.md').read_text()
+    section = text.partition('## Missing effects')[2].partition('\n## ')[0]
+    rows = {
+        line.split(' | ')[0].strip('|` '): line.split(' | ')[-2]
+        for line in section.splitlines()
+        if line.startswith('| `')
+    }
+    assert rows == {name: r.limits.notation() for name, r in EFFECTS.items()}

@@ -4,8 +4,8 @@ import pytest
 
 from lumpbeam_ros.errors import ConfigError
 from lumpbeam_ros.ident.settings import (
+    IDENTIFIER_SETTINGS,
     NONLINEAR_CHOICES,
-    PARAMETER_KEYS,
     IdentifierConfig,
     config_from_parameters,
 )
@@ -14,7 +14,7 @@ from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA, NODE_ONLY
 
 
 def test_identifier_schema_is_the_identifier_config():
-    settings = set(PARAMETER_KEYS.values())
+    settings = {spec.name for spec in IDENTIFIER_SETTINGS}
     assert settings <= set(IDENTIFIER_SCHEMA.names)
     assert set(IDENTIFIER_SCHEMA.names) - settings == set(NODE_ONLY)
     defaults = IDENTIFIER_SCHEMA.defaults()
@@ -24,8 +24,11 @@ def test_identifier_schema_is_the_identifier_config():
 
 
 def test_every_setting_of_the_identifier_is_a_parameter():
-    fields = {f.name for f in dataclasses.fields(IdentifierConfig)}
-    assert set(PARAMETER_KEYS) == fields
+    fields = dataclasses.fields(IdentifierConfig)
+    assert [f.metadata['parameter'] for f in fields] == list(IDENTIFIER_SETTINGS)
+    assert [getattr(IdentifierConfig(), f.name) for f in fields] == [
+        spec.default for spec in IDENTIFIER_SETTINGS
+    ]
     assert IDENTIFIER_SCHEMA.node == IDENTIFIER_NODE
     assert all(spec.read_only for spec in IDENTIFIER_SCHEMA)  # the summary says so
     assert IDENTIFIER_SCHEMA['fit.nonlinear'].choices == NONLINEAR_CHOICES

@@ -4,7 +4,7 @@ import math
 import pytest
 
 from lumpbeam_ros.errors import ConfigError
-from lumpbeam_ros.ident.settings import PARAMETER_KEYS, config_from_parameters
+from lumpbeam_ros.ident.settings import IDENTIFIER_SETTINGS, config_from_parameters
 from lumpbeam_ros.paramfile import read_parameter_file
 from lumpbeam_ros.params import schema as schema_module
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
@@ -114,13 +114,15 @@ def test_schema_lookup_and_problems():
 @pytest.mark.parametrize('schema', SCHEMAS, ids=lambda s: s.node)
 def test_the_config_file_holds_the_schema_defaults(schema):
     values = read_parameter_file(config_path(schema.config_file))
-    assert set(values) <= set(schema.names)
-    assert {name: schema[name].default for name in values} == {
+    specs = {spec.name: spec for spec in (*schema, *schema.file_only)}
+    assert set(values) <= set(specs)
+    assert {name: specs[name].default for name in values} == {
         # The file's lists are the schema's tuples.
         name: tuple(v) if isinstance(v, list) else v
         for name, v in values.items()
     }
-    assert schema.first_problem(values) is None
+    assert schema.first_problem({k: v for k, v in values.items() if k in schema}) is None
+    assert all(specs[k].problem(v) is None for k, v in values.items())
 
 
 def _beyond(spec):
@@ -140,7 +142,11 @@ _CORE_CASES = [
     (loader, spec, value)
     for loader, schema, keys in [
         (lambda p: camera_config_from_parameters(p, 'probe'), CAMERA_SCHEMA, CONFIG_KEYS),
-        (lambda p: config_from_parameters(p, 'probe'), IDENTIFIER_SCHEMA, PARAMETER_KEYS.values()),
+        (
+            lambda p: config_from_parameters(p, 'probe'),
+            IDENTIFIER_SCHEMA,
+            [s.name for s in IDENTIFIER_SETTINGS],
+        ),
     ]
     for spec in schema
     if spec.name in keys and spec.bounds is not None and spec.name not in _NODE_ONLY_BOUNDS

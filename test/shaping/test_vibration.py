@@ -16,7 +16,11 @@ from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
 from lumpbeam_ros.shaping.apply import shape_trajectory
 from lumpbeam_ros.shaping.impulses import Impulses, Mode
 from lumpbeam_ros.shaping.shapers import zvd_shaper
-from lumpbeam_ros.shaping.vibration import insensitivity_band, residual_vibration
+from lumpbeam_ros.shaping.vibration import (
+    insensitivity_band,
+    residual_vibration,
+    vibration_summary,
+)
 
 #: The commanded move: 1 rad in 20 ms, from rest.
 MOVE = JointTrajectory(np.array([0.0, 0.02]), np.array([[0.0], [1.0]]))
@@ -67,3 +71,15 @@ def test_band_of_zvd_matches_its_closed_form_without_damping():
 def test_band_is_nan_when_the_design_point_itself_is_not_within_tolerance():
     mode = Mode(4.0, 0.0)
     assert all(math.isnan(x) for x in insensitivity_band(Impulses([0.0], [1.0]), mode, 0.05))
+
+
+def test_summary_reports_the_design_point_15_percent_off_and_the_band():
+    mode = Mode(4.0, 0.0)
+    summary = vibration_summary(zvd_shaper(mode), mode)
+    assert summary['vibration_left'] < 1e-15
+    # Undamped ZVD: V = cos^2(pi f / (2 f0)), symmetric about the design frequency.
+    expected = math.cos(math.pi * 0.85 / 2) ** 2
+    assert summary['vibration_left_15pct_low'] == pytest.approx(expected, rel=1e-12)
+    assert summary['vibration_left_15pct_high'] == pytest.approx(expected, rel=1e-12)
+    assert summary['band_hz'] == list(insensitivity_band(zvd_shaper(mode), mode, 0.05))
+    assert (summary['natural_frequency_hz'], summary['damping_ratio']) == (4.0, 0.0)

@@ -1,0 +1,1 @@
+"""The flexible arm: links of lumped segments joined by prescribed revolute joints."""

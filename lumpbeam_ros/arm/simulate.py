@@ -1,0 +1,194 @@
+"""The arm moved along a joint trajectory: B.16 with prescribed joint offsets, integrated.
+
+The arm starts at rest in its static equilibrium at the motion's first angles and follows
+
+    M(phi) phi'' + S(phi) phi'^2 + K phi + C phi' = g G cos phi + D^T (k o(q) + c o(q')),
+
+(:class:`~lumpbeam_ros.model.chain.LumpedChain`, :mod:`lumpbeam_ros.arm.model`), written in
+the angles and a momentum-like variable (:class:`_MomentumForm`) so that the joint rates, which
+jump at every sample of a trajectory file, drop out of the right-hand side. The springs between
+short segments make the chain stiff (its fastest modes are hundreds of times faster than the
+first), so it is integrated by ``scipy.integrate.solve_ivp(method='LSODA')``, which switches to
+BDF when the fast modes dominate, given the Jacobian of the forces (springs, gravity, dampers,
+the velocity terms; the change of ``M`` with ``phi`` in ``phi'`` left out, which only slows its
+Newton iterations). A trajectory of few samples (a few-row file's corners) is integrated
+sample to sample, so no step straddles a corner.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from lumpbeam_ros.arm.drive import JointMotion
+from lumpbeam_ros.arm.model import ArmModel
+from lumpbeam_ros.arm.statics import arm_equilibrium
+from lumpbeam_ros.errors import LumpbeamError
+
+#: Restart the integration at every sample of a trajectory with at most this many samples in
+#: the span (a few-row trajectory's corners); denser ones are integrated straight through.
+MAX_RESTARTS = 200
+
+
+@dataclass(frozen=True)
+class ArmMotion:
+    """The arm on a time grid.
+
+    Attributes:
+        t: Times, s.
+        q: Commanded joint angles, rad, (len(t), n_joints).
+        phi: Segment angles, rad, (len(t), n).
+        phi_dot: Segment rates, rad/s, (len(t), n).
+        tip_x: x of the last link's free end in beam_base, m.
+        tip_z: z of it, m.
+        tip_pitch: Its pitch (the last segment's angle), rad.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    phi: np.ndarray
+    phi_dot: np.ndarray
+    tip_x: np.ndarray
+    tip_z: np.ndarray
+    tip_pitch: np.ndarray
+
+
+class _MomentumForm:
+    """B.16 in the angles and ``w = M(phi) phi' + C phi - B_c q``, with its Jacobian.
+
+    ``w`` is the generalized momentum plus the dampers' stretch: with
+    ``dT/dphi_i = -phi'_i sum_j A_ij sin(phi_i - phi_j) phi'_j`` (T the kinetic energy),
+
+        phi' = M(phi)^-1 (w - C phi + B_c q),
+        w'   = dT/dphi + g G cos phi - K phi + B_k q,
+
+    where ``B_k q`` and ``B_c q`` are the springs' and dampers' prescribed stretches
+    (``D^T k o(q)``, ``D^T c o(q)``). The joint rates ``q'`` have gone: a sampled trajectory's
+    rates jump at every sample, its angles do not, so this right-hand side is continuous and
+    an adaptive integrator does not stall on the samples.
+    """
+
+    def __init__(self, model: ArmModel, motion: JointMotion):
+        chain = model.chain
+        self.n = chain.n
+        self.a = chain.inertia_coupling
+        self.inertia = chain.inertia
+        self.k = chain.stiffness_matrix
+        self.c = chain.damping_matrix
+        self.weight = chain.gravity * chain.gravity_moment
+        self.model = model
+        self.motion = motion
+
+    def _drive(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """``B_k q`` and ``B_c q`` at ``t``."""
+        chain, o = self.model.chain, self.model.offsets(self.motion.angles(t))
+        zero = np.zeros_like(o)
+        return chain.drive_forces(o, zero), chain.drive_forces(zero, o)
+
+    def rates(self, t: float, phi: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, ...]:
+        """phi', and the pieces the Jacobian reuses: M, sin(phi_i - phi_j)."""
+        spring, damper = self._drive(t)
+        diff = phi[:, None] - phi[None, :]
+        mass = self.a * np.cos(diff) + np.diag(self.inertia)
+        phi_dot = np.linalg.solve(mass, w - self.c @ phi + damper)
+        return phi_dot, mass, np.sin(diff), spring
+
+    def state_from(self, t: float, phi: np.ndarray, phi_dot: np.ndarray) -> np.ndarray:
+        """``[phi, w]`` from the angles and rates."""
+        _, damper = self._drive(t)
+        mass = self.a * np.cos(phi[:, None] - phi[None, :]) + np.diag(self.inertia)
+        return np.concatenate([phi, mass @ phi_dot + self.c @ phi - damper])
+
+    def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
+        """``[phi', w']``."""
+        phi, w = y[: self.n], y[self.n :]
+        phi_dot, _, sin, spring = self.rates(t, phi, w)
+        d_t = -phi_dot * ((self.a * sin) @ phi_dot)
+        w_dot = d_t + self.weight * np.cos(phi) - self.k @ phi + spring
+        return np.concatenate([phi_dot, w_dot])
+
+    def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
+        """Of :meth:`rhs`, leaving out the change of ``M`` with ``phi`` in ``phi'``."""
+        phi, w = y[: self.n], y[self.n :]
+        phi_dot, mass, sin, _ = self.rates(t, phi, w)
+        m_inv = np.linalg.inv(mass)
+        d_phidot_d_phi = -m_inv @ self.c
+        as_ = self.a * sin
+        # dT/dphi_i = -phi'_i sum_j A_ij s_ij phi'_j: its derivative in phi' ...
+        d_t_d_phidot = -np.diag(as_ @ phi_dot) - phi_dot[:, None] * as_
+        # ... and in phi at fixed phi' (ds_ij/dphi_i = c_ij, ds_ij/dphi_j = -c_ij).
+        ac = self.a * np.cos(phi[:, None] - phi[None, :]) * phi_dot[None, :]
+        d_t_d_phi = -phi_dot[:, None] * (np.diag(ac.sum(axis=1)) - ac)
+        stiff = d_t_d_phi - self.k - np.diag(self.weight * np.sin(phi))
+        top = np.hstack([d_phidot_d_phi, m_inv])
+        bottom = np.hstack([stiff + d_t_d_phidot @ d_phidot_d_phi, d_t_d_phidot @ m_inv])
+        return np.vstack([top, bottom])
+
+
+def simulate_arm(
+    model: ArmModel,
+    motion: JointMotion,
+    t_eval: np.ndarray,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+) -> ArmMotion:
+    """Moves the arm along ``motion`` from rest, sampled at ``t_eval``.
+
+    Args:
+        model: The arm.
+        motion: The joints' prescribed angles and rates.
+        t_eval: Output times, increasing; the arm is at rest in its static equilibrium at
+            ``motion.angles(t_eval[0])`` at the first.
+        rtol: Relative tolerance of the integrator.
+        atol: Absolute tolerance, rad and rad/s.
+
+    Returns:
+        The motion at ``t_eval``.
+
+    Raises:
+        LumpbeamError: The motion has the wrong number of joints, the times do not increase,
+            or the integrator failed.
+    """
+    t_eval = np.asarray(t_eval, dtype=float)
+    if t_eval.ndim != 1 or t_eval.size == 0 or np.any(np.diff(t_eval) <= 0.0):
+        raise LumpbeamError('arm simulation: output times must increase strictly')
+    if motion.n_joints != model.n_joints:
+        raise LumpbeamError(
+            f'arm simulation: the arm has {model.n_joints} joints, the motion {motion.n_joints}'
+        )
+    n = model.chain.n
+    t0, t1 = float(t_eval[0]), float(t_eval[-1])
+    form = _MomentumForm(model, motion)
+    y = form.state_from(t0, arm_equilibrium(model, motion.angles(t0)), np.zeros(n))
+    knots = motion.knots[(motion.knots > t0) & (motion.knots < t1)]
+    bounds = [t0, *(knots if knots.size <= MAX_RESTARTS else []), t1]
+    states = np.empty((t_eval.size, 2 * n))
+    states[0] = y
+    for start, end in zip(bounds[:-1], bounds[1:], strict=True):
+        inside = (t_eval > start) & (t_eval <= end)
+        wanted = t_eval[inside]
+        if wanted.size == 0 or wanted[-1] != end:
+            wanted = np.append(wanted, end)
+        result = solve_ivp(
+            form.rhs,
+            (start, end),
+            y,
+            method='LSODA',
+            t_eval=wanted,
+            jac=form.jacobian,
+            rtol=rtol,
+            atol=atol,
+        )
+        if not result.success:
+            raise LumpbeamError(f'arm simulation failed at t = {start:.3f} s: {result.message}')
+        states[inside] = result.y.T[: int(inside.sum())]
+        y = result.y[:, -1]
+    phi = states[:, :n]
+    phi_dot = np.array(
+        [form.rates(t, p, w)[0] for t, p, w in zip(t_eval, phi, states[:, n:], strict=True)]
+    )
+    x, z, pitch = model.chain.tip_pose(phi)
+    q = np.array([motion.angles(t) for t in t_eval])
+    return ArmMotion(t_eval, q, phi, phi_dot, x, z, pitch)

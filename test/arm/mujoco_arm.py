@@ -1,0 +1,209 @@
+"""The same arm built in MuJoCo: an independent multibody model for the arm's tests.
+
+Every segment is a MuJoCo body hanging from the previous one by a hinge about +y (MuJoCo's
+relative joint coordinates, its own mass matrix, bias forces and gravity), carrying its mass
+at its centre with rotary inertia ``m L_s^2 / 12``; joint masses and the payload are welded
+point masses. The link springs and dampers are the hinges' ``stiffness`` and ``damping``.
+
+An ideal stiff servo sets the angle of the clamp against the previous link's last segment,
+and the massless clamp passes the spring's torque on: so the first hinge of each link is the
+spring whose rest angle (MuJoCo's ``qpos_spring``) is the commanded joint angle ``q_i``, and
+the damper's ``c q_i'`` is applied as a joint force. Both are set before every step at the
+step's midpoint (MuJoCo holds them over the step), which keeps RK4 second-order in the drive.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from lumpbeam_ros.arm.config import ArmConfig
+
+Drive = Callable[[float], tuple[np.ndarray, np.ndarray]]
+
+
+def _inertial(mass: float, x: float, iyy: float) -> str:
+    # MuJoCo needs positive principal inertias obeying the triangle inequality: a thin rod
+    # about y and z, a vanishing one about its axis.
+    tiny = 1e-12
+    return (
+        f'<inertial pos="{x!r} 0 0" mass="{mass!r}" '
+        f'diaginertia="{tiny + iyy * 1e-9!r} {iyy + tiny!r} {iyy + tiny!r}"/>'
+    )
+
+
+def arm_mjcf(config: ArmConfig, timestep: float) -> str:
+    """The MJCF text of the arm."""
+    body = ''
+    close = ''
+    index = 0
+    prev_length = 0.0
+    for i, link in enumerate(config.links):
+        ls = link.segment_length_m
+        k = link.spring_stiffness()
+        c = link.spring_damping()
+        for j in range(link.n_segments):
+            pos = prev_length
+            extra = ''
+            if j == 0 and i > 0 and link.joint_mass_kg > 0.0:
+                extra = (
+                    f'<body name="joint_mass_{i}" pos="0 0 0">'
+                    f'{_inertial(link.joint_mass_kg, 0.0, 0.0)}</body>'
+                )
+            m = float(link.segment_masses_kg[j])
+            body += (
+                f'<body name="s{index}" pos="{pos!r} 0 0">'
+                f'<joint name="h{index}" type="hinge" axis="0 1 0" '
+                f'stiffness="{float(k[j])!r}" damping="{float(c[j])!r}" armature="0"/>'
+                f'{_inertial(m, 0.5 * ls, m * ls**2 / 12.0)}{extra}'
+            )
+            close += '</body>'
+            prev_length = ls
+            index += 1
+    payload = ''
+    if config.payload_kg > 0.0:
+        payload = (
+            f'<body name="payload" pos="{prev_length!r} 0 0">'
+            f'{_inertial(config.payload_kg, 0.0, 0.0)}</body>'
+        )
+    tip = f'<site name="tip" pos="{prev_length!r} 0 0"/>'
+    gravity = config.gravity_mps2
+    return (
+        '<mujoco><compiler angle="radian"/>'
+        f'<option timestep="{timestep!r}" integrator="RK4" gravity="0 0 {-gravity!r}">'
+        '<flag contact="disable" constraint="disable"/></option>'
+        f'<worldbody>{body}{payload}{tip}{close}</worldbody></mujoco>'
+    )
+
+
+@dataclass
+class MujocoArm:
+    """The arm in MuJoCo, with its clamps driven.
+
+    Args:
+        config: The arm.
+        timestep: MuJoCo's step, s.
+    """
+
+    config: ArmConfig
+    timestep: float = 1e-4
+
+    def __post_init__(self) -> None:
+        self.model = mujoco.MjModel.from_xml_string(arm_mjcf(self.config, self.timestep))
+        self.data = mujoco.MjData(self.model)
+        starts = np.cumsum([0] + [link.n_segments for link in self.config.links])[:-1]
+        self.clamps = starts
+        self.clamp_damping = np.array([link.spring_damping()[0] for link in self.config.links])
+        self.tip = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, 'tip')
+
+    def set_drive(self, q: np.ndarray, q_dot: np.ndarray) -> None:
+        """Turns the clamps to ``q`` with rates ``q_dot``."""
+        self.model.qpos_spring[self.clamps] = q
+        self.data.qfrc_applied[:] = 0.0
+        self.data.qfrc_applied[self.clamps] = self.clamp_damping * q_dot
+
+    def set_absolute(self, phi: np.ndarray, phi_dot: np.ndarray) -> None:
+        """Sets the state from absolute segment angles (relative hinge angles in MuJoCo)."""
+        self.data.qpos[:] = np.diff(phi, prepend=0.0)
+        self.data.qvel[:] = np.diff(phi_dot, prepend=0.0)
+        mujoco.mj_forward(self.model, self.data)
+
+    def absolute_angles(self) -> np.ndarray:
+        """Absolute segment angles of the current state."""
+        return np.cumsum(self.data.qpos)
+
+    def tip_pose(self) -> tuple[float, float, float]:
+        """x, z and pitch of the tip site in the world (``beam_base``)."""
+        x, _, z = self.data.site_xpos[self.tip]
+        rot = self.data.site_xmat[self.tip].reshape(3, 3)
+        return float(x), float(z), float(np.arctan2(-rot[2, 0], rot[0, 0]))
+
+    def equilibrium(self, q: np.ndarray, tol: float = 1e-12) -> np.ndarray:
+        """Newton on MuJoCo's own static forces (``mj_inverse`` at rest); absolute angles."""
+        self.set_drive(q, np.zeros_like(q))
+        qpos = np.zeros(self.model.nv)
+        qpos[self.clamps] = q
+        for _ in range(50):
+            residual = self._static_force(qpos)
+            jac = np.empty((qpos.size, qpos.size))
+            for i in range(qpos.size):
+                h = 1e-7
+                step = np.zeros_like(qpos)
+                step[i] = h
+                jac[:, i] = (self._static_force(qpos + step) - self._static_force(qpos - step)) / (
+                    2 * h
+                )
+            update = np.linalg.solve(jac, residual)
+            qpos -= update
+            if np.max(np.abs(update)) < tol:
+                break
+        self.data.qpos[:] = qpos
+        self.data.qvel[:] = 0.0
+        mujoco.mj_forward(self.model, self.data)
+        return self.absolute_angles()
+
+    def _static_force(self, qpos: np.ndarray) -> np.ndarray:
+        self.data.qpos[:] = qpos
+        self.data.qvel[:] = 0.0
+        self.data.qacc[:] = 0.0
+        mujoco.mj_inverse(self.model, self.data)
+        # qfrc_inverse = M qacc + bias - passive - applied: zero at a static equilibrium.
+        return np.array(self.data.qfrc_inverse)
+
+    def modal_eigenvalues(self, h: float = 1e-6) -> np.ndarray:
+        """Eigenvalues of MuJoCo's dynamics linearized about the current state.
+
+        The continuous-time Jacobian of ``qacc`` (``mj_forward``) in ``qpos`` and ``qvel``
+        by central differences (``mjd_transitionFD`` does not take RK4).
+        """
+        nv = self.model.nv
+        qpos0, qvel0 = self.data.qpos.copy(), self.data.qvel.copy()
+
+        def acc(qpos: np.ndarray, qvel: np.ndarray) -> np.ndarray:
+            self.data.qpos[:] = qpos
+            self.data.qvel[:] = qvel
+            mujoco.mj_forward(self.model, self.data)
+            return np.array(self.data.qacc)
+
+        a = np.zeros((2 * nv, 2 * nv))
+        a[:nv, nv:] = np.eye(nv)
+        for i in range(nv):
+            e = np.zeros(nv)
+            e[i] = h
+            a[nv:, i] = (acc(qpos0 + e, qvel0) - acc(qpos0 - e, qvel0)) / (2 * h)
+            a[nv:, nv + i] = (acc(qpos0, qvel0 + e) - acc(qpos0, qvel0 - e)) / (2 * h)
+        acc(qpos0, qvel0)
+        return np.asarray(np.linalg.eigvals(a))
+
+    def run(self, drive: Drive, t_end: float, sample_every: float) -> dict[str, np.ndarray]:
+        """Steps to ``t_end`` from the current state at time 0, sampling the tip.
+
+        Args:
+            drive: ``t -> (q, q')``.
+            t_end: End time, s.
+            sample_every: Sampling interval, s (a multiple of the step).
+
+        Returns:
+            ``t``, ``x``, ``z``, ``pitch``, ``phi`` at the samples (time 0 included).
+        """
+        per_sample = round(sample_every / self.timestep)
+        count = round(t_end / sample_every) + 1
+        rows = []
+        step = 0
+        for k in range(count):
+            while step < k * per_sample:
+                self.set_drive(*drive((step + 0.5) * self.timestep))
+                mujoco.mj_step(self.model, self.data)
+                step += 1
+            mujoco.mj_kinematics(self.model, self.data)
+            rows.append((k * sample_every, *self.tip_pose(), self.absolute_angles()))
+        return {
+            't': np.array([r[0] for r in rows]),
+            'x': np.array([r[1] for r in rows]),
+            'z': np.array([r[2] for r in rows]),
+            'pitch': np.array([r[3] for r in rows]),
+            'phi': np.array([r[4] for r in rows]),
+        }
