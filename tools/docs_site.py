@@ -76,7 +76,8 @@ def on_config(config: MkDocsConfig, **_: Any) -> MkDocsConfig:
     nav = list(config.nav or [])
     listed = _listed(nav)
     docs = Path(config.docs_dir)
-    nav += sorted(p.name for p in docs.glob('*.md') if p.name not in listed | {HOME})
+    pages = (p.relative_to(docs).as_posix() for p in docs.rglob('*.md'))
+    nav += sorted(page for page in pages if page not in listed | {HOME})
     nav.append({API_SECTION: [{Path(path).stem: path} for path in api_pages()]})
     config.nav = nav
     return config
