@@ -34,6 +34,7 @@ COMPRESSED_IMAGE_TYPE = 'sensor_msgs/msg/CompressedImage'
 CAMERA_INFO_TYPE = 'sensor_msgs/msg/CameraInfo'
 CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
 MARKER_ARRAY = 'visualization_msgs/msg/MarkerArray'
+JOINT_STATE_TYPE = 'sensor_msgs/msg/JointState'
 
 # -- topics (absolute: the default graph's and the bags' names) -------------------------------
 
@@ -51,6 +52,8 @@ BEAM_MARKERS = '/beam_markers'
 MODEL_DISCREPANCY = '/model_discrepancy'
 DIAGNOSTICS = '/diagnostics'
 TIP_POSE_TRUTH = '/tip_pose_truth'
+#: An arm's joint angles (rad): its encoders, or the commanded angles of a simulated arm.
+JOINT_STATES = '/joint_states'
 
 #: Every topic of the interface with its message type.
 TOPIC_TYPES: dict[str, str] = {
@@ -68,6 +71,7 @@ TOPIC_TYPES: dict[str, str] = {
     MODEL_DISCREPANCY: DIAGNOSTIC_ARRAY,
     DIAGNOSTICS: DIAGNOSTIC_ARRAY,
     TIP_POSE_TRUTH: POSE_STAMPED,
+    JOINT_STATES: JOINT_STATE_TYPE,
 }
 
 #: Topics that stay absolute in a namespace: the graph-wide ones.
