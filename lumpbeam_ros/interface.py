@@ -35,6 +35,7 @@ CAMERA_INFO_TYPE = 'sensor_msgs/msg/CameraInfo'
 CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
 MARKER_ARRAY = 'visualization_msgs/msg/MarkerArray'
 JOINT_STATE_TYPE = 'sensor_msgs/msg/JointState'
+JOINT_TRAJECTORY_TYPE = 'trajectory_msgs/msg/JointTrajectory'
 
 # -- topics (absolute: the default graph's and the bags' names) -------------------------------
 
@@ -54,6 +55,8 @@ DIAGNOSTICS = '/diagnostics'
 TIP_POSE_TRUTH = '/tip_pose_truth'
 #: An arm's joint angles (rad): its encoders, or the commanded angles of a simulated arm.
 JOINT_STATES = '/joint_states'
+JOINT_TRAJECTORY = '/joint_trajectory'
+JOINT_TRAJECTORY_SHAPED = '/joint_trajectory_shaped'
 
 #: Every topic of the interface with its message type.
 TOPIC_TYPES: dict[str, str] = {
@@ -72,6 +75,8 @@ TOPIC_TYPES: dict[str, str] = {
     DIAGNOSTICS: DIAGNOSTIC_ARRAY,
     TIP_POSE_TRUTH: POSE_STAMPED,
     JOINT_STATES: JOINT_STATE_TYPE,
+    JOINT_TRAJECTORY: JOINT_TRAJECTORY_TYPE,
+    JOINT_TRAJECTORY_SHAPED: JOINT_TRAJECTORY_TYPE,
 }
 
 #: Topics that stay absolute in a namespace: the graph-wide ones.
@@ -92,6 +97,7 @@ CAMERA_NODE = 'camera_node'
 IDENTIFIER_NODE = 'identifier_node'
 SIMULATOR_NODE = 'simulator_node'
 DIAGNOSIS_NODE = 'diagnosis_node'
+SHAPER_NODE = 'shaper_node'
 PLAYER_NODE = 'lumpbeam_player'
 RECORDER_NODE = 'lumpbeam_recorder'
 

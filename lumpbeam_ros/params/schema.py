@@ -207,12 +207,15 @@ class ParameterSchema:
         parameters: The parameters, in the order they are documented.
         config_file: The package's parameter file under ``config/`` whose values are the
             defaults (empty: none); a test holds the two equal.
+        file_only: Parameters of ``config_file`` that the node does not declare, for the
+            commands that read the file (documented with the node).
     """
 
     node: str
     summary: str
     parameters: tuple[ParameterSpec, ...]
     config_file: str = ''
+    file_only: tuple[ParameterSpec, ...] = ()
     _by_name: dict[str, ParameterSpec] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:

@@ -23,7 +23,7 @@ from lumpbeam_ros.bagio import BagWriter
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.interface import JOINT_STATES, TIP_POSE, TIP_POSE_TRUTH
 from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
-from lumpbeam_ros.synthetic.drop_test import PITCH_NOISE_PER_M
+from lumpbeam_ros.synthetic.drop_test import PITCH_NOISE_PER_M, check_sample_count
 
 
 @dataclass(frozen=True)
@@ -51,8 +51,8 @@ def simulate_arm_record(
     """The arm along the trajectory at the record's stamps.
 
     Raises:
-        LumpbeamError: The trajectory has the wrong number of joints, or the record is
-            shorter than it.
+        LumpbeamError: The trajectory has the wrong number of joints, the record is shorter
+            than it, or it needs more samples than the drop test's limit.
     """
     if trajectory.joint_count != config.n_joints:
         raise LumpbeamError(
@@ -63,6 +63,7 @@ def simulate_arm_record(
             f'--duration {options.duration_s:g} s is shorter than the trajectory '
             f'({trajectory.duration_s:g} s)'
         )
+    check_sample_count(options.duration_s, {'poses': options.rate_hz})
     count = int(math.floor(options.duration_s * options.rate_hz + 1e-9)) + 1
     t = float(trajectory.time_s[0]) + np.arange(count) / options.rate_hz
     return simulate_arm(ArmModel.from_config(config), SampledMotion(trajectory), t)

@@ -1,4 +1,9 @@
-"""The camera configuration (``config/camera.yaml``): dataclasses and a validating loader."""
+"""The camera configuration (``config/camera.yaml``): its sections, each field a parameter.
+
+Each field of the four sections is declared once, with :func:`~lumpbeam_ros.params.schema.
+setting`; the camera node's parameters (:mod:`lumpbeam_ros.params.camera_params`), the checks
+of a parameter file and ``doc/parameters.md`` come from them.
+"""
 
 from __future__ import annotations
 
@@ -9,10 +14,9 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from lumpbeam_ros.errors import ConfigError, LumpbeamError
-from lumpbeam_ros.paramfile import check_known_keys, get_float, get_int, read_parameter_file
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.paramfile import check_known_keys, read_parameter_file
+from lumpbeam_ros.params.schema import Bounds, setting, settings_from_parameters, settings_specs
 from lumpbeam_ros.resources import config_path
 from lumpbeam_ros.vision.board import Checkerboard
 from lumpbeam_ros.vision.camera_model import CameraInfo
@@ -34,37 +38,244 @@ class RigGeometry:
     base_board: Transform
 
 
+_POSITIVE = Bounds(0.0, low_open=True)
+_NON_NEGATIVE = Bounds(0.0)
+_GREY = Bounds(0.0, 255.0)
+_HALF_PI = math.pi / 2.0
+
+
+@dataclass(frozen=True)
+class SensorSettings:
+    """The camera's intrinsics and its mount on the tip (``camera.*``)."""
+
+    width_px: int = setting(
+        'camera.width_px', 2048, 'sensor width; checked against each image', 'px', Bounds(64)
+    )
+    height_px: int = setting(
+        'camera.height_px', 2048, 'sensor height; checked against each image', 'px', Bounds(64)
+    )
+    focal_length_px: float = setting(
+        'camera.focal_length_px', 2400.0, 'focal length, fx = fy', 'px', _POSITIVE
+    )
+    principal_point_offset_px: tuple[float, float] = setting(
+        'camera.principal_point_offset_px',
+        (0.0, 0.0),
+        'principal point minus the image centre ((width - 1) / 2, (height - 1) / 2)',
+        'px',
+    )
+    distortion: tuple[float, float, float, float, float] = setting(
+        'camera.distortion',
+        (0.0, 0.0, 0.0, 0.0, 0.0),
+        'plumb_bob distortion k1, k2, p1, p2, k3 (all zero: an ideal pinhole)',
+    )
+    mount_xyz_m: tuple[float, float, float] = setting(
+        'camera.mount.xyz_m',
+        (0.0, 0.05, 0.0),
+        "origin of the camera's optical frame in the tip frame",
+        'm',
+    )
+    mount_rpy_rad: tuple[float, float, float] = setting(
+        'camera.mount.rpy_rad',
+        (-_HALF_PI, 0.0, 0.0),
+        "roll-pitch-yaw of the camera's optical frame in the tip frame (URDF convention)",
+        'rad',
+    )
+
+
+@dataclass(frozen=True)
+class BoardSettings:
+    """The checkerboard and where it stands (``board.*``)."""
+
+    squares_x: int = setting(
+        'board.squares_x',
+        9,
+        'squares along the board x axis (differs from squares_y)',
+        bounds=Bounds(3),
+    )
+    squares_y: int = setting(
+        'board.squares_y',
+        7,
+        'squares along the board y axis (differs from squares_x)',
+        bounds=Bounds(3),
+    )
+    square_size_m: float = setting(
+        'board.square_size_m', 0.06, 'edge of one square', 'm', _POSITIVE
+    )
+    margin_squares: float = setting(
+        'board.margin_squares', 1.0, 'white border around the squares', 'squares', _POSITIVE
+    )
+    xyz_m: tuple[float, float, float] = setting(
+        'board.xyz_m', (2.3107, 1.0, -0.01), 'position of the board frame in beam_base', 'm'
+    )
+    rpy_rad: tuple[float, float, float] = setting(
+        'board.rpy_rad',
+        (-_HALF_PI, 0.0, 0.0),
+        'roll-pitch-yaw of the board frame in beam_base',
+        'rad',
+    )
+
+    def relation_problem(self) -> tuple[str, str] | None:
+        """What the values break together: ``(key, problem)``, or ``None``."""
+        if self.squares_x == self.squares_y:
+            # A square pattern can be detected transposed; a rectangular one fixes which way
+            # the rows run, and the expected orientation then fixes where they start.
+            return 'board.squares_y', 'must differ from squares_x'
+        return None
+
+
 @dataclass(frozen=True)
 class SyntheticSettings:
-    """How the synthetic camera renders (see ``config/camera.yaml`` for each field)."""
+    """How the synthetic camera of ``lumpbeam synth`` renders (``synthetic.*``)."""
 
-    exposure_s: float = 0.001
-    noise_sigma_dn: float = 2.0
-    defocus_sigma_px: float = 0.8
-    dark_dn: float = 30.0
-    light_dn: float = 220.0
-    wall_dn: float = 110.0
-    supersample: int = 2
-    motion_step_px: float = 0.5
-    max_motion_samples: int = 16
-    seed: int = 1
+    exposure_s: float = setting(
+        'synthetic.exposure_s',
+        0.001,
+        'exposure time of the synthetic camera (motion blur); a stamp is its middle',
+        's',
+        _NON_NEGATIVE,
+    )
+    noise_sigma_dn: float = setting(
+        'synthetic.noise_sigma_dn',
+        2.0,
+        'standard deviation of additive Gaussian sensor noise',
+        'DN',
+        _NON_NEGATIVE,
+    )
+    defocus_sigma_px: float = setting(
+        'synthetic.defocus_sigma_px',
+        0.8,
+        'standard deviation of a Gaussian defocus blur',
+        'px',
+        _NON_NEGATIVE,
+    )
+    dark_dn: float = setting(
+        'synthetic.dark_dn', 30.0, 'grey level of the dark squares', 'DN', _GREY
+    )
+    light_dn: float = setting(
+        'synthetic.light_dn', 220.0, 'grey level of the light squares (above dark_dn)', 'DN', _GREY
+    )
+    wall_dn: float = setting('synthetic.wall_dn', 110.0, 'grey level of the wall', 'DN', _GREY)
+    supersample: int = setting(
+        'synthetic.supersample',
+        2,
+        'render at this many times the resolution, average down',
+        bounds=Bounds(1),
+    )
+    motion_step_px: float = setting(
+        'synthetic.motion_step_px',
+        0.5,
+        'motion blur: most a board point moves between two sub-poses of an exposure',
+        'px',
+        _POSITIVE,
+    )
+    max_motion_samples: int = setting(
+        'synthetic.max_motion_samples',
+        16,
+        'motion blur: most sub-poses per exposure',
+        bounds=Bounds(1),
+    )
+    seed: int = setting('synthetic.seed', 1, 'seed of the noise generator', bounds=Bounds(0))
+
+    def relation_problem(self) -> tuple[str, str] | None:
+        """What the values break together: ``(key, problem)``, or ``None``."""
+        if self.light_dn <= self.dark_dn:
+            return 'synthetic.light_dn', 'must be brighter than dark_dn'
+        return None
 
 
 @dataclass(frozen=True)
 class TrackerSettings:
-    """How the tracker detects, verifies and calibrates (see ``config/camera.yaml``)."""
+    """How the tracker detects, verifies and calibrates (``tracker.*``)."""
 
-    detect_max_side_px: int = 640
-    window_fraction: float = 0.2
-    max_homography_residual_px: float = 1.0
-    max_rms_px: float = 0.5
-    min_contrast_dn: float = 20.0
-    max_saturated_fraction: float = 0.2
-    calibration_frames: int = 30
-    calibration_min_step_m: float = 0.001
-    min_corners: int = 12
-    min_corner_spread: float = 0.5
-    tilt_prior_std_rad: float = 5.0e-6
+    detect_max_side_px: int = setting(
+        'tracker.detect_max_side_px',
+        640,
+        'full detection runs on a copy shrunk to at most this longer side',
+        'px',
+        Bounds(160),
+    )
+    window_fraction: float = setting(
+        'tracker.window_fraction',
+        0.2,
+        "corner refinement window half-size, as a fraction of a square's size in pixels",
+        # A window reaching the neighbouring corner pulls the estimate toward it.
+        bounds=Bounds(0.0, 0.5, low_open=True, high_open=True),
+    )
+    max_homography_residual_px: float = setting(
+        'tracker.max_homography_residual_px',
+        1.0,
+        'a frame is rejected when a homography through its corners misses one by more',
+        'px',
+        _POSITIVE,
+    )
+    max_rms_px: float = setting(
+        'tracker.max_rms_px',
+        0.5,
+        'a pose is rejected when the RMS reprojection error of its fit exceeds this',
+        'px',
+        _POSITIVE,
+    )
+    min_contrast_dn: float = setting(
+        'tracker.min_contrast_dn',
+        20.0,
+        'a frame is too dark when its 1st to 99th percentile spread is below this',
+        'DN',
+        _NON_NEGATIVE,
+    )
+    max_saturated_fraction: float = setting(
+        'tracker.max_saturated_fraction',
+        0.2,
+        'a frame is saturated when more than this fraction of its pixels is at 255',
+        bounds=_POSITIVE,
+    )
+    calibration_frames: int = setting(
+        'tracker.calibration_frames',
+        30,
+        'good frames that estimate the camera distance and tilt before the refined extrinsics '
+        'are used; 0 trusts the configured rig, else at least 3',
+        bounds=Bounds(0),
+    )
+    calibration_min_step_m: float = setting(
+        'tracker.calibration_min_step_m',
+        0.001,
+        'a good frame joins the calibration only if the tip moved this far since the last one',
+        'm',
+        _NON_NEGATIVE,
+    )
+    min_corners: int = setting(
+        'tracker.min_corners',
+        12,
+        'a partial view gives a pose from at least this many corners',
+        bounds=Bounds(6),
+    )
+    min_corner_spread: float = setting(
+        'tracker.min_corner_spread',
+        0.5,
+        "a partial view's corners spread at least this far (rms) across their weakest direction",
+        'squares',
+        _POSITIVE,
+    )
+    tilt_prior_std_rad: float = setting(
+        'tracker.tilt_prior_std_rad',
+        5.0e-6,
+        "how well the mount's out-of-plane tilt (camera.mount.rpy_rad) is known: the rig "
+        'calibration fits the tilt with this Gaussian prior',
+        'rad',
+        _POSITIVE,
+    )
+
+    def relation_problem(self) -> tuple[str, str] | None:
+        """What the values break together: ``(key, problem)``, or ``None``."""
+        if 0 < self.calibration_frames < 3:
+            return 'tracker.calibration_frames', 'must be 0 or at least 3'
+        return None
+
+
+#: The sections of ``config/camera.yaml``, in its order.
+CAMERA_SECTIONS = (SensorSettings, BoardSettings, SyntheticSettings, TrackerSettings)
+
+#: The parameters of ``config/camera.yaml``.
+CAMERA_SETTINGS = tuple(spec for section in CAMERA_SECTIONS for spec in settings_specs(section))
 
 
 @dataclass(frozen=True)
@@ -88,49 +299,10 @@ class CameraConfig:
         return replace(self, camera_info=self.camera_info.scaled(width, height))
 
 
-_KEYS = frozenset(
-    {
-        'camera.width_px',
-        'camera.height_px',
-        'camera.focal_length_px',
-        'camera.principal_point_offset_px',
-        'camera.distortion',
-        'camera.mount.xyz_m',
-        'camera.mount.rpy_rad',
-        'board.squares_x',
-        'board.squares_y',
-        'board.square_size_m',
-        'board.margin_squares',
-        'board.xyz_m',
-        'board.rpy_rad',
-    }
-    | {f'synthetic.{name}' for name in SyntheticSettings.__dataclass_fields__}
-    | {f'tracker.{name}' for name in TrackerSettings.__dataclass_fields__}
-)
-
-
-def _get_vector(
-    params: Mapping[str, Any], key: str, source: str | Path, default: tuple[float, ...]
-) -> tuple[float, ...]:
-    if key not in params:
-        return default
-    value = params[key]
-    if (
-        not isinstance(value, list | tuple)
-        or len(value) != len(default)
-        or any(isinstance(v, bool) or not isinstance(v, int | float) for v in value)
-        or not np.all(np.isfinite(np.asarray(value, dtype=float)))
-    ):
-        raise ConfigError(
-            source, key, f'must be a list of {len(default)} finite numbers, got {value!r}'
-        )
-    return tuple(float(v) for v in value)
-
-
 def camera_config_from_parameters(params: Mapping[str, Any], source: str | Path) -> CameraConfig:
     """Builds and validates the camera configuration from flat (dotted) ROS parameters.
 
-    Missing keys take the defaults documented in ``config/camera.yaml``.
+    Missing keys take the fields' defaults.
 
     Args:
         params: Flat parameters, e.g. from :func:`~lumpbeam_ros.paramfile.read_parameter_file`.
@@ -142,112 +314,29 @@ def camera_config_from_parameters(params: Mapping[str, Any], source: str | Path)
     Raises:
         ConfigError: An unknown key, a wrong type or an out-of-range value.
     """
-    check_known_keys(params, _KEYS, source)
-    pos = {'positive': True}
-    nonneg = {'non_negative': True}
-    half_pi = np.pi / 2.0
-    width = get_int(params, 'camera.width_px', source, 2048, minimum=64)
-    height = get_int(params, 'camera.height_px', source, 2048, minimum=64)
-    focal = get_float(params, 'camera.focal_length_px', source, 2400.0, **pos)
-    offset = _get_vector(params, 'camera.principal_point_offset_px', source, (0.0, 0.0))
-    distortion = _get_vector(params, 'camera.distortion', source, (0.0,) * 5)
-    camera_info = CameraInfo.pinhole(width, height, focal, offset, distortion)  # type: ignore[arg-type]
-    board = Checkerboard(
-        squares_x=get_int(params, 'board.squares_x', source, 9, minimum=3),
-        squares_y=get_int(params, 'board.squares_y', source, 7, minimum=3),
-        square_size_m=get_float(params, 'board.square_size_m', source, 0.06, **pos),
-        margin_squares=get_float(params, 'board.margin_squares', source, 1.0, positive=True),
+    check_known_keys(params, frozenset(spec.name for spec in CAMERA_SETTINGS), source)
+    sensor = settings_from_parameters(SensorSettings, params, source)
+    board = settings_from_parameters(BoardSettings, params, source)
+    camera_info = CameraInfo.pinhole(
+        sensor.width_px,
+        sensor.height_px,
+        sensor.focal_length_px,
+        sensor.principal_point_offset_px,
+        sensor.distortion,
     )
-    if board.squares_x == board.squares_y:
-        # A square pattern can be detected transposed; a rectangular one fixes which way
-        # the rows run, and the expected orientation then fixes where they start.
-        raise ConfigError(source, 'board.squares_y', 'must differ from squares_x')
     rig = RigGeometry(
-        board=board,
-        tip_camera=Transform.from_xyz_rpy(
-            _get_vector(params, 'camera.mount.xyz_m', source, (0.0, 0.05, 0.0)),  # type: ignore[arg-type]
-            _get_vector(params, 'camera.mount.rpy_rad', source, (-half_pi, 0.0, 0.0)),  # type: ignore[arg-type]
+        board=Checkerboard(
+            board.squares_x, board.squares_y, board.square_size_m, board.margin_squares
         ),
-        base_board=Transform.from_xyz_rpy(
-            _get_vector(params, 'board.xyz_m', source, (2.3107, 1.0, -0.01)),  # type: ignore[arg-type]
-            _get_vector(params, 'board.rpy_rad', source, (-half_pi, 0.0, 0.0)),  # type: ignore[arg-type]
-        ),
+        tip_camera=Transform.from_xyz_rpy(sensor.mount_xyz_m, sensor.mount_rpy_rad),
+        base_board=Transform.from_xyz_rpy(board.xyz_m, board.rpy_rad),
     )
-    s = SyntheticSettings()
-    synthetic = SyntheticSettings(
-        exposure_s=get_float(params, 'synthetic.exposure_s', source, s.exposure_s, **nonneg),
-        noise_sigma_dn=get_float(
-            params, 'synthetic.noise_sigma_dn', source, s.noise_sigma_dn, **nonneg
-        ),
-        defocus_sigma_px=get_float(
-            params, 'synthetic.defocus_sigma_px', source, s.defocus_sigma_px, **nonneg
-        ),
-        dark_dn=get_float(params, 'synthetic.dark_dn', source, s.dark_dn, **nonneg),
-        light_dn=get_float(params, 'synthetic.light_dn', source, s.light_dn, **nonneg),
-        wall_dn=get_float(params, 'synthetic.wall_dn', source, s.wall_dn, **nonneg),
-        supersample=get_int(params, 'synthetic.supersample', source, s.supersample, minimum=1),
-        motion_step_px=get_float(
-            params, 'synthetic.motion_step_px', source, s.motion_step_px, **pos
-        ),
-        max_motion_samples=get_int(
-            params, 'synthetic.max_motion_samples', source, s.max_motion_samples, minimum=1
-        ),
-        seed=get_int(params, 'synthetic.seed', source, s.seed, minimum=0),
+    return CameraConfig(
+        camera_info,
+        rig,
+        settings_from_parameters(SyntheticSettings, params, source),
+        settings_from_parameters(TrackerSettings, params, source),
     )
-    for key in ('dark_dn', 'light_dn', 'wall_dn'):
-        if getattr(synthetic, key) > 255.0:
-            raise ConfigError(source, f'synthetic.{key}', 'must be at most 255 (mono8)')
-    if synthetic.light_dn <= synthetic.dark_dn:
-        raise ConfigError(source, 'synthetic.light_dn', 'must be brighter than dark_dn')
-    t = TrackerSettings()
-    tracker = TrackerSettings(
-        detect_max_side_px=get_int(
-            params, 'tracker.detect_max_side_px', source, t.detect_max_side_px, minimum=160
-        ),
-        window_fraction=get_float(
-            params, 'tracker.window_fraction', source, t.window_fraction, **pos
-        ),
-        max_homography_residual_px=get_float(
-            params,
-            'tracker.max_homography_residual_px',
-            source,
-            t.max_homography_residual_px,
-            **pos,
-        ),
-        max_rms_px=get_float(params, 'tracker.max_rms_px', source, t.max_rms_px, **pos),
-        min_contrast_dn=get_float(
-            params, 'tracker.min_contrast_dn', source, t.min_contrast_dn, **nonneg
-        ),
-        max_saturated_fraction=get_float(
-            params, 'tracker.max_saturated_fraction', source, t.max_saturated_fraction, **pos
-        ),
-        calibration_frames=get_int(
-            params, 'tracker.calibration_frames', source, t.calibration_frames, minimum=0
-        ),
-        calibration_min_step_m=get_float(
-            params,
-            'tracker.calibration_min_step_m',
-            source,
-            t.calibration_min_step_m,
-            non_negative=True,
-        ),
-        tilt_prior_std_rad=get_float(
-            params, 'tracker.tilt_prior_std_rad', source, t.tilt_prior_std_rad, **pos
-        ),
-    )
-    tracker = replace(
-        tracker,
-        min_corners=get_int(params, 'tracker.min_corners', source, t.min_corners, minimum=6),
-        min_corner_spread=get_float(
-            params, 'tracker.min_corner_spread', source, t.min_corner_spread, positive=True
-        ),
-    )
-    if tracker.window_fraction >= 0.5:
-        # A window reaching the neighbouring corner pulls the estimate toward it.
-        raise ConfigError(source, 'tracker.window_fraction', 'must be below 0.5')
-    if 0 < tracker.calibration_frames < 3:
-        raise ConfigError(source, 'tracker.calibration_frames', 'must be 0 or at least 3')
-    return CameraConfig(camera_info, rig, synthetic, tracker)
 
 
 def load_camera_config(path: str | Path | None = None) -> CameraConfig:

@@ -5,15 +5,27 @@ from lumpbeam_ros.interface import BASE_FRAME, CAMERA_INFO, CAMERA_NODE, IMAGE
 from lumpbeam_ros.paramfile import read_parameter_file
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
 from lumpbeam_ros.resources import config_path
-from lumpbeam_ros.vision.config import camera_config_from_parameters, load_camera_config
+from lumpbeam_ros.vision.config import (
+    CAMERA_SETTINGS,
+    camera_config_from_parameters,
+    load_camera_config,
+)
 from lumpbeam_ros.vision.free_pose import POSE_MODELS
 
 
 def test_camera_schema_is_the_camera_config():
-    assert set(CONFIG_KEYS) == set(read_parameter_file(config_path('camera.yaml')))
+    names = {spec.name for spec in CAMERA_SETTINGS}
+    assert names == set(read_parameter_file(config_path('camera.yaml')))
+    assert names == set(CONFIG_KEYS) | {spec.name for spec in CAMERA_SCHEMA.file_only}
     defaults = CAMERA_SCHEMA.defaults()
     config = camera_config_from_parameters({k: defaults[k] for k in CONFIG_KEYS}, 'schema')
     assert repr(config) == repr(load_camera_config())  # numpy fields: no ==
+
+
+def test_the_node_declares_no_synthetic_camera_parameter():
+    # The synthetic camera renders lumpbeam synth's images; the node never reads it.
+    assert not any(name.startswith('synthetic.') for name in CAMERA_SCHEMA.names)
+    assert all(spec.name.startswith('synthetic.') for spec in CAMERA_SCHEMA.file_only)
 
 
 def test_the_node_parameters_follow_the_config_keys():
@@ -54,7 +66,8 @@ def test_vectors_have_their_geometric_length(name, length):
 )
 def test_what_one_value_cannot_show_is_refused_by_the_configuration(values, key, message):
     # Each value alone is one the schema accepts; together they describe no camera.
-    assert CAMERA_SCHEMA.first_problem(values) is None
+    specs = {spec.name: spec for spec in CAMERA_SETTINGS}
+    assert all(specs[k].problem(v) is None for k, v in values.items())
     with pytest.raises(ConfigError, match=f'{key}.*{message}'):
         camera_config_from_parameters(values, 'probe')
 
@@ -65,7 +78,6 @@ def test_what_one_value_cannot_show_is_refused_by_the_configuration(values, key,
         ('camera.width_px', 32, 'at least 64'),
         ('camera.focal_length_px', 0.0, 'positive'),
         ('camera.distortion', [0.0] * 4, 'a list of 5 finite numbers'),
-        ('synthetic.light_dn', 256.0, 'in [0, 255]'),
         ('pose_model', 'sphere', 'one of plane, free'),
         ('frame_id', 3, 'must be a string'),
         ('use_config_camera_info', 'yes', 'true or false'),

@@ -29,8 +29,10 @@ def test_the_module_prints_the_reference():
 def test_one_row_per_parameter(schema):
     table = node_table(schema)
     rows = [line for line in table.splitlines() if line.startswith('| `')]
-    assert [row.split('`')[1] for row in rows] == schema.names
-    assert all(row.count(' | ') == 6 for row in rows)  # no '|' inside a cell breaks the table
+    file_only = [spec.name for spec in schema.file_only]
+    assert [row.split('`')[1] for row in rows] == schema.names + file_only
+    # No '|' inside a cell breaks a table (the file's own parameters: no read-only column).
+    assert [row.count(' | ') for row in rows] == [6] * len(schema.names) + [5] * len(file_only)
     assert table.startswith(f'## `{schema.node}`')
 
 

@@ -114,13 +114,15 @@ def test_schema_lookup_and_problems():
 @pytest.mark.parametrize('schema', SCHEMAS, ids=lambda s: s.node)
 def test_the_config_file_holds_the_schema_defaults(schema):
     values = read_parameter_file(config_path(schema.config_file))
-    assert set(values) <= set(schema.names)
-    assert {name: schema[name].default for name in values} == {
+    specs = {spec.name: spec for spec in (*schema, *schema.file_only)}
+    assert set(values) <= set(specs)
+    assert {name: specs[name].default for name in values} == {
         # The file's lists are the schema's tuples.
         name: tuple(v) if isinstance(v, list) else v
         for name, v in values.items()
     }
-    assert schema.first_problem(values) is None
+    assert schema.first_problem({k: v for k, v in values.items() if k in schema}) is None
+    assert all(specs[k].problem(v) is None for k, v in values.items())
 
 
 def _beyond(spec):

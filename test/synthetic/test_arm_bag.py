@@ -63,6 +63,7 @@ def test_the_record_starts_at_rest_at_the_first_row():
         (3, 1.0, 0.0, 'trajectory has 3 joints, the arm 2'),
         (2, 0.2, 0.0, 'shorter than the trajectory'),
         (2, 1.0, -1.0, 'cannot be negative'),
+        (2, 1e6, 0.0, 'the limit is'),
     ],
 )
 def test_bad_inputs_are_one_line(tmp_path, joints, duration, start, words):
