@@ -53,6 +53,12 @@ test-slow: venv
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -m 'slow and not ros'
 	$(BIN)/python -m pytest -m 'slow and ros'
 
+# The bag fuzz campaign at length: random damage to a product-written bag through the
+# readers, doctor, repair, analyze and diagnose (test/bagio/test_fuzz.py; make test runs 200).
+FUZZ_CASES ?= 5000
+fuzz: venv
+	LUMPBEAM_FUZZ_CASES=$(FUZZ_CASES) $(BIN)/python -m pytest test/bagio/test_fuzz.py -n0 -q -p no:logging
+
 lint: venv
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
