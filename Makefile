@@ -16,7 +16,7 @@ export ROS_HOME := $(CURDIR)/.cache/ros
 export ROS_AUTOMATIC_DISCOVERY_RANGE ?= LOCALHOST
 export PYTHONDONTWRITEBYTECODE :=
 
-.PHONY: venv demo test test-slow lint typecheck bench docs clean
+.PHONY: venv demo test test-slow fuzz lint typecheck bench docs clean
 
 # One pip run: the venv's own pip installs these wheels as well as a newer one would, so it
 # is not upgraded first (about 5 s). --no-compile: Python compiles a module when it is first
