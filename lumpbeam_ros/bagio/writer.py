@@ -223,6 +223,13 @@ class BagWriter(ClosedOnExit):
         ns = convert.seconds_to_ns(stamp)
         self.write_message(topic, convert.float64(value), ns)
 
+    def write_joint_state(
+        self, topic: str, stamp: float, names: Iterable[str], positions: np.ndarray
+    ) -> None:
+        """Writes a ``sensor_msgs/msg/JointState`` of joint angles (e.g. ``/joint_states``)."""
+        ns = convert.seconds_to_ns(stamp)
+        self.write_message(topic, convert.joint_state(ns, names, positions), ns)
+
     def write_point(
         self, topic: str, stamp: float, x: float, y: float, z: float, frame: str
     ) -> None:
