@@ -17,9 +17,9 @@ from rclpy.node import Node
 from std_msgs.msg import Float64
 
 from lumpbeam_ros.errors import ConfigError, LumpbeamError
-from lumpbeam_ros.nodes.counts import COUNTS_DIR_ENV, read_counts
 from lumpbeam_ros.interface import BEAM_PARAMS, MODEL_DISCREPANCY, TIP_POSE, TIP_POSE_PREDICTED
 from lumpbeam_ros.model.parameters import load_beam_config
+from lumpbeam_ros.nodes.counts import COUNTS_DIR_ENV, read_counts
 from lumpbeam_ros.nodes.lifecycle import CONFIG_ERROR, run_node
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 from lumpbeam_ros.synthetic.images import ImageOptions
