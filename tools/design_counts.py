@@ -450,8 +450,12 @@ def effect_places(repo: Path) -> list[str]:
 
 
 def _names_effect(call: ast.Call, effects: set[str]) -> bool:
-    """Whether a call declares an effect record (its name among its literal arguments)."""
-    return any(isinstance(a, ast.Constant) and a.value in effects for a in call.args)
+    """Whether a call declares an effect record (its name a literal argument, maybe nested)."""
+    return any(
+        isinstance(a, ast.Constant) and a.value in effects
+        for arg in call.args
+        for a in ast.walk(arg)
+    )
 
 
 def lab_imports(repo: Path) -> list[str]:

@@ -22,7 +22,7 @@ import numpy as np
 
 from lumpbeam_ros.model.integrate import ChainState
 from lumpbeam_ros.model.parameters import BeamParameters
-from lumpbeam_ros.model.sensor import scaled_position
+from lumpbeam_ros.model.sensor import measured_position, scaled_position
 from lumpbeam_ros.model.simulate import DEFAULT_STEP_S, BeamSimulation
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
@@ -119,6 +119,7 @@ class PredictionStream:
         self._simulation = BeamSimulation(self._beam, load, t0=start, step=self.step)
         self._events.clear()
         self._time = float(t)
+        self._origin = float(t)  # mount_creep counts from here
         self._next_index = first_index
 
     def set_beam(self, beam: BeamParameters) -> None:
@@ -206,7 +207,7 @@ class PredictionStream:
         phi[lo:], _ = simulation.advance(physical[lo:])
         loads[lo:] = simulation.load_kg
         x, z, pitch = simulation.chain.tip_pose(phi)
-        x, z = scaled_position(self._beam, x, z)
+        x, z = measured_position(self._beam, stamps - self._origin, x, z)
         return TipTrajectory(t=stamps, x=x, z=z, pitch=pitch, load_kg=loads, q=phi)
 
 
