@@ -15,6 +15,7 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import POSE_RATE_HZ
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.integrate import ChainState, ModalSolver, solve_reference
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
@@ -200,7 +201,7 @@ def drop_test_events(drop: DropTestConfig) -> list[tuple[float, float]]:
 def simulate_drop_test(
     beam: BeamParameters,
     drop: DropTestConfig | None = None,
-    rate_hz: float = 180.0,
+    rate_hz: float = POSE_RATE_HZ,
     step: float = DEFAULT_STEP_S,
 ) -> TipTrajectory:
     """The paper's drop test (section B.3): at rest with ``m_d + m_l``, ``m_l`` released.

@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from lumpbeam_ros.interface import POSE_RATE_HZ
 from lumpbeam_ros.model.integrate import ChainState
 from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.model.sensor import measured_position, scaled_position
@@ -57,7 +58,7 @@ class PredictionStream:
         beam: BeamParameters,
         load_kg: float,
         t0: float,
-        rate_hz: float = 180.0,
+        rate_hz: float = POSE_RATE_HZ,
         step: float = DEFAULT_STEP_S,
     ):
         self.step = step
