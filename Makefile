@@ -16,7 +16,7 @@ export ROS_HOME := $(CURDIR)/.cache/ros
 export ROS_AUTOMATIC_DISCOVERY_RANGE ?= LOCALHOST
 export PYTHONDONTWRITEBYTECODE :=
 
-.PHONY: venv demo test test-slow lint typecheck bench clean
+.PHONY: venv demo test test-slow lint typecheck bench docs clean
 
 # One pip run: the venv's own pip installs these wheels as well as a newer one would, so it
 # is not upgraded first (about 5 s). --no-compile: Python compiles a module when it is first
@@ -39,6 +39,8 @@ demo: venv
 PYTEST_WORKERS ?= auto
 PYTEST_PARALLEL := -n $(PYTEST_WORKERS) --maxprocesses=4 --dist loadscope
 
+# pytest also builds the documentation site (mkdocs build --strict) and checks its links
+# (test/test_docs.py).
 test: venv
 	$(BIN)/ruff check .
 	$(BIN)/mypy
@@ -62,5 +64,11 @@ typecheck: venv
 bench: venv
 	$(BIN)/lumpbeam bench --json results/bench.json
 
+# The documentation site (mkdocs.yml): the README, the pages under doc/ and the API reference
+# from the docstrings, into site/. `make test` builds it too, with warnings as errors, and
+# checks its internal links (test/test_docs.py).
+docs: venv
+	$(BIN)/mkdocs build --strict --site-dir site
+
 clean:
-	rm -rf $(VENV) .cache results build install log *.egg-info
+	rm -rf $(VENV) .cache results build install log site *.egg-info

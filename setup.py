@@ -49,6 +49,7 @@ setup(
             'simulator_node = lumpbeam_ros.nodes.simulator_node:main',
             'camera_node = lumpbeam_ros.nodes.camera_node:main',
             'diagnosis_node = lumpbeam_ros.nodes.diagnosis_node:main',
+            'shaper_node = lumpbeam_ros.nodes.shaper_node:main',
         ],
     },
 )

@@ -34,6 +34,7 @@ COMPRESSED_IMAGE_TYPE = 'sensor_msgs/msg/CompressedImage'
 CAMERA_INFO_TYPE = 'sensor_msgs/msg/CameraInfo'
 CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
 MARKER_ARRAY = 'visualization_msgs/msg/MarkerArray'
+JOINT_TRAJECTORY_TYPE = 'trajectory_msgs/msg/JointTrajectory'
 
 # -- topics (absolute: the default graph's and the bags' names) -------------------------------
 
@@ -51,6 +52,8 @@ BEAM_MARKERS = '/beam_markers'
 MODEL_DISCREPANCY = '/model_discrepancy'
 DIAGNOSTICS = '/diagnostics'
 TIP_POSE_TRUTH = '/tip_pose_truth'
+JOINT_TRAJECTORY = '/joint_trajectory'
+JOINT_TRAJECTORY_SHAPED = '/joint_trajectory_shaped'
 
 #: Every topic of the interface with its message type.
 TOPIC_TYPES: dict[str, str] = {
@@ -68,6 +71,8 @@ TOPIC_TYPES: dict[str, str] = {
     MODEL_DISCREPANCY: DIAGNOSTIC_ARRAY,
     DIAGNOSTICS: DIAGNOSTIC_ARRAY,
     TIP_POSE_TRUTH: POSE_STAMPED,
+    JOINT_TRAJECTORY: JOINT_TRAJECTORY_TYPE,
+    JOINT_TRAJECTORY_SHAPED: JOINT_TRAJECTORY_TYPE,
 }
 
 #: Topics that stay absolute in a namespace: the graph-wide ones.
@@ -88,6 +93,7 @@ CAMERA_NODE = 'camera_node'
 IDENTIFIER_NODE = 'identifier_node'
 SIMULATOR_NODE = 'simulator_node'
 DIAGNOSIS_NODE = 'diagnosis_node'
+SHAPER_NODE = 'shaper_node'
 PLAYER_NODE = 'lumpbeam_player'
 RECORDER_NODE = 'lumpbeam_recorder'
 

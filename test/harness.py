@@ -25,6 +25,9 @@ test without a graph that needs a domain of its own takes the ``ros_domain_id`` 
 from __future__ import annotations
 
 import os
+import signal
+import subprocess
+import sys
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -157,6 +160,49 @@ class RosGraph:
 
 
 SENSOR_QOS = qos_profile_sensor_data
+
+
+#: Longest time a node or a command may take to exit after SIGINT or SIGTERM, s.
+STOP_BOUND_S = 2.0
+
+
+def start_process(env: dict[str, str], *argv: str) -> subprocess.Popen[str]:
+    """Starts ``python -m ARGV...`` (a node's module or ``lumpbeam_ros.cli.main ...``).
+
+    Args:
+        env: Its environment (:func:`ros_env`).
+        *argv: The module and its arguments.
+
+    Returns:
+        The process, its output captured as text.
+    """
+    return subprocess.Popen(
+        [sys.executable, '-m', *argv],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def stop_with(
+    process: subprocess.Popen[str], sig: signal.Signals, bound_s: float = STOP_BOUND_S
+) -> tuple[int, str, str]:
+    """Sends ``sig`` and waits at most ``bound_s`` for the process to exit.
+
+    A process still running then is killed, and the test fails with its output.
+
+    Returns:
+        The exit code, stdout and stderr.
+    """
+    process.send_signal(sig)
+    try:
+        stdout, stderr = process.communicate(timeout=bound_s)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        stdout, stderr = process.communicate()
+        pytest.fail(f'still running {bound_s} s after {sig.name}; stderr: {stderr[-3000:]}')
+    return process.returncode, stdout, stderr
 
 
 @pytest.fixture

@@ -11,10 +11,16 @@ from __future__ import annotations
 import argparse
 import ast
 import doctest
+import os
 import re
+import shutil
+import subprocess
+import sys
 from dataclasses import fields
 from functools import cache
+from html.parser import HTMLParser
 from pathlib import Path
+from urllib.parse import unquote
 
 import pytest
 
@@ -275,3 +281,145 @@ def test_missing_effects_table():
             f'doc/interfaces.md "Missing effects": {name} is '
             f'{"" if name in EFFECT_PARAMETERS else "not "}in the model'
         )
+
+
+# --- The README and the documentation site -------------------------------------------------
+
+README = ROOT / 'README.md'
+#: The README is a quick start; the evidence and the details live under doc/.
+README_MAX_LINES = 250
+#: A command line in the README's code blocks: ``lumpbeam COMMAND ...``.
+README_COMMAND = re.compile(r'^(?:\$ )?lumpbeam (\w+)(.*)$', re.M)
+
+
+def readme_code() -> str:
+    """The README's fenced code blocks, one after the other."""
+    return '\n'.join(
+        re.findall(r'^```\w*\n(.*?)^```', README.read_text(encoding='utf-8'), re.M | re.S)
+    )
+
+
+def test_readme_is_a_quick_start():
+    lines = README.read_text(encoding='utf-8').splitlines()
+    assert len(lines) <= README_MAX_LINES, (
+        f'README.md has {len(lines)} lines: move the details into a page under doc/'
+    )
+
+
+def test_readme_commands_exist():
+    # Each `lumpbeam COMMAND --option` the README shows is a real subcommand and option.
+    parsers = subparsers()
+    shown = README_COMMAND.findall(readme_code())
+    assert {'track', 'analyze', 'diagnose', 'compare', 'campaign', 'view'} <= {c for c, _ in shown}
+    for command, rest in shown:
+        assert command in parsers, f'README.md shows `lumpbeam {command}`: no such command'
+        options = {o for a in parsers[command]._actions for o in a.option_strings}
+        for option in re.findall(r'(?<!\S)(--[\w-]+)', rest.split('#')[0]):
+            assert option in options, f'README.md: `lumpbeam {command}` has no {option}'
+
+
+def test_readme_links_into_doc_resolve():
+    # On a Git host the README links straight to the pages (the site's home page rewrites them).
+    text = README.read_text(encoding='utf-8')
+    for target in re.findall(r'\]\(([^)#]+)', text):
+        assert not re.match(r'\w+://', target), f'README.md links outside: {target}'
+        assert (ROOT / target).is_file(), f'README.md links to a missing file: {target}'
+
+
+@pytest.fixture(scope='module')
+def site(tmp_path_factory) -> Path:
+    """The documentation site, built as ``make docs`` builds it, with warnings as errors."""
+    out = tmp_path_factory.mktemp('site')
+    result = subprocess.run(
+        [sys.executable, '-m', 'mkdocs', 'build', '--strict', '--quiet', '--site-dir', str(out)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert result.returncode == 0, f'mkdocs build --strict failed:\n{result.stdout}{result.stderr}'
+    return out
+
+
+class _Links(HTMLParser):
+    """The ids a page defines and the local links (href, src) it makes."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.ids: set[str] = set()
+        self.links: list[str] = []
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        for name, value in attrs:
+            if value is None:
+                continue
+            if name in ('id', 'name'):
+                self.ids.add(value)
+            elif name in ('href', 'src') and not re.match(r'[a-z][a-z0-9+.-]*:|//', value):
+                self.links.append(value)
+
+
+def _parse_pages(site: Path) -> dict[Path, _Links]:
+    pages = {}
+    for path in sorted(site.rglob('*.html')):
+        parser = _Links()
+        parser.feed(path.read_text(encoding='utf-8'))
+        pages[path] = parser
+    return pages
+
+
+def broken_links(site: Path) -> list[str]:
+    """Every local link of the built site whose file or anchor does not exist."""
+    pages = _parse_pages(site)
+    broken = []
+    for page, parsed in pages.items():
+        for link in parsed.links:
+            address, _, anchor = unquote(link).partition('#')
+            if address.startswith('/'):
+                target = site / address.lstrip('/')
+            else:
+                target = page.parent / address if address else page
+            target = Path(os.path.normpath(target))
+            if target.is_dir():
+                target = target / 'index.html'
+            where = f'{page.relative_to(site)}: {link}'
+            if not target.is_file():
+                broken.append(f'{where} (no file)')
+            elif anchor and target in pages and anchor not in pages[target].ids:
+                broken.append(f'{where} (no anchor)')
+    return broken
+
+
+def test_site_links_resolve(site):
+    assert (site / 'index.html').is_file()
+    assert not broken_links(site)
+
+
+def test_the_link_check_finds_a_broken_link(site, tmp_path):
+    copy = tmp_path / 'site'
+    shutil.copytree(site, copy)
+    page = copy / 'guide' / 'index.html'
+    page.write_text(
+        page.read_text(encoding='utf-8') + '<a href="../interfaces/#no-such-heading">x</a>'
+        '<a href="../no-such-page/">y</a>',
+        encoding='utf-8',
+    )
+    assert broken_links(copy) == [
+        'guide/index.html: ../interfaces/#no-such-heading (no anchor)',
+        'guide/index.html: ../no-such-page/ (no file)',
+    ]
+
+
+def test_every_core_package_has_an_api_page(site):
+    # The pages are generated from tools/test_modules.py's core list (tools/docs_site.py).
+    from test_test_modules import _tool
+
+    for name in _tool().CORE_PACKAGES:
+        page = site / 'api' / name / 'index.html'
+        assert page.is_file(), f'no API page for lumpbeam_ros.{name}'
+        assert f'id="lumpbeam_ros.{name}' in page.read_text(encoding='utf-8')
+
+
+def test_every_doc_page_is_on_the_site(site):
+    for path in DOCS:
+        assert (site / path.stem / 'index.html').is_file(), f'doc/{path.name} is not on the site'

@@ -15,7 +15,14 @@ from lumpbeam_ros.paramfile import (
 )
 from lumpbeam_ros.resources import config_path
 
-CONFIGS = ['paper_beam.yaml', 'camera.yaml', 'identifier.yaml', 'simulator.yaml', 'diagnosis.yaml']
+CONFIGS = [
+    'paper_beam.yaml',
+    'camera.yaml',
+    'identifier.yaml',
+    'simulator.yaml',
+    'diagnosis.yaml',
+    'shaper.yaml',
+]
 
 
 @pytest.mark.parametrize('name', CONFIGS)

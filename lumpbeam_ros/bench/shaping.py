@@ -50,13 +50,14 @@ def shaping_speed(name: str, modes: list[Mode], points: int, repeat: int) -> Ben
     ours, shaped = best_time(lambda: shape_trajectory(trajectory, impulses), repeat)
     theirs, baseline = best_time(lambda: _fft_shaped(trajectory, impulses), repeat)
     rows = min(shaped.time_s.size, baseline.shape[0])
+    value, baseline_value = ours / JOINTS * 1e3, theirs / JOINTS * 1e3
     return BenchResult(
         name=name,
-        value=ours / JOINTS * 1e3,
+        value=value,
         unit='ms per joint',
         baseline=BASELINE,
-        baseline_value=theirs / JOINTS * 1e3,
-        ratio=theirs / ours,
+        baseline_value=baseline_value,
+        ratio=baseline_value / value,
         details={
             'points': points,
             'joints': JOINTS,

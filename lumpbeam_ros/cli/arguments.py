@@ -24,6 +24,28 @@ Subparsers = argparse._SubParsersAction
 Declare = Callable[[Subparsers], argparse.ArgumentParser]
 
 
+class IntermixedParser(argparse.ArgumentParser):
+    """A subcommand's parser that takes positional arguments before, between and after options.
+
+    ``lumpbeam record OUT --duration 1 /tip_pose``: the plain parser assigns every positional
+    at its first run of them (``TOPIC...`` gets none) and then refuses ``/tip_pose``.
+    """
+
+    _intermixing = False
+
+    def parse_known_args(  # type: ignore[override]
+        self, args: Any = None, namespace: Any = None
+    ) -> tuple[argparse.Namespace, list[str]]:
+        """Parses as :meth:`argparse.ArgumentParser.parse_known_intermixed_args` does."""
+        if self._intermixing:  # its own passes call this method again
+            return super().parse_known_args(args, namespace)
+        self._intermixing = True
+        try:
+            return self.parse_known_intermixed_args(args, namespace)
+        finally:
+            self._intermixing = False
+
+
 def _subcommand(name: str, **options: Any) -> Callable[[Callable[..., None]], Declare]:
     """Makes a function that adds a subcommand's arguments the one that declares it.
 

@@ -4,16 +4,22 @@ Each subcommand is registered here by name with the function that declares its a
 (:mod:`lumpbeam_ros.cli.arguments`, standard library only) and the ``'module:function'``
 that runs it, imported only once the command is chosen: ``lumpbeam --help`` and
 ``lumpbeam COMMAND --help`` load no numpy, OpenCV or ROS. This module only dispatches: a
-:class:`~lumpbeam_ros.errors.LumpbeamError` or a missing optional package becomes one line
-on stderr and exit code 2.
+:class:`~lumpbeam_ros.errors.LumpbeamError`, a missing optional package or a path the
+system refuses (an ``OSError`` naming a file: a name too long, no permission, no space)
+becomes one line on stderr and exit code 2. SIGTERM stops a command as Ctrl-C does (files
+being written are closed or removed on the way out), exit code 128 + the signal.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import signal
 import sys
-from collections.abc import Callable, Sequence
+import threading
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from types import FrameType
 from typing import NamedTuple
 
 from lumpbeam_ros import __version__
@@ -70,7 +76,12 @@ def build_parser() -> argparse.ArgumentParser:
         description='Lumped-parameter flexible beams: reproduce, track, identify, diagnose.',
     )
     parser.add_argument('--version', action='version', version=f'%(prog)s {__version__}')
-    subparsers = parser.add_subparsers(dest='command', metavar='COMMAND', required=True)
+    subparsers = parser.add_subparsers(
+        dest='command',
+        metavar='COMMAND',
+        required=True,
+        parser_class=arguments.IntermixedParser,
+    )
     for command in COMMANDS:
         command.declare(subparsers).set_defaults(target=command.target)
     return parser
@@ -103,20 +114,59 @@ def main(argv: Sequence[str] | None = None) -> int:
         else the subcommand's code.
     """
     args = build_parser().parse_args(argv)
+    with _sigterm_interrupts() as received:
+        try:
+            return int(load_target(args.target)(args) or 0)
+        except LumpbeamError as exc:
+            print(f'lumpbeam {args.command}: error: {exc}', file=sys.stderr)
+            return USAGE_ERROR
+        except ModuleNotFoundError as exc:
+            message = missing_package_message(args.command, exc)
+            if message is None:
+                raise
+            print(message, file=sys.stderr)
+            return USAGE_ERROR
+        except OSError as exc:
+            if exc.filename is None:
+                raise
+            print(f'lumpbeam {args.command}: error: {_os_error_line(exc)}', file=sys.stderr)
+            return USAGE_ERROR
+        except KeyboardInterrupt:
+            print(f'lumpbeam {args.command}: interrupted', file=sys.stderr)
+            return 128 + (received[0] if received else signal.SIGINT)
+
+
+def _os_error_line(exc: OSError) -> str:
+    """``OSError`` as one line: the path(s) and what the system said."""
+    paths = ' -> '.join(str(p) for p in (exc.filename, exc.filename2) if p is not None)
+    return f'{paths}: {exc.strerror or exc}'
+
+
+@contextmanager
+def _sigterm_interrupts() -> Iterator[list[int]]:
+    """Within the block, SIGTERM raises ``KeyboardInterrupt`` as Ctrl-C does.
+
+    Python's default SIGTERM ends the process at once, leaving a bag being written without
+    its summary. A command that handles its signals itself (``play``, ``record``) installs
+    its own handlers inside the block. Outside the main thread nothing is changed.
+
+    Yields:
+        The signals received (SIGTERM), for the exit code.
+    """
+    received: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield received
+        return
+
+    def interrupt(signum: int, _frame: FrameType | None) -> None:
+        received.append(signum)
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
     try:
-        return int(load_target(args.target)(args) or 0)
-    except LumpbeamError as exc:
-        print(f'lumpbeam {args.command}: error: {exc}', file=sys.stderr)
-        return USAGE_ERROR
-    except ModuleNotFoundError as exc:
-        message = missing_package_message(args.command, exc)
-        if message is None:
-            raise
-        print(message, file=sys.stderr)
-        return USAGE_ERROR
-    except KeyboardInterrupt:
-        print(f'lumpbeam {args.command}: interrupted', file=sys.stderr)
-        return 130
+        yield received
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == '__main__':

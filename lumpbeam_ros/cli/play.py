@@ -22,7 +22,7 @@ def run(args: argparse.Namespace) -> int:
 
     from lumpbeam_ros.bagio import BagReader
     from lumpbeam_ros.nodes.lifecycle import checked_namespace, stoppable_session
-    from lumpbeam_ros.nodes.player import Player
+    from lumpbeam_ros.nodes.player import MAX_GAP_S, Player, PlayStats, sleep_until
 
     namespace = checked_namespace(args.namespace)
     reader = BagReader(args.bag)
@@ -30,19 +30,28 @@ def run(args: argparse.Namespace) -> int:
         player = None
         try:
             player = Player(reader, args.topics, rate=args.rate, namespace=namespace)
-            time.sleep(args.delay)
+            sleep_until(time.perf_counter() + args.delay, lambda: stop.requested)
             # A message sent before a reliable subscriber is matched is not delivered to it.
-            unheard = player.wait_for_subscribers(args.delay)
-            if unheard:
+            unheard = player.wait_for_subscribers(args.delay, lambda: stop.requested)
+            if unheard and not stop.requested:
                 print(
                     f'lumpbeam play: warning: no subscriber yet on {", ".join(unheard)}',
                     file=sys.stderr,
                 )
             passes = 0
-            while True:
+            stats = PlayStats({})
+            while not stop.requested:
                 stats = player.play(lambda: stop.requested)
                 passes += 1
-                if not args.loop or stop.requested:
+                if stats.gaps_shortened:
+                    print(
+                        f'lumpbeam play: warning: {stats.gaps_shortened} gap'
+                        f'{"s" if stats.gaps_shortened > 1 else ""} between messages longer '
+                        f'than {MAX_GAP_S:g} s played as {MAX_GAP_S:g} s (longest '
+                        f'{stats.longest_gap_s:g} s of bag time); /clock jumps as the bag does',
+                        file=sys.stderr,
+                    )
+                if not args.loop:
                     break
         finally:
             if player is not None:
@@ -52,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
     write_counts('player', {**stats.published, CLOCK: stats.clock_published})
     total = sum(stats.published.values())
     print(
-        f'played {args.bag} ({passes} pass{"es" if passes > 1 else ""}): {total} messages in '
+        f'played {args.bag} ({passes} pass{"" if passes == 1 else "es"}): {total} messages in '
         f'the last pass, lateness p99 {stats.lateness_percentile_ms(99):.2f} ms'
     )
     if not stats.delivered:

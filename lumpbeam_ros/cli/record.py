@@ -16,8 +16,8 @@ def run(args: argparse.Namespace) -> int:
         0 after a clean stop.
 
     Raises:
-        LumpbeamError: No topic given, a namespace rclpy rejects, an existing OUT, or a
-            write error.
+        LumpbeamError: No topic given, a topic name or namespace rclpy rejects, an existing
+            OUT, or a write error.
     """
     if not args.topics and not args.all:
         raise LumpbeamError('name the topics to record, or pass --all')
@@ -27,17 +27,18 @@ def run(args: argparse.Namespace) -> int:
     from rclpy.executors import SingleThreadedExecutor
 
     from lumpbeam_ros.bagio import BagWriter
-    from lumpbeam_ros.nodes.lifecycle import checked_namespace, stoppable_session
+    from lumpbeam_ros.nodes.lifecycle import checked_namespace, checked_topics, stoppable_session
     from lumpbeam_ros.nodes.recorder import Recorder
 
     namespace = checked_namespace(args.namespace)
+    topics = checked_topics(args.topics)
     bag = BagWriter(args.out, flush_period_s=args.flush_period)
     with stoppable_session() as stop:
         node = None
         try:
             node = Recorder(
                 bag,
-                None if args.all else args.topics,
+                None if args.all else topics,
                 flush_period_s=args.flush_period,
                 namespace=namespace,
             )
@@ -68,8 +69,8 @@ def run(args: argparse.Namespace) -> int:
 
 #: After Ctrl-C the recorder keeps taking messages until none came for this long, s ...
 DRAIN_QUIET_S = 0.2
-#: ... but no longer than this, s.
-DRAIN_MAX_S = 2.0
+#: ... but no longer than this, s (a stop is obeyed within 2 s, also under steady traffic).
+DRAIN_MAX_S = 1.0
 
 
 def _drain(executor: Any, node: Any) -> None:

@@ -10,8 +10,8 @@ One place for what each node's ``main`` did alike (:func:`run_node`):
   (:mod:`lumpbeam_ros.nodes.counts`) however it stopped.
 
 The commands that run a node in their own loop (``lumpbeam play``, ``lumpbeam record``) take
-their namespace from :func:`checked_namespace` and their rclpy session and stop request from
-:func:`stoppable_session`.
+their namespace from :func:`checked_namespace`, their topic names from :func:`checked_topics`
+and their rclpy session and stop request from :func:`stoppable_session`.
 """
 
 from __future__ import annotations
@@ -24,12 +24,18 @@ from types import FrameType
 from typing import TypeVar
 
 import rclpy
-from rclpy.exceptions import InvalidNamespaceException, ParameterException
+from rclpy.exceptions import (
+    InvalidNamespaceException,
+    InvalidTopicNameException,
+    ParameterException,
+)
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
+from rclpy.validate_full_topic_name import validate_full_topic_name
 from rclpy.validate_namespace import validate_namespace
+from rclpy.validate_topic_name import validate_topic_name
 
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.nodes.counts import write_counts
@@ -105,6 +111,30 @@ def checked_namespace(namespace: str | None) -> str:
         reason = str(exc).splitlines()[0].removeprefix('Invalid namespace: ').rstrip(':')
         raise LumpbeamError(f'--namespace {namespace!r}: {reason}') from None
     return namespace
+
+
+def checked_topics(topics: Sequence[str]) -> list[str]:
+    """Topic names given on the command line, checked by rclpy's validator.
+
+    Args:
+        topics: Topic names (``'/tip_pose'``; a relative name is taken in the node's
+            namespace; ``~`` and ``{}`` substitutions are refused).
+
+    Returns:
+        The names, unchanged.
+
+    Raises:
+        LumpbeamError: rclpy rejects one; the message names it and says what is wrong.
+    """
+    for topic in topics:
+        try:
+            validate_topic_name(topic)
+            # The full name's rules too (no '//'), as the topic would have in the root.
+            validate_full_topic_name(topic if topic.startswith('/') else f'/{topic}')
+        except InvalidTopicNameException as exc:
+            reason = str(exc).splitlines()[0].split(': ', 1)[-1].rstrip(':')
+            raise LumpbeamError(f'topic {topic!r}: {reason}') from None
+    return list(topics)
 
 
 class StopRequest:

@@ -6,11 +6,16 @@ read in file order, can hold one earlier than the last, which is published at on
 ``Publisher.publish(bytes)`` publishes serialized data), so nothing is deserialized.
 Message ``i`` is published at wall time ``start + (log_time_i - log_time_0) / rate``;
 ``/clock`` carries the log time before each message, so nodes with ``use_sim_time`` follow
-the bag. Each topic is published with the QoS its recorder was offered, or the project's
-default (:mod:`lumpbeam_ros.bagio.qos`): best effort for images, reliable transient-local
-for ``/tip_load``, reliable otherwise. Each topic is published by its relative name: in a
-namespace (``/beam_a``) the bag's ``/tip_pose`` goes to ``/beam_a/tip_pose``; ``/clock`` stays
-graph-wide (:func:`~lumpbeam_ros.interface.node_topic`).
+the bag. A gap between two messages longer than :data:`MAX_GAP_S` (after ``rate``) is played
+as :data:`MAX_GAP_S` and counted (a bag whose stamps jump by days is not waited through);
+``/clock`` still jumps as the bag does. The player sleeps in slices of at most
+:data:`SLEEP_SLICE_S`, asking between them whether to stop, so a stop request is obeyed
+within one slice whatever the gap. Each topic is published with the QoS its recorder was
+offered, or the project's default (:mod:`lumpbeam_ros.bagio.qos`): best effort for images,
+reliable transient-local for ``/tip_load``, reliable otherwise. Each topic is published by
+its relative name: in a namespace (``/beam_a``) the bag's ``/tip_pose`` goes to
+``/beam_a/tip_pose``; ``/clock`` stays graph-wide
+(:func:`~lumpbeam_ros.interface.node_topic`).
 """
 
 from __future__ import annotations
@@ -34,6 +39,31 @@ from lumpbeam_ros.nodes.msgtypes import from_bag_qos, message_class, topic_qos
 
 #: Longest wait at the end of playback for reliable subscribers' acknowledgements, s.
 DELIVERY_TIMEOUT_S = 5.0
+#: The same wait after a stop request, s.
+STOPPED_DELIVERY_TIMEOUT_S = 0.5
+#: Longest wall-clock wait between two messages, s: a longer gap is shortened to it.
+MAX_GAP_S = 5.0
+#: Longest single sleep, s: a stop request waits at most this long to be seen.
+SLEEP_SLICE_S = 0.1
+
+
+def sleep_until(due: float, should_stop: Callable[[], bool]) -> bool:
+    """Sleeps until ``time.perf_counter()`` reaches ``due``, in slices that check for a stop.
+
+    Args:
+        due: The ``time.perf_counter()`` value to wait for.
+        should_stop: Polled before each slice.
+
+    Returns:
+        ``False`` when a stop was requested before ``due``.
+    """
+    while True:
+        if should_stop():
+            return False
+        left = due - time.perf_counter()
+        if left <= 0.0:
+            return True
+        time.sleep(min(left, SLEEP_SLICE_S))
 
 
 @dataclass
@@ -47,6 +77,9 @@ class PlayStats:
         clock_published: ``/clock`` messages published (one before each message).
         out_of_order: Messages whose log time was before an earlier one's; they are
             published at once, and ``/clock`` holds its latest value rather than go back.
+        gaps_shortened: Gaps longer than :data:`MAX_GAP_S` (wall time) played as that.
+        longest_gap_s: The longest of them as the bag has it, s (0 when none).
+        stopped: Whether a stop request ended the pass early.
     """
 
     published: dict[str, int] = field(default_factory=dict)
@@ -54,6 +87,9 @@ class PlayStats:
     delivered: bool = True
     clock_published: int = 0
     out_of_order: int = 0
+    gaps_shortened: int = 0
+    longest_gap_s: float = 0.0
+    stopped: bool = False
 
     def lateness_percentile_ms(self, q: float) -> float:
         """Returns a percentile of the lateness, ms (0 when nothing was published)."""
@@ -109,16 +145,23 @@ class Player(Node):
         start_wall = None
         first_ns = 0
         clock_ns = 0
+        skipped_s = 0.0  # wall time taken out of long gaps
         clock = Clock()
         for raw in self.reader.iter_raw(self._outlets):
             if should_stop():
+                stats.stopped = True
                 break
             if start_wall is None:
                 start_wall, first_ns = time.perf_counter(), raw.log_time_ns
-            due = start_wall + (raw.log_time_ns - first_ns) * 1e-9 / self.rate
-            delay = due - time.perf_counter()
-            if delay > 0.0:
-                time.sleep(delay)
+            gap_s = (raw.log_time_ns - max(clock_ns, first_ns)) * 1e-9 / self.rate
+            if gap_s > MAX_GAP_S:
+                stats.gaps_shortened += 1
+                stats.longest_gap_s = max(stats.longest_gap_s, gap_s * self.rate)
+                skipped_s += gap_s - MAX_GAP_S
+            due = start_wall + (raw.log_time_ns - first_ns) * 1e-9 / self.rate - skipped_s
+            if not sleep_until(due, should_stop):
+                stats.stopped = True
+                break
             if raw.log_time_ns < clock_ns:
                 stats.out_of_order += 1  # a cut file is read in file order: never turn back
             clock_ns = max(clock_ns, raw.log_time_ns)
@@ -128,11 +171,20 @@ class Player(Node):
             self._outlets[raw.topic].publish(bytes(raw.data))
             stats.lateness_s.append(time.perf_counter() - due)
             stats.published[raw.topic] += 1
-        stats.delivered = self.wait_for_delivery()
+        # Stopped: a short wait only, the stop must not take longer than a user waits.
+        stats.delivered = self.wait_for_delivery(
+            STOPPED_DELIVERY_TIMEOUT_S if stats.stopped else DELIVERY_TIMEOUT_S
+        )
         return stats
 
-    def wait_for_subscribers(self, timeout_s: float) -> list[str]:
+    def wait_for_subscribers(
+        self, timeout_s: float, should_stop: Callable[[], bool] = lambda: False
+    ) -> list[str]:
         """Waits until every played topic has a matched subscriber, at most ``timeout_s``.
+
+        Args:
+            timeout_s: Longest wait, s.
+            should_stop: Polled while waiting; ``True`` ends the wait.
 
         Returns:
             The topics still without one (empty when all are heard).
@@ -142,7 +194,7 @@ class Player(Node):
             unheard = [
                 name for name, pub in self._outlets.items() if pub.get_subscription_count() == 0
             ]
-            if not unheard or time.monotonic() >= deadline:
+            if not unheard or time.monotonic() >= deadline or should_stop():
                 return unheard
             time.sleep(0.05)
 

@@ -12,6 +12,7 @@ from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA
 from lumpbeam_ros.params.diagnosis_params import DIAGNOSIS_SCHEMA
 from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA
 from lumpbeam_ros.params.schema import ParameterSchema, ParameterSpec, ParameterValue
+from lumpbeam_ros.params.shaper_params import SHAPER_SCHEMA
 from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA
 
 #: Every node's schema, in the order the reference lists them.
@@ -19,6 +20,7 @@ SCHEMAS: tuple[ParameterSchema, ...] = (
     CAMERA_SCHEMA,
     DIAGNOSIS_SCHEMA,
     IDENTIFIER_SCHEMA,
+    SHAPER_SCHEMA,
     SIMULATOR_SCHEMA,
 )
 

@@ -1,8 +1,11 @@
 """A joint trajectory shaped: the commanded angles convolved with a shaper's impulses.
 
 The shaped command is ``u_s(t) = sum_i A_i u(t - t_i)``. The trajectory is linear between
-its samples and held outside them, so each term is one linear interpolation of the input at
-shifted times: a sum over the few impulses replaces a full convolution.
+its samples and held outside them, so each term is the input linearly interpolated at
+shifted times: a sum over the few impulses replaces a full convolution. When the input is
+evenly sampled at 1 kHz or finer, the output keeps its grid and each shifted copy is a
+weighted sum of two row slices of the input (a fractional delay, exact for linear
+interpolation); otherwise each is one ``np.interp`` per joint.
 """
 
 from __future__ import annotations
@@ -21,26 +24,66 @@ MAX_STEP_S = 1e-3
 #: Most samples a shaped trajectory may have (about 2.8 h at 1 kHz).
 MAX_SAMPLES = 10_000_000
 
+#: Relative spread of the intervals below which samples count as evenly spaced.
+_EVEN = 1e-9
+
+
+def _even_step(time: np.ndarray) -> float | None:
+    """The sample interval of evenly spaced times, else ``None``."""
+    step = float(time[-1] - time[0]) / (time.size - 1)
+    return step if float(np.max(np.abs(np.diff(time) - step))) <= _EVEN * step else None
+
+
+def _count(span_s: float, step_s: float) -> int:
+    """Samples at ``step_s`` (the last interval possibly shorter) over ``span_s``."""
+    count = math.ceil(span_s / step_s * (1.0 - 1e-12)) + 1
+    if count > MAX_SAMPLES:
+        raise LumpbeamError(
+            f'the shaped trajectory would have {count} samples ({span_s:.6g} s at '
+            f'{1.0 / step_s:.6g} Hz), more than {MAX_SAMPLES}: is the frequency too low?'
+        )
+    return count
+
 
 def shaped_times(trajectory: JointTrajectory, impulses: Impulses) -> np.ndarray:
     """The sample times of the shaped trajectory.
 
-    Evenly spaced from the input's first time to its last plus the shaper's duration, at
-    1 kHz or at the input's own rate (its median interval) if finer.
+    From the input's first time to its last plus the shaper's duration. An input evenly
+    sampled at 1 kHz or finer keeps its grid (the last interval may be shorter, to end on
+    the last time); any other input gives evenly spaced times at 1 kHz, or at the input's
+    median interval if finer.
 
     Raises:
         LumpbeamError: The shaped trajectory would exceed :data:`MAX_SAMPLES` samples.
     """
-    step = min(MAX_STEP_S, float(np.median(np.diff(trajectory.time_s))))
     start = float(trajectory.time_s[0])
-    end = float(trajectory.time_s[-1]) + impulses.duration_s
-    count = math.ceil((end - start) / step * (1.0 - 1e-12)) + 1
-    if count > MAX_SAMPLES:
-        raise LumpbeamError(
-            f'the shaped trajectory would have {count} samples ({end - start:.6g} s at '
-            f'{1.0 / step:.6g} Hz), more than {MAX_SAMPLES}: is the frequency too low?'
-        )
-    return np.linspace(start, end, count)
+    span = trajectory.duration_s + impulses.duration_s
+    step = _even_step(trajectory.time_s)
+    if step is not None and step <= MAX_STEP_S:
+        times = start + np.arange(_count(span, step)) * step
+        times[-1] = start + span
+        return times
+    step = min(MAX_STEP_S, float(np.median(np.diff(trajectory.time_s))))
+    return np.linspace(start, start + span, _count(span, step))
+
+
+def _delayed_sum(angles: np.ndarray, step: float, count: int, impulses: Impulses) -> np.ndarray:
+    """``sum_i A_i u(k step - t_i)`` for ``k < count`` on the input's own even grid."""
+    shift = (impulses.time_s - impulses.time_s[0]) / step
+    whole = np.floor(shift).astype(int)
+    fraction = shift - whole
+    # The input held at its first row before it and at its last after it.
+    left = int(whole.max()) + 1
+    right = max(0, count - angles.shape[0]) + 1
+    padded = np.concatenate(
+        [np.repeat(angles[:1], left, axis=0), angles, np.repeat(angles[-1:], right, axis=0)]
+    )
+    shaped = np.zeros((count, angles.shape[1]))
+    for m, f, a in zip(whole, fraction, impulses.amplitude, strict=True):
+        at = padded[left - m : left - m + count]  # u at k - m
+        before = padded[left - m - 1 : left - m - 1 + count]  # u at k - m - 1
+        shaped += a * (at + f * (before - at))
+    return shaped
 
 
 def shape_trajectory(trajectory: JointTrajectory, impulses: Impulses) -> JointTrajectory:
@@ -59,11 +102,13 @@ def shape_trajectory(trajectory: JointTrajectory, impulses: Impulses) -> JointTr
         LumpbeamError: The shaped trajectory would be too long (see :func:`shaped_times`).
     """
     times = shaped_times(trajectory, impulses)
+    step = _even_step(trajectory.time_s)
+    if step is not None and step <= MAX_STEP_S:
+        shaped = _delayed_sum(trajectory.angles_rad, step, times.size, impulses)
+        return JointTrajectory(times, shaped, trajectory.joint_names)
     delay = impulses.time_s - impulses.time_s[0]
-    shaped = np.empty((times.size, trajectory.joint_count))
+    shaped = np.zeros((times.size, trajectory.joint_count))
     for j, angles in enumerate(trajectory.angles_rad.T):
-        column = shaped[:, j]
-        column[:] = impulses.amplitude[0] * np.interp(times - delay[0], trajectory.time_s, angles)
-        for t_i, a_i in zip(delay[1:], impulses.amplitude[1:], strict=True):
-            column += a_i * np.interp(times - t_i, trajectory.time_s, angles)
+        for t_i, a_i in zip(delay, impulses.amplitude, strict=True):
+            shaped[:, j] += a_i * np.interp(times - t_i, trajectory.time_s, angles)
     return JointTrajectory(times, shaped, trajectory.joint_names)

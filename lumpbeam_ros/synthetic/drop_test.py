@@ -9,6 +9,7 @@ The model is simulated under the drop-test load schedule and written as a rosbag
 from __future__ import annotations
 
 import math
+import shutil
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -31,7 +32,7 @@ from lumpbeam_ros.model.parameters import (
     DropTestConfig,
     effect_value_problem,
 )
-from lumpbeam_ros.model.simulate import drop_test_events, simulate_loads
+from lumpbeam_ros.model.simulate import DEFAULT_STEP_S, drop_test_events, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.synthetic.reference_sensor import (
     ReferenceSensorOptions,
@@ -56,6 +57,11 @@ PITCH_NOISE_PER_M = 1.0
 
 #: How often ``/tip_load`` repeats its value (doc/interfaces.md, 'Topics': at least 1 Hz).
 LOAD_REPEAT_S = 1.0
+
+#: Most samples one simulated stream may hold: the whole record is simulated in memory
+#: (about 1.8 kB a sample: the angles, poses, truth and the solver's grid), so this bounds
+#: it near 1 GB; 2777 s at the default 180 Hz.
+MAX_SAMPLES = 500_000
 
 
 @dataclass(frozen=True)
@@ -145,6 +151,27 @@ def simulate_experiment(
     return measured, simulate_loads(true_sensor, t, events, drop.load_kg)
 
 
+def check_sample_count(duration_s: float, rates_hz: Mapping[str, float]) -> None:
+    """Refuses a record that needs more than :data:`MAX_SAMPLES` samples in one stream.
+
+    Args:
+        duration_s: Record length, s.
+        rates_hz: Each stream's name and rate, Hz (the poses, the solver's grid, ...); the
+            fastest is checked.
+
+    Raises:
+        LumpbeamError: Too many samples; the message names the limit.
+    """
+    name, rate = max(rates_hz.items(), key=lambda item: item[1])
+    count = duration_s * rate
+    if not count <= MAX_SAMPLES:
+        raise LumpbeamError(
+            f'duration {duration_s:g} s at {rate:g} Hz ({name}) is {count:.3g} samples; '
+            f'the limit is {MAX_SAMPLES} ({MAX_SAMPLES / rate:.0f} s at {rate:g} Hz), '
+            'each simulated in memory'
+        )
+
+
 def load_messages(drop: DropTestConfig, duration_s: float) -> list[tuple[float, float]]:
     """``/tip_load`` samples: the load at 0 s, at every whole second, and at the release."""
     stamps = sorted({*np.arange(0.0, duration_s + 1e-9, LOAD_REPEAT_S), drop.release_time_s})
@@ -182,11 +209,17 @@ def write_drop_test_bag(
 
     Raises:
         BagError: ``out`` exists or cannot be written.
+        LumpbeamError: The record ends before the release, or needs more than
+            :data:`MAX_SAMPLES` samples in a stream.
     """
     if options.duration_s <= drop.release_time_s:
         raise LumpbeamError(
             f'duration {options.duration_s} s ends before the release at {drop.release_time_s} s'
         )
+    rates = {'poses': options.rate_hz, 'simulation grid': 1.0 / DEFAULT_STEP_S}
+    if tracker is not None:
+        rates['tracker'] = tracker.rate_hz
+    check_sample_count(options.duration_s, rates)
     measured, truth = simulate_experiment(beam, drop, options)
     assert truth.q is not None  # the truth keeps its joint angles
     rng = np.random.default_rng(options.seed)
@@ -210,34 +243,43 @@ def write_drop_test_bag(
             load_camera_config(None if images is None else images.camera_config)
         )
         lifetime = lifetime_for_rate(options.markers_rate_hz)
-    with BagWriter(out) as bag:
-        loads = iter(load_messages(drop, options.duration_s))
-        pending = next(loads, None)
-        for i, stamp in enumerate(measured.t):
-            while pending is not None and pending[0] <= stamp:
-                bag.write_float(TIP_LOAD, pending[0], pending[1])
-                pending = next(loads, None)
-            if points is not None:
-                written = write_reference_points(bag, points, written, stamp)
-            bag.write_pose(
-                TIP_POSE,
-                stamp,
-                measured.x[i] + noise[0, i],
-                measured.z[i] + noise[1, i],
-                measured.pitch[i] + noise[2, i],
-            )
-            bag.write_pose(TIP_POSE_TRUTH, stamp, truth.x[i], truth.z[i], truth.pitch[i])
-            if i in drawn:
-                scene = BeamScene(
-                    beam.segment_length_m,
-                    phi=truth.q[i],
-                    measured=TipPoint(measured.x[i] + noise[0, i], measured.z[i] + noise[1, i]),
-                    load_kg=float(truth.load_kg[i]),
-                    board=board,
+    created = not Path(out).exists()  # BagWriter refuses an existing OUT: never removed below
+    try:
+        with BagWriter(out) as bag:
+            loads = iter(load_messages(drop, options.duration_s))
+            pending = next(loads, None)
+            for i, stamp in enumerate(measured.t):
+                while pending is not None and pending[0] <= stamp:
+                    bag.write_float(TIP_LOAD, pending[0], pending[1])
+                    pending = next(loads, None)
+                if points is not None:
+                    written = write_reference_points(bag, points, written, stamp)
+                bag.write_pose(
+                    TIP_POSE,
+                    stamp,
+                    measured.x[i] + noise[0, i],
+                    measured.z[i] + noise[1, i],
+                    measured.pitch[i] + noise[2, i],
                 )
-                write_scene(bag, stamp, scene, lifetime)
-            if camera is not None:
-                camera.write_next(bag)
-        if points is not None:
-            write_reference_points(bag, points, written, math.inf)
+                bag.write_pose(TIP_POSE_TRUTH, stamp, truth.x[i], truth.z[i], truth.pitch[i])
+                if i in drawn:
+                    scene = BeamScene(
+                        beam.segment_length_m,
+                        phi=truth.q[i],
+                        measured=TipPoint(
+                            measured.x[i] + noise[0, i], measured.z[i] + noise[1, i]
+                        ),
+                        load_kg=float(truth.load_kg[i]),
+                        board=board,
+                    )
+                    write_scene(bag, stamp, scene, lifetime)
+                if camera is not None:
+                    camera.write_next(bag)
+            if points is not None:
+                write_reference_points(bag, points, written, math.inf)
+    except BaseException:
+        # Interrupted (Ctrl-C, SIGTERM) or failed: a bag cut short is not the record asked for.
+        if created:
+            shutil.rmtree(out, ignore_errors=True)
+        raise
     return measured, truth

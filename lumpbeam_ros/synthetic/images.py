@@ -27,6 +27,8 @@ CAMERA_INFO_TOPIC = CAMERA_INFO
 
 #: Smallest image side the camera configuration accepts, px.
 MIN_SIDE_PX = 64
+#: Largest frame rendered, px: rendering holds about 45 bytes a pixel (0.75 GB at this size).
+MAX_PIXELS = 4096 * 4096
 
 
 @dataclass(frozen=True)
@@ -51,13 +53,19 @@ class ImageOptions:
                 f'image size {self.width}x{self.height}: each side must be at least '
                 f'{MIN_SIDE_PX} px'
             )
+        if self.width * self.height > MAX_PIXELS:
+            raise LumpbeamError(
+                f'image size {self.width}x{self.height}: {self.width * self.height} px; the '
+                f'limit is {MAX_PIXELS} px (4096x4096), each frame rendered in memory'
+            )
 
 
 def parse_image_size(text: str) -> tuple[int, int]:
     """Parses ``WxH`` (e.g. ``1024x1024``) for ``--image-size``.
 
     Raises:
-        LumpbeamError: Not two positive integers joined by ``x``, or a side below 64 px.
+        LumpbeamError: Not two positive integers joined by ``x``, a side below 64 px, or
+            more than :data:`MAX_PIXELS`.
     """
     match = re.fullmatch(r'\s*(\d+)\s*[xX]\s*(\d+)\s*', text)
     if match is None:
@@ -65,6 +73,7 @@ def parse_image_size(text: str) -> tuple[int, int]:
     width, height = int(match.group(1)), int(match.group(2))
     if min(width, height) < MIN_SIDE_PX:
         raise LumpbeamError(f'--image-size {text!r}: each side must be at least {MIN_SIDE_PX} px')
+    ImageOptions(width, height)  # refuses a frame too large to render
     return width, height
 
 

@@ -40,6 +40,25 @@ class Checkerboard:
         return cols * rows
 
     @property
+    def turn_swaps_colours(self) -> bool:
+        """Whether the colours tell the board from itself turned by 180 degrees.
+
+        A turn maps square ``(i, j)`` to ``(squares_x - 1 - i, squares_y - 1 - j)``, which
+        has the other colour when ``squares_x + squares_y`` is odd (OpenCV's 10 x 7 squares
+        of 9 x 6 corners); with an even sum (9 x 7 squares) the turned board looks the same.
+        """
+        return (self.squares_x + self.squares_y) % 2 == 1
+
+    @property
+    def corner_polarity(self) -> float:
+        """Sign of corner 0's saddle in :func:`~lumpbeam_ros.vision.partial.board_polarity`.
+
+        -1: the square on corner 0's ``(+x, +y)`` side is dark, as the corner square at
+        ``(-x, -y)`` (:meth:`texture`, and OpenCV's labelling of its printed pattern).
+        """
+        return -1.0
+
+    @property
     def outline_m(self) -> np.ndarray:
         """The printed sheet's four corners (4 x 3, board frame, margin included), m."""
         half_x = (self.squares_x / 2.0 + self.margin_squares) * self.square_size_m

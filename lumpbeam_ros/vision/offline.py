@@ -14,7 +14,7 @@ camera node's.
 
 A frame that does not decode is a lost frame (counted, and the first of each kind named in
 the summary); an image whose size is not the camera's stops the run with an error, and OUT,
-incomplete, is removed.
+incomplete, is removed; so is OUT when no frame gave a pose, or when the run is interrupted.
 """
 
 from __future__ import annotations
@@ -282,11 +282,19 @@ class _Run:
         """Fills in the summary.
 
         Raises:
-            FootageError: Not one frame was read.
+            FootageError: Not one frame was read, or not one gave a pose (OUT would hold
+                no ``/tip_pose``).
         """
         stats, summary = self.session.stats, self.summary
         if stats.frames_in == 0:
             raise FootageError(f'{self.source}: no frames at all')
+        if stats.poses_out == 0:
+            lost = ', '.join(f'{k} {v}' for k, v in sorted(Counter(stats.lost).items()))
+            first = '; '.join(w for _, w in sorted(summary.first_problems.items()))
+            raise FootageError(
+                f'{self.source}: no pose in any of its {stats.frames_in} frames ({lost}); '
+                f'first: {first}'
+            )
         summary.frames, summary.poses = stats.frames_in, stats.poses_out
         summary.lost_by_reason = dict(Counter(stats.lost))
         summary.fps = stats.frames_in / self.tracking_s if self.tracking_s > 0 else float('nan')
@@ -302,10 +310,10 @@ class _Run:
 
 
 def _removing_on_error(out: Path, write: Callable[[], TrackSummary]) -> TrackSummary:
-    """Runs ``write``; when the input turns out unusable, removes the incomplete OUT."""
+    """Runs ``write``; removes the incomplete OUT when the input is unusable or on Ctrl-C."""
     try:
         return write()
-    except LumpbeamError:
+    except (LumpbeamError, KeyboardInterrupt):
         shutil.rmtree(out, ignore_errors=True)
         raise
 

@@ -474,6 +474,8 @@ class TipTracker:
             self._expected_axes,
             self.settings.detect_max_side_px,
             self._half_window,
+            # The free model's rig says nothing of the squares' size in the footage.
+            snap_to_grid=self.pose_model == 'free',
         )
         if corners is None:
             self.reset()
@@ -483,6 +485,7 @@ class TipTracker:
                 stamp, TrackStatus.BOARD_NOT_FOUND, 'no complete checkerboard in the frame',
                 detected=True,
             )  # fmt: skip
+        corners = self._turned_by_colour(gray, corners)
         ideal, problem = self._verify(gray, corners)
         if ideal is None:
             self.reset()
@@ -513,6 +516,30 @@ class TipTracker:
                 stamp, TrackStatus.POSE_REJECTED, problem, corners=corners, detected=True
             )
         return self._accept(stamp, corners, ideal, fit, detected=True)
+
+    def _turned_by_colour(self, gray: np.ndarray, corners: np.ndarray) -> np.ndarray:
+        """The detected corners, labelled by the board's colours where the free model needs it.
+
+        The detector's labelling follows the expected orientation, which the plane model's
+        rig fixes but the free model's board, turned any way, does not: a board turned by
+        some 90 degrees is as near one labelling as the other, 180 degrees apart, and a pose
+        would come out turned by 180 degrees about the board's normal (a stereo pair then
+        disagrees). When the colours tell the two apart, they decide.
+
+        Args:
+            gray: The frame.
+            corners: The detected corners (N x 2, finite) in board order.
+
+        Returns:
+            ``corners``, or the same turned by 180 degrees (reversed).
+        """
+        board = self._board
+        if self.pose_model != 'free' or not board.turn_swaps_colours:
+            return corners
+        polarity = board_polarity(gray, corners, board.pattern_size, self._half_window)
+        if polarity == board.corner_polarity:
+            return corners
+        return np.ascontiguousarray(corners[::-1])
 
     def _accept(
         self,

@@ -112,3 +112,70 @@ def test_a_missing_core_module_is_a_broken_install_not_a_hint():
     result = lumpbeam('reproduce', blocked=('numpy',))
     assert result.returncode == 1
     assert "ModuleNotFoundError: No module named 'numpy" in result.stderr
+
+
+#: One path component longer than any file system allows (255 bytes).
+LONG = 'a' * 300
+
+
+@pytest.mark.parametrize(
+    'argv',
+    [
+        ['synth', '{long}', '--duration', '3'],
+        ['track', '{bag}', '{long}'],
+        ['analyze', '{long}'],
+        ['diagnose', '{long}'],
+        ['compare', '{long}'],
+        ['record', '{long}', '/tip_pose'],
+        ['repair', '{long}'],
+        ['repair', '{bag}', '{long}'],
+        ['doctor', '{long}'],
+        ['play', '{long}'],
+        ['view', '--bag', '{long}', '--port', '0'],
+        ['campaign', '{long}', '--out', '{tmp}/results'],
+    ],
+    ids=lambda argv: ' '.join(argv[:2]),
+)
+def test_a_path_the_system_refuses_is_one_line(argv, small_bag, tmp_path, capsys, monkeypatch):
+    from lumpbeam_ros.cli.main import main
+
+    monkeypatch.chdir(tmp_path)
+    args = [a.format(long=LONG, bag=small_bag, tmp=tmp_path) for a in argv]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f'lumpbeam {argv[0]}: error: ') and '\n' not in err
+    assert LONG in err and 'too long' in err.lower()
+
+
+def test_sigterm_interrupts_a_command_as_ctrl_c_does(tmp_path):
+    """`synth` stopped by SIGTERM while it writes (frames): exit 143, one line, no partial bag."""
+    import signal
+    import time
+
+    out = tmp_path / 'long'
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            '-m',
+            'lumpbeam_ros.cli.main',
+            'synth',
+            str(out),
+            '--duration',
+            '4',
+            '--rate',
+            '30',
+            '--images',
+            '--image-size',
+            '320x240',
+        ],  # fmt: skip
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    while not out.exists() and process.poll() is None:
+        time.sleep(0.05)  # the simulation is done, the writing has begun
+    process.send_signal(signal.SIGTERM)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 128 + signal.SIGTERM, stderr
+    assert stderr.strip() == 'lumpbeam synth: interrupted'
+    assert not out.exists()

@@ -1,5 +1,6 @@
 import logging
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -8,7 +9,7 @@ import time
 import numpy as np
 import pytest
 from geometry_msgs.msg import PoseStamped
-from harness import SENSOR_QOS, ros_env
+from harness import SENSOR_QOS, ros_env, start_process, stop_with
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Image
@@ -16,6 +17,7 @@ from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio import BagReader, BagWriter
 from lumpbeam_ros.cli.main import main
+from lumpbeam_ros.nodes import player as player_module
 from lumpbeam_ros.nodes.player import Player
 
 T0 = 1000.0
@@ -260,3 +262,40 @@ def test_a_namespaced_player_and_recorder_keep_the_bag_names(ros_graph, short_ba
     assert set(reader.topics) == {'/tip_pose', '/tip_load', '/clock'}
     loads = [m.data for _, m in reader.messages('/tip_load', 'std_msgs/msg/Float64')]
     assert loads == [4.5]  # the namespace's load, not the other beam's 1.0
+
+
+@pytest.fixture
+def gap_bag(tmp_path):
+    """Five poses, a jump of 1e6 s (11.6 days), five more."""
+    with BagWriter(tmp_path / 'gap') as bag:
+        for i in range(10):
+            bag.write_pose('/tip_pose', T0 + (1e6 if i >= 5 else 0.0) + i / 100, 2.3, -i, 0.0)
+    return tmp_path / 'gap'
+
+
+def test_a_huge_gap_is_played_short_and_counted(ros_graph, gap_bag, monkeypatch):
+    monkeypatch.setattr(player_module, 'MAX_GAP_S', 0.3)
+    poses = ros_graph.collect('/tip_pose', PoseStamped, 100)
+    clock = ros_graph.collect('/clock', Clock, 100)
+    _, stats = _play(ros_graph, gap_bag)
+    assert stats.published == {'/tip_pose': 10} and not stats.stopped
+    assert stats.gaps_shortened == 1
+    assert stats.longest_gap_s == pytest.approx(1e6 + 0.01, abs=1e-3)
+    assert ros_graph.spin_until(lambda: len(poses) == 10 and len(clock) == 10, 5.0)
+    # /clock keeps the bag's time: it jumps by the gap.
+    ticks = np.array([c.clock.sec + c.clock.nanosec * 1e-9 for c in clock])
+    assert ticks[5] - ticks[4] == pytest.approx(1e6 + 0.01, abs=1e-3)
+
+
+@pytest.mark.parametrize('sig', [signal.SIGINT, signal.SIGTERM])
+def test_play_stops_within_the_bound_of_a_signal_in_a_huge_gap(ros_graph, gap_bag, sig):
+    poses = ros_graph.collect('/tip_pose', PoseStamped, 100)
+    argv = ['lumpbeam_ros.cli.main', 'play', str(gap_bag), '--delay', '3.0']
+    process = start_process(ros_env(ros_graph.domain_id), *argv)
+    try:
+        ok = ros_graph.spin_until(lambda: len(poses) == 5, 30.0)
+    finally:
+        code, stdout, stderr = stop_with(process, sig)
+    assert ok, stderr
+    assert code == 0, stderr
+    assert 'played' in stdout and '5 messages in the last pass' in stdout

@@ -111,6 +111,22 @@ def test_a_signal_closes_the_bag_cleanly(ros_graph, tmp_path, sig, mcap_doctor):
             ['record', '{out}', '/a', '--namespace', '/beam_a/'],
             "--namespace '/beam_a/': namespace must not end with a '/'",
         ),
+        (
+            ['record', '--duration', '0.5', '{out}', '/bad topic!'],
+            "topic '/bad topic!': topic name must not contain characters other than",
+        ),
+        (
+            ['record', '--duration', '0.5', '{out}', '/tip_pose', '/a//b'],
+            "topic '/a//b': topic name must not contain repeated '/'",
+        ),
+        (
+            ['record', '--duration', '0.5', '{out}', '/tip_pose/'],
+            "topic '/tip_pose/': topic name must not end with",
+        ),
+        (
+            ['record', '--duration', '0.5', '{out}', '9lives'],
+            "topic '9lives': topic name token must not start with a number",
+        ),
     ],
 )
 def test_bad_invocations_print_one_line(tmp_path, capsys, argv, match):
@@ -138,3 +154,13 @@ def test_a_namespaced_recorder_stores_its_topics_under_the_bag_names(ros_graph, 
     reader = BagReader(out)
     assert set(reader.topics) == {'/tip_pose'}
     np.testing.assert_array_equal(read_tip_poses(reader).t, 100.0 + np.arange(20))
+
+
+def test_topics_may_follow_the_options(tmp_path, capsys, ros_domain_id, monkeypatch):
+    monkeypatch.setenv('ROS_DOMAIN_ID', str(ros_domain_id))
+    out = tmp_path / 'after'
+    assert main(['record', str(out), '--duration', '0.2', '/tip_pose', '/tip_load']) == 0
+    printed = capsys.readouterr()
+    assert 'recorded 0 messages' in printed.out
+    assert '/tip_pose never appeared' in printed.out and '/tip_load never appeared' in printed.out
+    assert BagReader(out).topics == {}

@@ -137,3 +137,23 @@ def test_out_draws_the_tracked_tip_and_the_board(bag, tmp_path, capsys):
         tip = by_ns['tip_measured'].position
         assert (tip[0], tip[2]) == pytest.approx((tracked.x[i], tracked.z[i]), abs=1e-12)
         assert by_ns['board'].position == pytest.approx((2.3107, 1.0, -0.01))
+
+
+def test_no_pose_in_any_frame_is_an_error_without_out(bag, tmp_path, capsys):
+    """Every frame black: the board is never found. No OUT without a /tip_pose."""
+    dark = tmp_path / 'dark'
+    with BagWriter(dark) as writer:
+        reader = BagReader(bag)
+        writer.add_topic('/camera/camera_info', reader.topics['/camera/camera_info'].msgtype)
+        for raw in reader.iter_raw(['/camera/camera_info']):
+            writer.write_raw(raw.topic, raw.log_time_ns, raw.data)
+        for i in range(12):
+            writer.write_image('/camera/image_raw', 10.0 + i / 30, np.zeros((240, 320), np.uint8))
+    out = tmp_path / 'out'
+    assert main(['track', str(dark), str(out), '--json', str(tmp_path / 'r.json')]) == 2
+    printed = capsys.readouterr()
+    assert printed.out == ''
+    err = printed.err.strip()
+    assert err.startswith('lumpbeam track: error:') and len(err.splitlines()) == 1
+    assert f'{dark}: no pose in any of its 12 frames (' in err and 'first:' in err
+    assert not out.exists() and not (tmp_path / 'r.json').exists()

@@ -26,15 +26,24 @@ def _move(duration_s=0.1, rate_hz=1000.0, joints=1):
     return JointTrajectory(t, np.column_stack([angle * (j + 1) for j in range(joints)]))
 
 
-def test_shaped_angles_are_the_weighted_sum_of_the_delayed_command():
-    move = _move(joints=2)
+@pytest.mark.parametrize(
+    'move',
+    [
+        _move(joints=2),  # even at 1 kHz: the fractional-delay path
+        _move(rate_hz=4000.0, joints=2),
+        _move(rate_hz=100.0, joints=2),  # coarser than 1 kHz: interpolated
+        JointTrajectory([0.0, 0.013, 0.02, 0.1], [[0.0, 1.0], [0.2, 0.5], [0.3, 0.1], [0.5, 0]]),
+    ],
+    ids=['1kHz', '4kHz', '100Hz', 'uneven'],
+)
+def test_shaped_angles_are_the_weighted_sum_of_the_delayed_command(move):
     impulses = Impulses([0.0, 0.0371, 0.09], [0.2, 0.5, 0.3])
     shaped = shape_trajectory(move, impulses)
     expected = sum(
         a * move.at(shaped.time_s - t)
         for t, a in zip([0.0, 0.0371, 0.09], [0.2, 0.5, 0.3], strict=True)
     )
-    assert np.allclose(shaped.angles_rad, expected, rtol=0, atol=1e-15)
+    assert np.allclose(shaped.angles_rad, expected, rtol=0, atol=1e-12)
     assert shaped.joint_names == move.joint_names
 
 
@@ -48,14 +57,27 @@ def test_shaped_move_ends_later_at_rest_at_the_same_angles():
     assert np.max(np.diff(shaped.time_s)) <= 1e-3 + 1e-15
 
 
-@pytest.mark.parametrize(('rate_hz', 'step_s'), [(100.0, 1e-3), (1000.0, 1e-3), (4000.0, 2.5e-4)])
-def test_sampling_is_1_khz_or_the_input_rate_if_finer(rate_hz, step_s):
+@pytest.mark.parametrize('rate_hz', [1000.0, 4000.0])
+def test_an_even_input_at_1_khz_or_finer_keeps_its_grid(rate_hz):
     move = _move(rate_hz=rate_hz)
-    times = shaped_times(move, design_shaper('zv', [Mode(3.0, 0.0)]))
+    impulses = design_shaper('zv', [Mode(3.0, 0.0)])
+    times = shaped_times(move, impulses)
+    assert np.allclose(times[: move.time_s.size], move.time_s, rtol=0, atol=1e-12)
     steps = np.diff(times)
+    assert np.allclose(steps[:-1], 1 / rate_hz, rtol=1e-9, atol=0)
+    assert 0 < steps[-1] <= 1 / rate_hz * (1 + 1e-9)
+    assert times[-1] == move.time_s[-1] + impulses.duration_s
+
+
+@pytest.mark.parametrize('times', [np.arange(11) * 0.01, np.array([0.0, 0.0007, 0.001, 0.0041])])
+def test_other_inputs_are_resampled_evenly_at_1_khz_or_their_median_interval(times):
+    move = JointTrajectory(times, times * 2)
+    impulses = design_shaper('zv', [Mode(3.0, 0.0)])
+    steps = np.diff(shaped_times(move, impulses))
+    step = min(1e-3, float(np.median(np.diff(times))))
     # Evenly spaced, the step shrunk just enough to end on the last time.
     assert np.ptp(steps) < 1e-12
-    assert step_s * 0.99 < steps[0] <= step_s * (1 + 1e-12)
+    assert step * 0.99 < steps[0] <= step * (1 + 1e-12)
 
 
 def test_too_low_a_frequency_is_refused_before_allocating():

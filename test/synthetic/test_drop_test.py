@@ -1,3 +1,5 @@
+import math
+
 import numpy as np
 import pytest
 
@@ -7,7 +9,9 @@ from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.model.simulate import simulate_loads
 from lumpbeam_ros.synthetic.drop_test import (
+    MAX_SAMPLES,
     SynthOptions,
+    check_sample_count,
     parse_effect,
     simulate_experiment,
     with_effects,
@@ -88,6 +92,56 @@ def test_cli_errors_are_one_line(tmp_path, capsys, args):
     err = capsys.readouterr().err
     assert err.count('\n') == 1 and err.startswith('lumpbeam synth: error:')
     assert not (tmp_path / 'bag').exists()
+
+
+@pytest.mark.parametrize(
+    ('args', 'message'),
+    [
+        (
+            ['--duration', '1e9'],
+            'duration 1e+09 s at 180 Hz (poses) is 1.8e+11 samples; the limit',
+        ),
+        (['--duration', '1e15', '--rate', '1e-9'], '(simulation grid) is 1.8e+17 samples'),
+        (
+            ['--duration', '3', '--tracker', '--tracker-rate', '1e12'],
+            'duration 3 s at 1e+12 Hz (tracker) is 3e+12 samples; the limit is 500000',
+        ),
+        (
+            ['--images', '--image-size', '100000x100000'],
+            'image size 100000x100000: 10000000000 px; the limit is 16777216 px (4096x4096)',
+        ),
+    ],
+)
+def test_cli_refuses_what_needs_unbounded_memory(tmp_path, capsys, args, message):
+    assert main(['synth', str(tmp_path / 'bag'), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and err.startswith('lumpbeam synth: error:')
+    assert message in err
+    assert not (tmp_path / 'bag').exists()
+
+
+def test_the_sample_limit_is_checked_before_simulating():
+    with pytest.raises(LumpbeamError, match=f'the limit is {MAX_SAMPLES}'):
+        check_sample_count(MAX_SAMPLES / 100.0 + 1e-6, {'poses': 100.0})
+    check_sample_count(MAX_SAMPLES / 100.0, {'poses': 100.0})
+    with pytest.raises(LumpbeamError, match='nan samples'):
+        check_sample_count(math.nan, {'poses': 100.0})
+
+
+def test_a_failed_write_leaves_no_partial_bag(tmp_path, monkeypatch):
+    from lumpbeam_ros.synthetic import drop_test
+
+    def fail(*_args, **_kwargs):
+        raise KeyboardInterrupt  # what SIGTERM raises in `lumpbeam`
+
+    monkeypatch.setattr(drop_test, 'write_scene', fail)
+    with pytest.raises(KeyboardInterrupt):
+        write_drop_test_bag(tmp_path / 'bag', BeamParameters(), DropTestConfig(), SynthOptions())
+    assert not (tmp_path / 'bag').exists()
+    (tmp_path / 'kept').mkdir()
+    with pytest.raises(LumpbeamError, match='never overwritten'):
+        write_drop_test_bag(tmp_path / 'kept', BeamParameters(), DropTestConfig(), SynthOptions())
+    assert (tmp_path / 'kept').is_dir()  # an existing folder is not the writer's to remove
 
 
 def test_cli_never_overwrites(tmp_path, capsys):

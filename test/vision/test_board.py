@@ -2,6 +2,10 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.vision.board import Checkerboard
+from lumpbeam_ros.vision.config import with_board
+from lumpbeam_ros.vision.partial import board_polarity
+from lumpbeam_ros.vision.pose import PlaneModel
+from lumpbeam_ros.vision.synthetic import SyntheticCamera
 
 
 def test_object_points_are_row_major_and_centred():
@@ -27,3 +31,18 @@ def test_texture_edges_fall_where_the_affine_map_says(n):
     assert texture[2 * n - 1, 2 * n - 1] == 10.0
     assert texture[2 * n - 1, 2 * n] == 200.0
     assert texture[0, 0] == 200.0
+
+
+@pytest.mark.parametrize(('corners', 'swaps'), [((8, 6), False), ((9, 6), True), ((7, 4), True)])
+def test_corner_polarity_is_that_of_the_printed_board(config, rest_pose, corners, swaps):
+    """The rendered texture, labelled in board order, has corner 0's documented polarity."""
+    board_config = with_board(config, corners)
+    board = board_config.rig.board
+    assert board.turn_swaps_colours is swaps
+    image = SyntheticCamera(board_config).render(rest_pose)
+    truth = PlaneModel(board_config.rig, board_config.camera_info).project(rest_pose)
+    pattern = board.pattern_size
+    assert board_polarity(image, truth, pattern, 5) == board.corner_polarity
+    # Turned by 180 degrees (the labelling reversed), the colours give it away or not.
+    turned = board_polarity(image, truth[::-1], pattern, 5)
+    assert (turned != board.corner_polarity) is swaps

@@ -1,0 +1,212 @@
+"""The shaper node: ``/joint_trajectory`` shaped onto ``/joint_trajectory_shaped``.
+
+Each JointTrajectory received is convolved with an input shaper
+(:mod:`lumpbeam_ros.shaping`) and published with the same header and joint names, its
+points (positions only) at 1 kHz or the input's rate if finer, ending the shaper's duration
+later. The shaper cancels:
+
+- ``source: beam_params``: the modes of the latest valid ``/beam_params`` estimate (status
+  ``lumpbeam/identifier``; up to ``max_modes``; ``shaper``, or ``robust_shaper`` when an
+  identified frequency's relative standard deviation exceeds ``robust_above``);
+- ``source: parameters``: one mode fixed by ``frequency_hz`` and ``damping_ratio``.
+
+An invalid estimate (level ERROR, a value missing or not finite, a standard deviation larger
+than its value) never makes a shaper: the node keeps the last good one and warns (throttled).
+Until it has a first one it publishes nothing, and warns for each trajectory dropped: a
+consumer of ``/joint_trajectory_shaped`` relies on the commands being shaped, and an unshaped
+move published there would ring while claiming not to; the unshaped command stays on
+``/joint_trajectory`` for whoever wants it. ``unshaped_until_estimate: true`` forwards it
+unshaped instead (a first move that rings to be identified). A trajectory that cannot be
+shaped (fewer than 2 points, times that do not increase, positions missing or not finite) is
+dropped with a throttled warning.
+
+Parameters: :data:`~lumpbeam_ros.params.shaper_params.SHAPER_SCHEMA` (``doc/parameters.md``)::
+
+    shaper_node --ros-args --params-file config/shaper.yaml
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+from typing import Unpack
+
+import numpy as np
+from builtin_interfaces.msg import Duration
+from diagnostic_msgs.msg import DiagnosticArray
+from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
+from trajectory_msgs.msg import JointTrajectoryPoint
+
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import (
+    BEAM_PARAMS,
+    IDENTIFIER_STATUS,
+    JOINT_TRAJECTORY,
+    JOINT_TRAJECTORY_SHAPED,
+)
+from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
+from lumpbeam_ros.nodes.endpoints import publisher, subscription
+from lumpbeam_ros.nodes.lifecycle import run_node
+from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
+from lumpbeam_ros.params.shaper_params import SHAPER_SCHEMA
+from lumpbeam_ros.shaping.apply import shape_trajectory
+from lumpbeam_ros.shaping.estimate import choose_shaper, estimate_from_status
+from lumpbeam_ros.shaping.impulses import Impulses, Mode
+from lumpbeam_ros.shaping.shapers import design_shaper
+
+#: Seconds between repeated warnings about the same kind of bad input.
+WARN_PERIOD_S = 5.0
+
+
+def trajectory_from_msg(msg: JointTrajectoryMsg) -> JointTrajectory:
+    """The positions of a JointTrajectory message against ``time_from_start``.
+
+    Raises:
+        LumpbeamError: No joint names, a point without one position per joint, or what
+            :class:`~lumpbeam_ros.motion.joint_trajectory.JointTrajectory` refuses.
+    """
+    names = tuple(msg.joint_names)
+    if not names:
+        raise LumpbeamError('no joint names')
+    for i, point in enumerate(msg.points):
+        if len(point.positions) != len(names):
+            raise LumpbeamError(
+                f'point {i} has {len(point.positions)} positions for {len(names)} joints'
+            )
+    time = [p.time_from_start.sec + p.time_from_start.nanosec * 1e-9 for p in msg.points]
+    angles = np.array([list(p.positions) for p in msg.points], dtype=float)
+    return JointTrajectory(np.array(time), angles.reshape(len(time), len(names)), names)
+
+
+def trajectory_msg(trajectory: JointTrajectory, like: JointTrajectoryMsg) -> JointTrajectoryMsg:
+    """A JointTrajectory message of positions, with the header of ``like``."""
+    msg = JointTrajectoryMsg(header=like.header, joint_names=list(trajectory.joint_names))
+    nanoseconds = np.rint(trajectory.time_s * 1e9).astype(np.int64)
+    seconds, remainder = np.divmod(nanoseconds, 1_000_000_000)
+    msg.points = [
+        JointTrajectoryPoint(
+            positions=row.tolist(), time_from_start=Duration(sec=int(s), nanosec=int(r))
+        )
+        for row, s, r in zip(trajectory.angles_rad, seconds, remainder, strict=True)
+    ]
+    return msg
+
+
+class ShaperNode(SchemaNode):
+    """Publishes ``/joint_trajectory_shaped`` from ``/joint_trajectory`` (and ``/beam_params``).
+
+    Args:
+        **options: See :class:`~lumpbeam_ros.nodes.ros_parameters.NodeOptions`.
+
+    Attributes:
+        impulses: The shaper in use (``None`` until the first valid estimate).
+        description: What it cancels, e.g. ``'ZV for 3.2 Hz (zeta 0.01)'``.
+        published: Shaped trajectories published.
+        dropped: Trajectories received and not published.
+
+    Raises:
+        ConfigError: A parameter is invalid.
+    """
+
+    def __init__(self, **options: Unpack[NodeOptions]):
+        super().__init__(SHAPER_SCHEMA, **options)
+        values = self.parameter_values
+        self.impulses: Impulses | None = None
+        self.description = ''
+        self.published = 0
+        self.dropped = 0
+        self._unshaped_first = bool(values['unshaped_until_estimate'])
+        self._output = publisher(self, JointTrajectoryMsg, JOINT_TRAJECTORY_SHAPED)
+        subscription(self, JointTrajectoryMsg, JOINT_TRAJECTORY, self._on_trajectory)
+        if values['source'] == 'parameters':
+            mode = Mode(float(values['frequency_hz']), float(values['damping_ratio']))
+            self._adopt(str(values['shaper']), [mode])
+        else:
+            subscription(self, DiagnosticArray, BEAM_PARAMS, self._on_params)
+
+    def _adopt(self, kind: str, modes: Sequence[Mode]) -> None:
+        impulses = design_shaper(kind, modes)
+        description = f'{kind.upper()} for ' + ', '.join(
+            f'{m.frequency_hz:.4g} Hz (zeta {m.damping_ratio:.3g})' for m in modes
+        )
+        if description != self.description:
+            self.get_logger().info(
+                f'shaping with {description}: {impulses.time_s.size} impulses, '
+                f'{impulses.duration_s:.4f} s added'
+            )
+        self.impulses, self.description = impulses, description
+
+    def _on_params(self, msg: DiagnosticArray) -> None:
+        values = self.parameter_values
+        for status in msg.status:
+            if status.name != IDENTIFIER_STATUS:
+                continue
+            pairs = {kv.key: kv.value for kv in status.values}
+            try:
+                estimate = estimate_from_status(status.level[0], pairs, int(values['max_modes']))
+                kind = choose_shaper(
+                    estimate.modes,
+                    str(values['shaper']),
+                    str(values['robust_shaper']),
+                    float(values['robust_above']),
+                )
+                self._adopt(kind, [m.mode for m in estimate.modes])
+            except LumpbeamError as exc:
+                kept = f'keeping {self.description}' if self.impulses else 'no shaper yet'
+                self.get_logger().warning(
+                    f'{BEAM_PARAMS}: invalid estimate ({exc}): {kept}',
+                    throttle_duration_sec=WARN_PERIOD_S,
+                )
+                continue
+            for note in estimate.left_out:
+                self.get_logger().warning(
+                    f'{BEAM_PARAMS}: {note}: left out', throttle_duration_sec=WARN_PERIOD_S
+                )
+
+    def _on_trajectory(self, msg: JointTrajectoryMsg) -> None:
+        try:
+            trajectory = trajectory_from_msg(msg)
+            if self.impulses is None:
+                if not self._unshaped_first:
+                    self._drop('no valid estimate yet: nothing published')
+                    return
+                self.get_logger().warning(
+                    'no valid estimate yet: published unshaped',
+                    throttle_duration_sec=WARN_PERIOD_S,
+                )
+                shaped = trajectory
+            else:
+                shaped = shape_trajectory(trajectory, self.impulses)
+        except LumpbeamError as exc:
+            self._drop(f'cannot shape it ({exc})')
+            return
+        self._output.publish(trajectory_msg(shaped, msg))
+        self.published += 1
+
+    def _drop(self, why: str) -> None:
+        self.dropped += 1
+        self.get_logger().warning(
+            f'{JOINT_TRAJECTORY}: {why}; {self.dropped} dropped so far',
+            throttle_duration_sec=WARN_PERIOD_S,
+        )
+
+
+def main(args: Sequence[str] | None = None) -> int:
+    """Runs the node until Ctrl-C (console script ``shaper_node``).
+
+    Args:
+        args: Command-line arguments (default ``sys.argv``), incl. ``--ros-args``.
+
+    Returns:
+        0, or 2 when the configuration is invalid (one line on stderr).
+    """
+    return run_node(
+        SHAPER_SCHEMA.node,
+        ShaperNode,
+        lambda node: {JOINT_TRAJECTORY_SHAPED: node.published},
+        args,
+    )
+
+
+if __name__ == '__main__':
+    sys.exit(main())

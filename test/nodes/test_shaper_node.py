@@ -1,0 +1,197 @@
+"""The shaper node on a private graph: fixed and live modes, invalid estimates, bad input."""
+
+import math
+
+import numpy as np
+import pytest
+from builtin_interfaces.msg import Duration
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
+from trajectory_msgs.msg import JointTrajectoryPoint
+
+from lumpbeam_ros.errors import ConfigError, LumpbeamError
+from lumpbeam_ros.interface import BEAM_PARAMS, IDENTIFIER_STATUS
+from lumpbeam_ros.interface import JOINT_TRAJECTORY as IN
+from lumpbeam_ros.interface import JOINT_TRAJECTORY_SHAPED as OUT
+from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
+from lumpbeam_ros.nodes.shaper_node import ShaperNode, trajectory_from_msg
+from lumpbeam_ros.shaping.apply import shape_trajectory
+from lumpbeam_ros.shaping.impulses import Mode
+from lumpbeam_ros.shaping.shapers import design_shaper
+
+OK, ERROR = 0, 2
+
+
+def _command(times=(0.0, 0.1, 0.2), names=('joint_1', 'joint_2'), positions=None):
+    msg = JointTrajectoryMsg(joint_names=list(names))
+    msg.header.frame_id = 'beam_base'
+    msg.header.stamp.sec = 42
+    for i, t in enumerate(times):
+        sec, nanosec = divmod(round(t * 1e9), 1_000_000_000)
+        point = positions[i] if positions is not None else [0.5 * t, -0.25 * t]
+        msg.points.append(
+            JointTrajectoryPoint(
+                positions=list(point), time_from_start=Duration(sec=sec, nanosec=nanosec)
+            )
+        )
+    return msg
+
+
+def _status(level=OK, **values):
+    defaults = {
+        'natural_frequency_hz': 3.0,
+        'natural_frequency_hz_std': 0.003,
+        'damping_ratio': 0.02,
+        'damping_ratio_std': 0.001,
+    }
+    defaults.update(values)
+    status = DiagnosticStatus(level=bytes([level]), name=IDENTIFIER_STATUS)
+    status.values = [KeyValue(key=k, value=repr(v)) for k, v in defaults.items()]
+    return DiagnosticArray(status=[status])
+
+
+def _start(ros_graph, **overrides):
+    node = ShaperNode(context=ros_graph.context, parameter_overrides=overrides)
+    ros_graph.add_node(node)
+    return node
+
+
+def _send(ros_graph, topic, msg):
+    ros_graph.publish(topic, msg)
+    ros_graph.wait_for_subscribers(topic)
+    ros_graph.publish(topic, msg)
+
+
+def _expected(command, kind, modes):
+    return shape_trajectory(trajectory_from_msg(command), design_shaper(kind, modes))
+
+
+def _assert_is(msg, expected, command):
+    got = trajectory_from_msg(msg)
+    assert got.joint_names == expected.joint_names
+    assert np.allclose(got.time_s, expected.time_s, rtol=0, atol=1e-9)
+    assert np.array_equal(got.angles_rad, expected.angles_rad)
+    assert msg.header.stamp.sec == command.header.stamp.sec
+    assert msg.header.frame_id == command.header.frame_id
+
+
+def test_fixed_mode_from_parameters(ros_graph):
+    got = ros_graph.collect(OUT, JointTrajectoryMsg)
+    node = _start(ros_graph, source='parameters', frequency_hz=2.5, damping_ratio=0.03)
+    command = _command()
+    _send(ros_graph, IN, command)
+    assert ros_graph.spin_until(lambda: len(got) >= 1, 10.0)
+    _assert_is(got[0], _expected(command, 'zv', [Mode(2.5, 0.03)]), command)
+    assert node.published >= 1 and node.description.startswith('ZV for 2.5 Hz')
+
+
+def test_live_modes_certain_uncertain_invalid_and_two(ros_graph):
+    got = ros_graph.collect(OUT, JointTrajectoryMsg)
+    node = _start(ros_graph)
+    command = _command()
+    # No estimate yet: nothing is published, the trajectory is counted as dropped.
+    _send(ros_graph, IN, command)
+    assert ros_graph.spin_until(lambda: node.dropped >= 1, 10.0)
+    assert node.impulses is None and got == []
+
+    # An invalid estimate before any valid one: still no shaper.
+    _send(ros_graph, BEAM_PARAMS, _status(ERROR))
+    ros_graph.spin_for(0.3)
+    assert node.impulses is None
+
+    # A certain estimate: ZV; an uncertain one (std 3 % of the value): the robust EI.
+    ros_graph.publish(BEAM_PARAMS, _status())
+    assert ros_graph.spin_until(lambda: node.impulses is not None, 10.0)
+    assert node.description == 'ZV for 3 Hz (zeta 0.02)'
+    ros_graph.publish(BEAM_PARAMS, _status(natural_frequency_hz_std=0.09))
+    assert ros_graph.spin_until(lambda: node.description.startswith('EI'), 10.0)
+    ei = node.impulses
+
+    # Invalid estimates keep the last good shaper.
+    for bad in (
+        _status(ERROR),
+        _status(natural_frequency_hz_std=4.0),
+        _status(damping_ratio=math.nan),
+        _status(natural_frequency_hz=-3.0, natural_frequency_hz_std=0.1),
+    ):
+        ros_graph.publish(BEAM_PARAMS, bad)
+    ros_graph.spin_for(0.5)
+    assert node.impulses is ei
+    ros_graph.publish(IN, command)
+    assert ros_graph.spin_until(lambda: len(got) >= 1, 10.0)
+    _assert_is(got[0], _expected(command, 'ei', [Mode(3.0, 0.02)]), command)
+
+    # Two modes: their shapers convolved.
+    two = _status(
+        mode_count=2.0,
+        mode_2_natural_frequency_hz=11.0,
+        mode_2_natural_frequency_hz_std=0.01,
+        mode_2_damping_ratio=0.01,
+        mode_2_damping_ratio_std=0.001,
+    )
+    ros_graph.publish(BEAM_PARAMS, two)
+    assert ros_graph.spin_until(lambda: '11 Hz' in node.description, 10.0)
+    ros_graph.publish(IN, command)
+    assert ros_graph.spin_until(lambda: len(got) >= 2, 10.0)
+    _assert_is(got[1], _expected(command, 'zv', [Mode(3.0, 0.02), Mode(11.0, 0.01)]), command)
+
+
+def test_unshaped_until_the_first_estimate_when_asked(ros_graph):
+    got = ros_graph.collect(OUT, JointTrajectoryMsg)
+    _start(ros_graph, unshaped_until_estimate=True)
+    command = _command()
+    _send(ros_graph, IN, command)
+    assert ros_graph.spin_until(lambda: len(got) >= 1, 10.0)
+    _assert_is(got[0], trajectory_from_msg(command), command)
+
+
+@pytest.mark.parametrize(
+    'command',
+    [
+        _command(times=(0.0,)),
+        _command(times=()),
+        _command(times=(0.0, 0.2, 0.1)),
+        _command(times=(0.0, 0.1), positions=[[0.0, 0.0], [math.nan, 0.0]]),
+        _command(times=(0.0, 0.1), positions=[[0.0, 0.0], [1.0]]),
+        _command(times=(0.0, 0.1), names=(), positions=[[], []]),
+    ],
+    ids=['one point', 'no point', 'times back', 'nan', 'missing position', 'no names'],
+)
+def test_bad_trajectories_are_dropped(ros_graph, command):
+    got = ros_graph.collect(OUT, JointTrajectoryMsg)
+    node = _start(ros_graph, source='parameters', frequency_hz=2.0)
+    _send(ros_graph, IN, command)
+    assert ros_graph.spin_until(lambda: node.dropped >= 1, 10.0)
+    ros_graph.spin_for(0.2)
+    assert got == [] and node.published == 0
+
+
+@pytest.mark.parametrize(
+    ('overrides', 'error', 'problem'),
+    [
+        ({'frequency_hz': 0.0}, ConfigError, 'frequency_hz: must be positive'),
+        ({'damping_ratio': 1.0}, ConfigError, 'damping_ratio: must be in [0, 1)'),
+        ({'shaper': 'zvdd'}, ConfigError, 'shaper: must be one of'),
+        (
+            {'source': 'parameters', 'shaper': 'ei', 'damping_ratio': 0.7},
+            LumpbeamError,
+            'EI shaper: damping ratio 0.7 is above 0.5',
+        ),
+    ],
+)
+def test_bad_parameters_stop_the_node_in_one_line(ros_graph, overrides, error, problem):
+    with pytest.raises(error) as caught:
+        ShaperNode(context=ros_graph.context, parameter_overrides=overrides)
+    assert problem in str(caught.value) and '\n' not in str(caught.value)
+
+
+def test_message_conversion_round_trips():
+    trajectory = JointTrajectory(np.array([0.0, 0.5, 1.25]), np.array([[0.1], [0.2], [0.3]]))
+    from lumpbeam_ros.nodes.shaper_node import trajectory_msg
+
+    msg = trajectory_msg(trajectory, JointTrajectoryMsg())
+    assert msg.points[2].time_from_start.sec == 1
+    assert msg.points[2].time_from_start.nanosec == 250_000_000
+    back = trajectory_from_msg(msg)
+    assert np.array_equal(back.time_s, trajectory.time_s)
+    assert np.array_equal(back.angles_rad, trajectory.angles_rad)

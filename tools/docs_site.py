@@ -1,0 +1,97 @@
+"""MkDocs hooks: the README is the site's home page, and every core package gets an API page.
+
+Both are derived, never written twice. The home page is README.md with its links into
+``doc/`` made relative to the site (and the pages' links back to ``../README.md`` pointed at
+it), so the same Markdown reads right on a Git host and on the site. The API pages follow
+the core's package list in ``tools/test_modules.py``: a new core package gets its page
+without an edit here.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+from pathlib import Path
+from typing import Any
+
+from mkdocs.config.defaults import MkDocsConfig
+from mkdocs.structure.files import File, Files
+from mkdocs.structure.pages import Page
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = 'lumpbeam_ros'
+HOME = 'index.md'
+API_SECTION = 'API reference'
+
+#: The README's links into doc/, the site's own folder.
+_README_DOC_LINK = re.compile(r'\]\(doc/')
+#: A page's link to the README, one folder up from doc/.
+_PAGE_README_LINK = re.compile(r'\]\(\.\./README\.md')
+
+
+def core_packages() -> tuple[str, ...]:
+    """The core packages, as ``tools/test_modules.py`` declares them."""
+    path = ROOT / 'tools' / 'test_modules.py'
+    spec = importlib.util.spec_from_file_location('test_modules_tool', path)
+    if spec is None or spec.loader is None:
+        raise RuntimeError(f'cannot load {path}')
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return tuple(module.CORE_PACKAGES)
+
+
+def top_level_modules() -> list[str]:
+    """The modules at the top of the package (errors, paramfile, ...), ``__init__`` aside."""
+    return sorted(p.stem for p in (ROOT / PACKAGE).glob('*.py') if p.stem != '__init__')
+
+
+def api_pages() -> dict[str, str]:
+    """Site path -> Markdown of each API page: one per core package, one for the top level."""
+    pages = {
+        f'api/{name}.md': f'# `{PACKAGE}.{name}`\n\n::: {PACKAGE}.{name}\n'
+        for name in core_packages()
+    }
+    modules = '\n'.join(f'::: {PACKAGE}.{name}\n' for name in top_level_modules())
+    pages['api/top_level.md'] = f'# Top-level modules\n\n{modules}'
+    return pages
+
+
+def _listed(nav: Any) -> set[str]:
+    """The page paths a navigation (nested lists and one-key mappings) names."""
+    if isinstance(nav, str):
+        return {nav}
+    if isinstance(nav, dict):
+        return set().union(*(_listed(value) for value in nav.values()))
+    if isinstance(nav, list):
+        return set().union(*(_listed(item) for item in nav))
+    return set()
+
+
+def on_config(config: MkDocsConfig, **_: Any) -> MkDocsConfig:
+    """Completes the navigation ``mkdocs.yml`` starts.
+
+    A page under ``doc/`` that it does not list comes next, titled by its first heading (a
+    new page is on the site without an edit to ``mkdocs.yml``), then the API pages.
+    """
+    nav = list(config.nav or [])
+    listed = _listed(nav)
+    docs = Path(config.docs_dir)
+    pages = (p.relative_to(docs).as_posix() for p in docs.rglob('*.md'))
+    nav += sorted(page for page in pages if page not in listed | {HOME})
+    nav.append({API_SECTION: [{Path(path).stem: path} for path in api_pages()]})
+    config.nav = nav
+    return config
+
+
+def on_files(files: Files, config: MkDocsConfig, **_: Any) -> Files:
+    """Adds the generated pages: the home page from the README, and the API pages."""
+    readme = (ROOT / 'README.md').read_text(encoding='utf-8')
+    files.append(File.generated(config, HOME, content=_README_DOC_LINK.sub('](', readme)))
+    for path, content in api_pages().items():
+        files.append(File.generated(config, path, content=content))
+    return files
+
+
+def on_page_markdown(markdown: str, page: Page, **_: Any) -> str:
+    """Points a page's links to ``../README.md`` at the home page."""
+    return _PAGE_README_LINK.sub(f']({HOME}', markdown)
