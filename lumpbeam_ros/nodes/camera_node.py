@@ -118,6 +118,9 @@ class CameraNode(SchemaNode):
         self._warning_period = float(self._param('warning_period_s'))
         self._period_counts = (0, 0)
         self._period_start = time.monotonic()
+        #: Poses whose image stamp was not after the previous pose's (published all the same).
+        self.stamps_back = 0
+        self._last_stamp_ns: int | None = None
 
         # /tip_pose: reliable, more than a second of poses; images and camera info: the
         # sensor-data profile (best effort, keep last 5); lumpbeam_ros.bagio.qos.
@@ -266,7 +269,22 @@ class CameraNode(SchemaNode):
     # -- output -----------------------------------------------------------------------------
 
     def publish_pose(self, stamp_ns: int, result: TrackResult) -> None:
-        """Publishes a tracked pose and its covariance with the image's stamp."""
+        """Publishes a tracked pose and its covariance with the image's stamp.
+
+        A stamp that is not after the previous pose's (a driver's clock stepping back, a
+        looping bag) is counted (``stamps_back`` in the diagnostics) with a throttled
+        warning, and the pose is still published with its image's stamp: the stamp is the
+        camera's word, and the subscribers drop or reset on it (the identifier and the
+        diagnosis count out-of-order poses, a jump back empties their windows).
+        """
+        if self._last_stamp_ns is not None and stamp_ns <= self._last_stamp_ns:
+            self.stamps_back += 1
+            self.get_logger().warning(
+                f"image stamp {stamp_ns * 1e-9:.9f} s is not after the previous pose's "
+                f'{self._last_stamp_ns * 1e-9:.9f} s ({self.stamps_back} so far)',
+                throttle_duration_sec=self._warning_period,
+            )
+        self._last_stamp_ns = stamp_ns
         x, z, pitch = (float(v) for v in result.pose)
         msg = PoseStamped()
         _stamp(msg.header.stamp, stamp_ns)
@@ -321,6 +339,7 @@ class CameraNode(SchemaNode):
             'frames_per_s': frames / elapsed,
             'poses_per_s': poses / elapsed,
             'last_reason': stats.last_reason,
+            'stamps_back': self.stamps_back,
             'camera_info': 'received' if self.session.camera_info is not None else 'waiting',
             'calibrated': bool(tracker is not None and tracker.calibration is not None),
         }

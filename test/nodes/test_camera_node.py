@@ -359,3 +359,19 @@ def test_pose_model_parameter(ros_graph):
             context=ros_graph.context,
             parameter_overrides=[Parameter('pose_model', value='bent')],
         )
+
+
+def test_a_stamp_that_goes_back_is_counted_warned_and_published(ros_graph, node):
+    from lumpbeam_ros.vision.tracker import TrackResult, TrackStatus
+
+    poses = ros_graph.collect('/tip_pose', PoseStamped, 10)
+    result = TrackResult(
+        1.0, TrackStatus.OK, pose=np.array([2.3, -0.01, 0.0]), covariance=np.eye(3) * 1e-12
+    )
+    for stamp_s in (10.0, 11.0, 10.0, 11.0, 11.0):  # back 1 s, on again, repeated
+        node.publish_pose(int(stamp_s * 1e9), result)
+    assert node.stamps_back == 2
+    assert ros_graph.spin_until(lambda: len(poses) == 5, 5.0)
+    assert [p.header.stamp.sec for p in poses] == [10, 11, 10, 11, 11]
+    values = {kv.key: kv.value for kv in node.diagnostic_status().values}
+    assert values['stamps_back'] == '2'
