@@ -24,7 +24,7 @@ from urllib.parse import unquote
 
 import pytest
 
-from lumpbeam_ros.bench.bench_result import BenchResult
+from lumpbeam_lab.bench.bench_result import BenchResult
 from lumpbeam_ros.campaign.task import ID_COLUMNS
 from lumpbeam_ros.cli.analyze import CONTRACT_KEYS
 from lumpbeam_ros.cli.main import COMMANDS, build_parser

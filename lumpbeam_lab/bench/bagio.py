@@ -23,7 +23,7 @@ import numpy as np
 
 from lumpbeam_ros.bagio import BagReader, BagWriter, convert
 from lumpbeam_ros.bagio.typestore import serialize
-from lumpbeam_ros.bench.bench_result import BenchResult
+from lumpbeam_lab.bench.bench_result import BenchResult
 from lumpbeam_ros.interface import (
     BASE_FRAME,
     CAMERA_FRAME,

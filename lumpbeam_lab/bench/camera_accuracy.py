@@ -1,7 +1,7 @@
 """The camera's validation matrix (``lumpbeam bench --only camera-accuracy``).
 
 Every row is a short drop test filmed by the independent ray caster
-(:mod:`lumpbeam_ros.synthetic.raycast_camera`) and scored over every published pose: tip z
+(:mod:`lumpbeam_lab.camera.raycast_camera`) and scored over every published pose: tip z
 RMS with the bias in it against the 10 um target. The rows are printed as they finish, one
 line each, then come back as results.
 """
@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import dataclasses
 
-from lumpbeam_ros.bench.bench_result import BenchResult
-from lumpbeam_ros.vision.accuracy import drop_test_trajectory
-from lumpbeam_ros.vision.validation import (
+from lumpbeam_lab.bench.bench_result import BenchResult
+from lumpbeam_lab.camera.accuracy import drop_test_trajectory
+from lumpbeam_lab.camera.validation import (
     Z_RMS_LIMIT_UM,
     ValidationCase,
     format_row,

@@ -11,7 +11,7 @@ Fast DDS's default shared-memory segment (512 kB) is smaller than a 1 MB frame, 
 fallback drops most of a 180 fps stream of them; :data:`LARGE_FRAMES_PROFILE` gives the
 processes a 32 MB segment. The bench runs both transports and reports both.
 
-Run as ``python -m lumpbeam_ros.bench.camera_stream publish|echo ...`` for the processes.
+Run as ``python -m lumpbeam_lab.bench.camera_stream publish|echo ...`` for the processes.
 """
 
 from __future__ import annotations
@@ -100,7 +100,7 @@ def _frames(width: int, height: int) -> list[np.ndarray]:
     The tip is at rest at both ends, so the loop never jumps: the tracker tracks it as it
     would a real oscillation.
     """
-    from lumpbeam_ros.vision.accuracy import drop_test_trajectory, render_frames
+    from lumpbeam_lab.camera.accuracy import drop_test_trajectory, render_frames
     from lumpbeam_ros.vision.config import load_camera_config
 
     trajectory = drop_test_trajectory()

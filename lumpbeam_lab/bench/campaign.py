@@ -17,7 +17,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from lumpbeam_ros.bench.bench_result import BenchResult
+from lumpbeam_lab.bench.bench_result import BenchResult
 from lumpbeam_ros.campaign.engine import run_campaign, run_serial
 from lumpbeam_ros.campaign.store import ResultsStore
 from lumpbeam_ros.campaign.task import CampaignSettings, warm_up

@@ -13,7 +13,7 @@ import subprocess
 import sys
 import time
 
-from lumpbeam_ros.bench.bench_result import BenchResult
+from lumpbeam_lab.bench.bench_result import BenchResult
 
 #: What the ``lumpbeam`` console script runs.
 ENTRY_POINT = 'import sys; from lumpbeam_ros.cli.main import main; sys.exit(main())'

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lumpbeam_ros.bench.bench_result import BenchResult, best_time
+from lumpbeam_lab.bench.bench_result import BenchResult, best_time
 from lumpbeam_ros.diagnose.record import read_record
 from lumpbeam_ros.diagnose.workflow import diagnose
 from lumpbeam_ros.model.chain import LumpedChain

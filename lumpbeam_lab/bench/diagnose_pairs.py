@@ -21,7 +21,7 @@ import time
 from collections.abc import Mapping
 from pathlib import Path
 
-from lumpbeam_ros.bench.bench_result import BenchResult
+from lumpbeam_lab.bench.bench_result import BenchResult
 from lumpbeam_ros.diagnose.record import read_record
 from lumpbeam_ros.diagnose.workflow import Diagnosis, diagnose
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, load_beam_config

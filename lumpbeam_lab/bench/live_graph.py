@@ -1,12 +1,12 @@
 """End-to-end latency of the live graph: camera frame stamp to ``/beam_params`` publication.
 
 Three processes, as in the demo: a camera publisher offering frames stamped with the wall
-clock (:mod:`lumpbeam_ros.bench.camera_stream`), the camera node tracking them into
+clock (:mod:`lumpbeam_lab.bench.camera_stream`), the camera node tracking them into
 ``/tip_pose``, and the identifier node (on wall time) publishing ``/beam_params``. Each
 ``/beam_params`` message names the newest pose it used (``window_end_s``, the stamp of that
 frame); its header stamp is when it was published. Their difference is the latency of the
 whole chain, timed for the messages that bring a newer frame than the one before
-(:class:`~lumpbeam_ros.bench.camera_stream.ParamsAges`: a repeated window only measures a
+(:class:`~lumpbeam_lab.bench.camera_stream.ParamsAges`: a repeated window only measures a
 pause in the poses, such as the end of the stream). The baseline, measured in the same
 run, is the first hop alone: frame stamp to the arrival of its ``/tip_pose`` at the bench
 process. The ratio (baseline over value) is the part of the end-to-end latency that the
@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import math
 
-from lumpbeam_ros.bench import camera_stream
-from lumpbeam_ros.bench.bench_result import BenchResult
+from lumpbeam_lab.bench import camera_stream
+from lumpbeam_lab.bench.bench_result import BenchResult
 
 #: How often the identifier publishes during the bench, Hz (more samples than the default).
 PUBLISH_RATE_HZ = 10.0

@@ -11,7 +11,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from lumpbeam_ros.bench.bench_result import BenchResult, best_time
+from lumpbeam_lab.bench.bench_result import BenchResult, best_time
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.integrate import ChainState, solve_reference
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig

@@ -6,9 +6,9 @@ import importlib
 import importlib.util
 from collections.abc import Iterable
 
-from lumpbeam_ros.bench.bench_result import BenchResult
+from lumpbeam_lab.bench.bench_result import BenchResult
 
-#: Suite modules under :mod:`lumpbeam_ros.bench`.
+#: Suite modules under :mod:`lumpbeam_lab.bench`.
 SUITES = (
     'model',
     'tracker',
@@ -26,7 +26,7 @@ SUITES = (
 
 def _module(suite: str) -> str:
     """The module of a suite (suite names use hyphens, modules underscores)."""
-    return f'lumpbeam_ros.bench.{suite.replace("-", "_")}'
+    return f'lumpbeam_lab.bench.{suite.replace("-", "_")}'
 
 
 def available_suites() -> list[str]:
@@ -78,7 +78,7 @@ def format_table(results: Iterable[BenchResult]) -> str:
             shown = f'{value:.4g}' if isinstance(value, float) else str(value)
             lines.append(f'    {key}: {shown}')
     if cases:
-        from lumpbeam_ros.bench.diagnose_pairs import format_cases
+        from lumpbeam_lab.bench.diagnose_pairs import format_cases
 
         lines = ([*lines, ''] if results else []) + [format_cases(cases)]
     return '\n'.join(lines)

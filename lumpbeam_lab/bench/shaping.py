@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import fftconvolve
 
-from lumpbeam_ros.bench.bench_result import BenchResult, best_time
+from lumpbeam_lab.bench.bench_result import BenchResult, best_time
 from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
 from lumpbeam_ros.shaping.apply import shape_trajectory
 from lumpbeam_ros.shaping.impulses import Impulses, Mode

@@ -6,7 +6,7 @@ what a calibration script does to every frame: ``findChessboardCorners`` on the 
 
 Accuracy is scored on the model's whole drop test (every frame; every 20th in quick mode),
 and the camera node is run end to end through ROS topics between processes
-(:mod:`lumpbeam_ros.bench.camera_stream`).
+(:mod:`lumpbeam_lab.bench.camera_stream`).
 """
 
 from __future__ import annotations
@@ -18,9 +18,9 @@ from dataclasses import replace
 import cv2
 import numpy as np
 
-from lumpbeam_ros.bench import camera_stream
-from lumpbeam_ros.bench.bench_result import BenchResult
-from lumpbeam_ros.vision.accuracy import (
+from lumpbeam_lab.bench import camera_stream
+from lumpbeam_lab.bench.bench_result import BenchResult
+from lumpbeam_lab.camera.accuracy import (
     drop_test_trajectory,
     measure_accuracy,
     render_frames,

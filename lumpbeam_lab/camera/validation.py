@@ -1,11 +1,11 @@
 """The camera's validation matrix: short drop tests filmed by the independent ray caster.
 
 Each case renders a stretch of the model's drop test with
-:class:`~lumpbeam_ros.synthetic.raycast_camera.RaycastCamera` (its own lens, geometry and
+:class:`~lumpbeam_lab.camera.raycast_camera.RaycastCamera` (its own lens, geometry and
 board code), gives the tracker the same set-up through a :class:`CameraConfig` and a
 :class:`CameraInfo` (the mount tilt and the board's in-plane rotation are known from the
 configuration; the rig calibration still runs), and scores every published pose with
-:func:`~lumpbeam_ros.vision.accuracy.score`.
+:func:`~lumpbeam_lab.camera.accuracy.score`.
 """
 
 from __future__ import annotations
@@ -17,8 +17,8 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from lumpbeam_ros.model.trajectory import TipTrajectory
-from lumpbeam_ros.synthetic.raycast_camera import Lens, Optics, RaycastCamera, Scene
-from lumpbeam_ros.vision.accuracy import AccuracyReport, score
+from lumpbeam_lab.camera.raycast_camera import Lens, Optics, RaycastCamera, Scene
+from lumpbeam_lab.camera.accuracy import AccuracyReport, score
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import CameraConfig, RigGeometry, load_camera_config
 from lumpbeam_ros.vision.geometry import Transform

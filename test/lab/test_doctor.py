@@ -20,11 +20,11 @@ from mcap.reader import make_reader
 from mcap.records import Channel, DataEnd, Footer, Header, Message, Schema
 from mcap.writer import CompressionType, Writer
 
-from lumpbeam_ros.bagio import doctor
-from lumpbeam_ros.bagio.doctor import MAGIC, examine, examine_bag, examine_file
+from lumpbeam_lab import doctor
+from lumpbeam_lab.doctor import MAGIC, examine, examine_bag, examine_file
 from lumpbeam_ros.errors import BagError
 
-from .helpers import write_drop_bag
+from bagio.helpers import write_drop_bag
 
 ROOT = Path(__file__).resolve().parents[2]
 FOOTER_RECORD = 9 + 20  # opcode, length, summary_start, summary_offset_start, crc

@@ -23,7 +23,7 @@ from lumpbeam_ros.interface import (
     TIP_POSE,
     TIP_POSE_TRUTH,
 )
-from lumpbeam_ros.vision.accuracy import render_frames
+from lumpbeam_lab.camera.accuracy import render_frames
 from lumpbeam_ros.vision.messages import camera_info_to_data, decode_camera_info
 from lumpbeam_ros.vision.offline import TrackSummary, pose_message, track_bag, track_footage
 from lumpbeam_ros.vision.sources import FootageError, FootageFrame

@@ -8,7 +8,7 @@ import pytest
 
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.interface import COMPRESSED_IMAGE_TYPE
-from lumpbeam_ros.vision.accuracy import render_frames
+from lumpbeam_lab.camera.accuracy import render_frames
 from lumpbeam_ros.vision.session import SessionStats, TrackingSession
 from lumpbeam_ros.vision.tracker import TrackStatus
 

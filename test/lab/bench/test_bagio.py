@@ -1,4 +1,4 @@
-from lumpbeam_ros.bench import bagio
+from lumpbeam_lab.bench import bagio
 
 
 def test_quick_run_reports_both_figures():

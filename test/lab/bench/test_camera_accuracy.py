@@ -1,5 +1,5 @@
-from lumpbeam_ros.bench.camera_accuracy import run
-from lumpbeam_ros.bench.runner import available_suites
+from lumpbeam_lab.bench.camera_accuracy import run
+from lumpbeam_lab.bench.runner import available_suites
 
 
 def test_quick_run_prints_one_row_against_the_target(capsys):

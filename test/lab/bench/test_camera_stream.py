@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from lumpbeam_ros.bench.camera_stream import ParamsAges
+from lumpbeam_lab.bench.camera_stream import ParamsAges
 
 
 def _ages(messages):

@@ -1,7 +1,7 @@
 import pytest
 
-from lumpbeam_ros.bench import campaign
-from lumpbeam_ros.bench.runner import available_suites
+from lumpbeam_lab.bench import campaign
+from lumpbeam_lab.bench.runner import available_suites
 
 
 def test_quick_run_compares_workers_with_a_plain_loop():

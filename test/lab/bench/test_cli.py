@@ -1,5 +1,5 @@
-from lumpbeam_ros.bench import cli
-from lumpbeam_ros.bench.runner import available_suites
+from lumpbeam_lab.bench import cli
+from lumpbeam_lab.bench.runner import available_suites
 from lumpbeam_ros.cli.main import main
 
 

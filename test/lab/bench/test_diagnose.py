@@ -2,8 +2,8 @@ import math
 
 import pytest
 
-from lumpbeam_ros.bench import diagnose
-from lumpbeam_ros.bench.runner import available_suites
+from lumpbeam_lab.bench import diagnose
+from lumpbeam_lab.bench.runner import available_suites
 
 
 def test_quick_run_diagnoses_the_bag_and_compares_with_radau():

@@ -2,9 +2,9 @@ import math
 
 import pytest
 
-from lumpbeam_ros.bench import diagnose_pairs
-from lumpbeam_ros.bench.bench_result import BenchResult
-from lumpbeam_ros.bench.runner import available_suites, format_table
+from lumpbeam_lab.bench import diagnose_pairs
+from lumpbeam_lab.bench.bench_result import BenchResult
+from lumpbeam_lab.bench.runner import available_suites, format_table
 
 
 def _row(case, cpu, ratio, found, error):

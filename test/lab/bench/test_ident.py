@@ -1,7 +1,7 @@
 import pytest
 
-from lumpbeam_ros.bench import ident
-from lumpbeam_ros.bench.runner import available_suites
+from lumpbeam_lab.bench import ident
+from lumpbeam_lab.bench.runner import available_suites
 from lumpbeam_ros.model.parameters import BeamParameters
 
 

@@ -1,7 +1,7 @@
 import math
 
-from lumpbeam_ros.bench.live_graph import run
-from lumpbeam_ros.bench.runner import available_suites, format_table
+from lumpbeam_lab.bench.live_graph import run
+from lumpbeam_lab.bench.runner import available_suites, format_table
 
 
 def test_quick_run_reports_the_demo_latency_against_the_camera_hop():

@@ -1,4 +1,4 @@
-from lumpbeam_ros.bench.model import run
+from lumpbeam_lab.bench.model import run
 
 
 def test_quick_suite_measures_against_radau():

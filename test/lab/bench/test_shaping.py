@@ -1,5 +1,5 @@
-from lumpbeam_ros.bench.runner import available_suites
-from lumpbeam_ros.bench.shaping import run
+from lumpbeam_lab.bench.runner import available_suites
+from lumpbeam_lab.bench.shaping import run
 
 
 def test_quick_suite_measures_against_fftconvolve():

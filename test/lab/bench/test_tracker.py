@@ -1,7 +1,7 @@
 import math
 
-from lumpbeam_ros.bench.runner import available_suites
-from lumpbeam_ros.bench.tracker import run
+from lumpbeam_lab.bench.runner import available_suites
+from lumpbeam_lab.bench.tracker import run
 
 
 def test_quick_run_reports_speed_accuracy_and_end_to_end_against_same_run_baselines():

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.vision.accuracy import (
+from lumpbeam_lab.camera.accuracy import (
     ErrorStats,
     drop_test_trajectory,
     frame_times,

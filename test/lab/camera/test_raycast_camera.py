@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.synthetic.raycast_camera import (
+from lumpbeam_lab.camera.raycast_camera import (
     Lens,
     Optics,
     RaycastCamera,
@@ -132,7 +132,7 @@ def test_bad_lens_and_board_behind_the_camera():
 
 def test_shares_no_code_with_the_tracker():
     code = (
-        'import sys, lumpbeam_ros.synthetic.raycast_camera; '
+        'import sys, lumpbeam_lab.camera.raycast_camera; '
         'print(sorted(m for m in sys.modules if m.startswith("lumpbeam_ros.vision")))'
     )
     out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True, check=True)

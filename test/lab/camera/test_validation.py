@@ -9,7 +9,7 @@ import dataclasses
 
 import pytest
 
-from lumpbeam_ros.vision.validation import (
+from lumpbeam_lab.camera.validation import (
     PITCH_RMS_LIMIT_MRAD,
     Z_RMS_LIMIT_UM,
     format_row,
