@@ -39,3 +39,26 @@ def test_parameters_are_declared_only_from_the_schemas():
         _tool()._grep(ROOT, r'\.declare_parameters?\(', ('lumpbeam_ros/nodes/ros_parameters.py',))
         == []
     )
+
+
+def test_the_product_imports_nothing_of_the_lab():
+    assert _tool().lab_imports(ROOT) == []
+
+
+def test_a_lab_import_by_the_product_is_found_and_the_cli_may_run_the_lab(tmp_path):
+    tool = _tool()
+    for folder in ('vision', 'nodes', 'cli'):
+        (tmp_path / 'lumpbeam_ros' / folder).mkdir(parents=True)
+    (tmp_path / 'lumpbeam_ros' / 'vision' / 'scores.py').write_text(
+        'from lumpbeam_lab.camera.accuracy import score\n'
+    )
+    (tmp_path / 'lumpbeam_ros' / 'nodes' / 'node.py').write_text(
+        'def f():\n    import lumpbeam_lab.doctor\n'
+    )
+    (tmp_path / 'lumpbeam_ros' / 'cli' / 'bench.py').write_text(
+        'from lumpbeam_lab.bench.runner import run_suites\n'
+    )
+    assert tool.lab_imports(tmp_path) == [
+        'lumpbeam_ros/nodes/node.py:2: lumpbeam_lab.doctor',
+        'lumpbeam_ros/vision/scores.py:1: lumpbeam_lab.camera.accuracy',
+    ]
