@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
+from lumpbeam_lab.bench.bench_result import BenchResult
 from lumpbeam_ros.bagio import BagReader, BagWriter, convert
 from lumpbeam_ros.bagio.typestore import serialize
-from lumpbeam_lab.bench.bench_result import BenchResult
 from lumpbeam_ros.interface import (
     BASE_FRAME,
     CAMERA_FRAME,

@@ -22,8 +22,8 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import curve_fit
 
-from lumpbeam_ros.bagio import BagWriter, read_load_events, read_tip_poses
 from lumpbeam_lab.bench.bench_result import BenchResult, best_time
+from lumpbeam_ros.bagio import BagWriter, read_load_events, read_tip_poses
 from lumpbeam_ros.ident.identify import identify, identify_from
 from lumpbeam_ros.ident.samples import PoseWindow, clean_loads, clean_window
 from lumpbeam_ros.ident.settings import IdentifierConfig

@@ -16,9 +16,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from lumpbeam_ros.model.trajectory import TipTrajectory
-from lumpbeam_lab.camera.raycast_camera import Lens, Optics, RaycastCamera, Scene
 from lumpbeam_lab.camera.accuracy import AccuracyReport, score
+from lumpbeam_lab.camera.raycast_camera import Lens, Optics, RaycastCamera, Scene
+from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.config import CameraConfig, RigGeometry, load_camera_config
 from lumpbeam_ros.vision.geometry import Transform

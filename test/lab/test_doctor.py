@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from bagio.helpers import write_drop_bag
 from mcap.data_stream import RecordBuilder
 from mcap.reader import make_reader
 from mcap.records import Channel, DataEnd, Footer, Header, Message, Schema
@@ -23,8 +24,6 @@ from mcap.writer import CompressionType, Writer
 from lumpbeam_lab import doctor
 from lumpbeam_lab.doctor import MAGIC, examine, examine_bag, examine_file
 from lumpbeam_ros.errors import BagError
-
-from bagio.helpers import write_drop_bag
 
 ROOT = Path(__file__).resolve().parents[2]
 FOOTER_RECORD = 9 + 20  # opcode, length, summary_start, summary_offset_start, crc

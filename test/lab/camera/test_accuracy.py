@@ -1,7 +1,6 @@
 import numpy as np
 import pytest
 
-from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_lab.camera.accuracy import (
     ErrorStats,
     drop_test_trajectory,
@@ -9,6 +8,7 @@ from lumpbeam_lab.camera.accuracy import (
     measure_accuracy,
     score,
 )
+from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.vision.tracker import TrackResult, TrackStatus
 
 

@@ -8,7 +8,6 @@ import cv2
 import numpy as np
 import pytest
 
-from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_lab.camera.raycast_camera import (
     Lens,
     Optics,
@@ -17,6 +16,7 @@ from lumpbeam_lab.camera.raycast_camera import (
     lens_distort,
     lens_rays,
 )
+from lumpbeam_ros.errors import LumpbeamError
 
 SCENE = Scene(
     9, 7, 0.06, 1.0, (0.0, 0.05, 0.0), (-np.pi / 2 + 0.02, 0.0, -0.03),
