@@ -11,6 +11,8 @@ record classes (:mod:`mcap.records`) and its chunk decompression
 - schemas and channels defined before what uses them, an id never redefined differently;
 - every chunk decompresses to its uncompressed size and CRC, and its message start and end
   times are the least and greatest log time of its messages;
+- every message of a type the ROS 2 Jazzy typestore knows decodes (CDR), so damage inside
+  a message is found in a file without CRCs too;
 - messages' log times never decrease in file order (``Message.log_time X on "/topic" is less
   than the latest log time Y``, the doctor's warning);
 - the message indexes after each chunk list exactly its messages, with their channels and
@@ -59,7 +61,8 @@ from mcap.records import (
 from mcap.stream_reader import get_chunk_data_stream
 
 from lumpbeam_ros.bagio import metadata
-from lumpbeam_ros.bagio.fastscan import MAGIC
+from lumpbeam_ros.bagio.reader import MAGIC
+from lumpbeam_ros.bagio.typestore import deserialize, is_known
 from lumpbeam_ros.errors import BagError
 
 #: Profiles of the MCAP registry; ``''`` is a file without one.
@@ -174,11 +177,13 @@ class FileReport:
         problems: One line per problem (empty: clean).
         profile: The Header's profile (``None``: no readable Header).
         topic_counts: Messages counted per topic.
+        complete: Whether every message could be counted (no unreadable chunk, not cut).
     """
 
     problems: list[str]
     profile: str | None
     topic_counts: dict[str, int]
+    complete: bool = True
 
 
 class _Examiner:
@@ -386,6 +391,12 @@ class _Examiner:
                 f'Message at {where} is on channel {message.channel_id}, not defined before it',
             )
         topic = channel.topic if channel else f'<channel {message.channel_id}>'
+        schema = self.schemas.get(channel.schema_id) if channel is not None else None
+        if schema is not None and is_known(schema.name):
+            try:
+                deserialize(message.data, schema.name)
+            except BagError as exc:
+                self.problem('message', f'Message at {where} on "{topic}" does not decode: {exc}')
         log_time = message.log_time
         if self.latest_time is not None and log_time < self.latest_time:
             self.problem(
@@ -708,14 +719,17 @@ def examine(path: str | Path) -> FileReport:
         file = path.open('rb')
     except OSError as exc:
         raise BagError(f'{path}: cannot open ({exc.strerror or exc})') from None
+    complete = True
     with file:
         examiner = _Examiner(file, path.stat().st_size)
         try:
             examiner.run()
         except _UnreadableError as exc:
             examiner.problems.append(str(exc))
+            complete = False
+    complete = complete and all(seen.readable for seen in examiner.chunks.values())
     profile = examiner.header.profile if examiner.header else None
-    return FileReport(examiner.report(), profile, examiner.topic_counts())
+    return FileReport(examiner.report(), profile, examiner.topic_counts(), complete)
 
 
 def examine_file(path: str | Path) -> list[str]:
@@ -742,30 +756,42 @@ def examine_bag(bag: str | Path) -> list[str]:
     Args:
         bag: The bag folder.
 
+    The counts are compared only when every message of the files could be counted: a
+    damaged chunk is reported as such, not again as a count that differs.
+
     Returns:
         The problems; an empty list for a clean bag.
 
     Raises:
-        BagError: Not a bag folder, or a file that cannot be opened.
+        BagError: Not a bag folder (no folder, or one with neither ``metadata.yaml`` nor an
+            ``.mcap`` file), or a file that cannot be opened.
     """
     folder = Path(bag)
     if not folder.is_dir():
         raise BagError(f'{folder}: not a bag folder')
     problems: list[str] = []
     files = sorted(folder.glob('*.mcap'))
+    if not files and not (folder / metadata.FILENAME).exists():
+        raise BagError(
+            f'{folder}: not a bag folder (neither {metadata.FILENAME} nor an .mcap file)'
+        )
     if not files:
         problems.append(f'{folder}: no .mcap file')
     counts: Counter[str] = Counter()
+    complete = True
     for file in files:
         report = examine(file)
         problems += [f'{file.name}: {line}' for line in report.problems]
         if report.profile not in (None, 'ros2'):
             problems.append(f"{file.name}: Header.profile {report.profile!r}, a bag needs 'ros2'")
         counts.update(report.topic_counts)
+        complete = complete and report.complete
     try:
         info = metadata.load(folder)
     except BagError as exc:
         return [*problems, str(exc)]
+    if not complete:
+        return problems
     listed = {entry.name: entry.count for entry in info.topics.values()}
     for topic in sorted(set(listed) | set(counts)):
         if topic not in listed:

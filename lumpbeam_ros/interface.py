@@ -34,6 +34,7 @@ COMPRESSED_IMAGE_TYPE = 'sensor_msgs/msg/CompressedImage'
 CAMERA_INFO_TYPE = 'sensor_msgs/msg/CameraInfo'
 CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
 MARKER_ARRAY = 'visualization_msgs/msg/MarkerArray'
+JOINT_STATE_TYPE = 'sensor_msgs/msg/JointState'
 JOINT_TRAJECTORY_TYPE = 'trajectory_msgs/msg/JointTrajectory'
 
 # -- topics (absolute: the default graph's and the bags' names) -------------------------------
@@ -52,6 +53,8 @@ BEAM_MARKERS = '/beam_markers'
 MODEL_DISCREPANCY = '/model_discrepancy'
 DIAGNOSTICS = '/diagnostics'
 TIP_POSE_TRUTH = '/tip_pose_truth'
+#: An arm's joint angles (rad): its encoders, or the commanded angles of a simulated arm.
+JOINT_STATES = '/joint_states'
 JOINT_TRAJECTORY = '/joint_trajectory'
 JOINT_TRAJECTORY_SHAPED = '/joint_trajectory_shaped'
 
@@ -71,6 +74,7 @@ TOPIC_TYPES: dict[str, str] = {
     MODEL_DISCREPANCY: DIAGNOSTIC_ARRAY,
     DIAGNOSTICS: DIAGNOSTIC_ARRAY,
     TIP_POSE_TRUTH: POSE_STAMPED,
+    JOINT_STATES: JOINT_STATE_TYPE,
     JOINT_TRAJECTORY: JOINT_TRAJECTORY_TYPE,
     JOINT_TRAJECTORY_SHAPED: JOINT_TRAJECTORY_TYPE,
 }

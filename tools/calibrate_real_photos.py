@@ -67,27 +67,50 @@ def calibration_yaml(name: str, size: tuple[int, int], k: np.ndarray, d: np.ndar
     return yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
 
 
+#: Views with the board a calibration needs at least (OpenCV's minimum for K and 5 terms).
+MIN_VIEWS = 3
+
+
 def calibrate(folder: Path) -> tuple[str, float, int]:
-    """Calibrates the camera of one folder; returns the YAML, the RMS error and the views."""
-    objects, images, size = [], [], (0, 0)
+    """Calibrates the camera of one folder; returns the YAML, the RMS error and the views.
+
+    Raises:
+        ValueError: Fewer than :data:`MIN_VIEWS` photographs show the board, or they differ
+            in size (the message names the folder).
+    """
+    objects, images, sizes = [], [], set()
     for path in sorted(folder.glob('*.jpg')):
         gray = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
-        size = (gray.shape[1], gray.shape[0])
+        if gray is None:
+            continue
         corners = find_corners(gray)
         if corners is not None:
             objects.append(board_points())
             images.append(corners)
+            sizes.add((gray.shape[1], gray.shape[0]))
+    if len(images) < MIN_VIEWS or len(sizes) != 1:
+        raise ValueError(
+            f'{folder}: {len(images)} JPEG photographs show a {PATTERN[0]}x{PATTERN[1]} board '
+            f'in {len(sizes)} image sizes (need {MIN_VIEWS} of one size)'
+        )
+    size = sizes.pop()
     rms, k, d, _, _ = cv2.calibrateCamera(objects, images, size, None, None)
     return calibration_yaml(folder.name, size, k, d.ravel()[:5]), float(rms), len(images)
 
 
 def main(argv: list[str]) -> int:
-    """Writes ``left.yaml`` and ``right.yaml`` beside the photographs."""
+    """Writes ``left.yaml`` and ``right.yaml`` beside the photographs (exit 2 on bad input)."""
     root = Path(argv[1]) if len(argv) > 1 else Path(__file__).resolve().parents[1]
     if len(argv) <= 1:
         root = root / 'test' / 'data' / 'real_photos'
+    results = []
     for camera in ('left', 'right'):
-        text, rms, views = calibrate(root / camera)
+        try:
+            results.append((camera, *calibrate(root / camera)))
+        except ValueError as exc:
+            print(f'calibrate_real_photos: {exc}', file=sys.stderr)
+            return 2
+    for camera, text, rms, views in results:
         (root / f'{camera}.yaml').write_text(text)
         print(f'{camera}: {views} views, RMS reprojection error {rms:.4f} px')
     return 0

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from lumpbeam_lab.bench.bench_result import BenchResult, best_time
-from lumpbeam_ros.diagnose.record import read_record
+from lumpbeam_ros.diagnose.measurement import read_record
 from lumpbeam_ros.diagnose.workflow import diagnose
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.integrate import ChainState, solve_reference

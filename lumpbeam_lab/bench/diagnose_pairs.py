@@ -22,7 +22,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from lumpbeam_lab.bench.bench_result import BenchResult
-from lumpbeam_ros.diagnose.record import read_record
+from lumpbeam_ros.diagnose.measurement import read_record
 from lumpbeam_ros.diagnose.workflow import Diagnosis, diagnose
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, load_beam_config
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag

@@ -191,7 +191,7 @@ def _analyze(quick: bool, beam: BeamParameters) -> BenchResult:
         name='analyze_bag_throughput',
         value=value,
         unit='pose msgs/s',
-        baseline='the same analysis through the mcap reader and per-message CDR decoding',
+        baseline='the same analysis with per-message CDR decoding (rosbags)',
         baseline_value=baseline_value,
         ratio=value / baseline_value,
         details={'poses': int(t.size), 'status': status, 'seconds': ours_s},

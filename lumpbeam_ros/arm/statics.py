@@ -55,3 +55,15 @@ def arm_modes(model: ArmModel, q: np.ndarray) -> Modes:
         The modes.
     """
     return linear_modes(arm_linear_model(model, q))
+
+
+def modes_table(modes: Modes) -> list[dict[str, float]]:
+    """The modes as ``lumpbeam modes`` lists them in JSON, slowest first.
+
+    Returns:
+        One ``{natural_frequency_hz, damping_ratio}`` per underdamped mode.
+    """
+    return [
+        {'natural_frequency_hz': float(f), 'damping_ratio': float(z)}
+        for f, z in zip(modes.natural_frequency_hz, modes.damping_ratio, strict=True)
+    ]

@@ -26,6 +26,7 @@ from lumpbeam_ros.interface import (
     DIAGNOSTIC_ARRAY,
     FLOAT64,
     IMAGE_TYPE,
+    JOINT_STATE_TYPE,
     POINT_STAMPED,
     POSE_STAMPED,
 )
@@ -151,6 +152,28 @@ def pose_values(msg: Any) -> tuple[int, float, float, float, str]:
 def float64(value: float) -> Any:
     """Builds a ``std_msgs/msg/Float64``."""
     return message_class(FLOAT64)(data=float(value))
+
+
+def joint_state(ns: int, names: Iterable[str], positions: np.ndarray) -> Any:
+    """Builds a ``sensor_msgs/msg/JointState`` of joint angles (rad), without rates or efforts.
+
+    Args:
+        ns: Stamp, ns.
+        names: One name per joint (``joint_1`` ...).
+        positions: The angles, rad.
+    """
+    return message_class(JOINT_STATE_TYPE)(
+        header=header(ns, ''),
+        name=list(names),
+        position=np.asarray(positions, dtype=np.float64),
+        velocity=np.zeros(0),
+        effort=np.zeros(0),
+    )
+
+
+def joint_state_values(msg: Any) -> tuple[int, list[str], np.ndarray]:
+    """Returns ``(stamp_ns, names, positions)`` of a ``JointState``."""
+    return time_ns(msg.header.stamp), list(msg.name), np.asarray(msg.position, dtype=float)
 
 
 def point_stamped(ns: int, x: float, y: float, z: float, frame_id: str) -> Any:

@@ -9,6 +9,8 @@ summary and exact counts. :func:`reindex` covers a metadata file that was delete
 
 from __future__ import annotations
 
+import shutil
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -17,8 +19,8 @@ from mcap.records import Channel, Schema
 
 from lumpbeam_ros.bagio import metadata
 from lumpbeam_ros.bagio.qos import from_dict
-from lumpbeam_ros.bagio.reader import BagReader, probe, stream_messages
-from lumpbeam_ros.bagio.typestore import is_known, type_description
+from lumpbeam_ros.bagio.reader import BagReader, FileWalk, probe
+from lumpbeam_ros.bagio.typestore import deserialize, is_known, type_description
 from lumpbeam_ros.bagio.writer import BagWriter
 from lumpbeam_ros.errors import BagError
 
@@ -47,16 +49,16 @@ def reindex(path: str | Path) -> int:
     if len(files) != 1:
         raise BagError(f'{folder}: reindex needs exactly one .mcap file, found {len(files)}')
     data_file = files[0]
-    probe(data_file, folder)  # an empty or foreign file is no bag: write no metadata for it
+    # An empty or foreign file is no bag: write no metadata for it.
+    summary = probe(data_file, folder)
     declared: dict[str, tuple[Schema | None, Channel]] = {}
     counts: dict[str, int] = {}
     start, end = 2**63 - 1, 0
     try:
-        with data_file.open('rb') as stream:
-            for _, channel, message in stream_messages(stream, str(data_file), None, declared):
-                counts[channel.topic] = counts.get(channel.topic, 0) + 1
-                start = min(start, message.log_time)
-                end = max(end, message.log_time)
+        for _, channel, message in FileWalk(data_file, folder, summary, None, declared):
+            counts[channel.topic] = counts.get(channel.topic, 0) + 1
+            start = min(start, message.log_time)
+            end = max(end, message.log_time)
         topics = []
         for name, (schema, channel) in declared.items():
             msgtype = schema.name if schema is not None else ''
@@ -78,12 +80,15 @@ class RepairSummary:
         out: The repaired bag.
         listed: Messages per topic that the damaged bag's metadata listed.
         kept: Messages per topic copied into the repaired bag.
+        undecodable: Messages per topic left out because they do not decode (damaged bytes
+            in a chunk without a CRC); topics without any are absent.
         truncated: Whether the damaged bag had data files without their closing summary.
     """
 
     out: Path
     listed: dict[str, int] = field(default_factory=dict)
     kept: dict[str, int] = field(default_factory=dict)
+    undecodable: dict[str, int] = field(default_factory=dict)
     truncated: bool = False
 
 
@@ -96,11 +101,13 @@ def default_repair_path(bag: str | Path) -> Path:
 def repair_bag(bag: str | Path, out: str | Path | None = None) -> RepairSummary:
     """Copies every readable message of a bag into a new, complete bag.
 
-    The copy has one MCAP file with chunk indexes, statistics and summary, its messages in
-    log-time order, and a ``metadata.yaml`` whose counts are those of the copy. Topics keep
+    The copy has one MCAP file with chunk indexes, statistics, CRCs and summary, its messages
+    in log-time order, and a ``metadata.yaml`` whose counts are those of the copy. Topics keep
     their types, message definitions, type hashes and offered QoS, those without messages
-    too. Messages after an incomplete or damaged record are lost (the reader warns, naming
-    the topic and count).
+    too. What a damaged chunk or an incomplete record held is lost, and a message of a known
+    type that does not decode is left out: the copy holds only what every reader can read
+    (the reader warns, naming each topic and count). When the copy fails, nothing of it is
+    left behind.
 
     Args:
         bag: The damaged bag folder (e.g. a recording whose recorder was killed).
@@ -119,25 +126,50 @@ def repair_bag(bag: str | Path, out: str | Path | None = None) -> RepairSummary:
         listed={name: entry.count for name, entry in reader.topics.items()},
         truncated=bool(reader.truncated),
     )
-    declared: dict[str, tuple[Schema | None, Channel]] = {}
-    with BagWriter(target) as writer:
-        for schema, channel, message in reader.iter_records(declared=declared):
-            topic = channel.topic
-            if not writer.has_topic(topic):
-                _declare(writer, reader, topic, schema)
-                summary.kept[topic] = 0
-            writer.write_raw(topic, message.log_time, message.data)
-            summary.kept[topic] += 1
-        # Topics without a message: the file's own schema describes a type Jazzy lacks.
-        for name, (schema, _) in declared.items():
-            if not writer.has_topic(name):
-                _declare(writer, reader, name, schema)
-                summary.kept[name] = 0
-        for name, entry in reader.topics.items():
-            if not writer.has_topic(name) and is_known(entry.msgtype):
-                writer.add_topic(name, entry.msgtype, qos=[from_dict(p) for p in entry.qos])
-                summary.kept[name] = 0
+    writer = BagWriter(target)  # refuses an existing OUT: nothing of the user's is removed
+    try:
+        with writer:
+            _copy(reader, writer, summary)
+    except BaseException:
+        shutil.rmtree(target, ignore_errors=True)
+        raise
     return summary
+
+
+def _copy(reader: BagReader, writer: BagWriter, summary: RepairSummary) -> None:
+    """Copies the readable, decodable messages and declares every topic the bag declares."""
+    declared: dict[str, tuple[Schema | None, Channel]] = {}
+    read: Counter[str] = Counter()
+    undecodable: Counter[str] = Counter()
+    errors: dict[str, str] = {}
+    for schema, channel, message in reader.iter_records(declared=declared, report=False):
+        topic = channel.topic
+        read[topic] += 1
+        msgtype = schema.name if schema is not None else ''
+        if is_known(msgtype):
+            try:
+                deserialize(message.data, msgtype)
+            except BagError as exc:
+                undecodable[topic] += 1
+                errors.setdefault(topic, str(exc))
+                continue
+        if not writer.has_topic(topic):
+            _declare(writer, reader, topic, schema)
+            summary.kept[topic] = 0
+        writer.write_raw(topic, message.log_time, message.data)
+        summary.kept[topic] += 1
+    for topic in sorted(set(reader.topics) | set(read)):
+        reader.report_loss(topic, read[topic], undecodable[topic], errors.get(topic, ''))
+    summary.undecodable = dict(undecodable)
+    # Topics without a message: the file's own schema describes a type Jazzy lacks.
+    for name, (schema, _) in declared.items():
+        if not writer.has_topic(name):
+            _declare(writer, reader, name, schema)
+            summary.kept[name] = 0
+    for name, entry in reader.topics.items():
+        if not writer.has_topic(name) and is_known(entry.msgtype):
+            writer.add_topic(name, entry.msgtype, qos=[from_dict(p) for p in entry.qos])
+            summary.kept[name] = 0
 
 
 def _declare(writer: BagWriter, reader: BagReader, topic: str, schema: object) -> None:

@@ -93,13 +93,15 @@ def read_tip_poses(bag: Bag, topic: str = TIP_POSE, *, fast: bool = True) -> Tip
         bag: Bag folder or open reader.
         topic: E.g. ``'/tip_pose'``, ``'/tip_pose_truth'``, ``'/tip_pose_predicted'``.
         fast: Decode the topic in one vectorized pass (:mod:`~lumpbeam_ros.bagio.fastscan`)
-            when the files allow it; ``False`` always takes the general, per-message reader.
+            when its messages allow it; ``False`` always takes the general, per-message
+            decoder. Both read the same verified messages.
 
     Returns:
         The poses sorted by stamp (empty arrays for an empty topic).
 
     Raises:
-        BagError: Missing topic, another type, corrupt messages or mixed frames.
+        BagError: Missing topic, another type or mixed frames (a message that does not
+            decode is skipped and counted).
     """
     reader = open_bag(bag)
     reader.require(topic, 'geometry_msgs/msg/PoseStamped')
@@ -112,28 +114,27 @@ def read_tip_poses(bag: Bag, topic: str = TIP_POSE, *, fast: bool = True) -> Tip
     return TipSeries(t, x, z, pitch, frame_id=frame)
 
 
-def _fast_scan(reader: BagReader, topic: str) -> tuple[list[int], list[bytes]] | None:
-    """Log times and payloads of a topic across a bag's files (``None``: read in full)."""
-    if reader.truncated:
-        return None
+def _fast_scan(reader: BagReader, topic: str) -> tuple[list[int], list[bytes]]:
+    """Log times and payloads of a topic across a bag's files, read past any damage.
+
+    What damaged data lost is not reported yet: the caller reports it once it knows whether
+    every payload decodes (:meth:`~.BagReader.report_loss`).
+    """
     log_times: list[int] = []
     payloads: list[bytes] = []
-    for file in reader.info.files:
-        part = fastscan.scan_topic(file, topic)
-        if part is None:
-            return None
-        log_times += part[0]
-        payloads += part[1]
-    reader.check_count(topic, len(payloads))
+    for raw in reader.iter_raw([topic], report=False):
+        log_times.append(raw.log_time_ns)
+        payloads.append(bytes(raw.data))
     return log_times, payloads
 
 
 def _fast_poses(reader: BagReader, topic: str) -> TipSeries | None:
-    """The poses by :mod:`~lumpbeam_ros.bagio.fastscan`, or ``None`` to read them in full."""
-    scanned = _fast_scan(reader, topic)
-    decoded = None if scanned is None else fastscan.decode_pose_stamped(scanned[1])
+    """The poses by :mod:`~lumpbeam_ros.bagio.fastscan`, or ``None`` to decode one by one."""
+    _, payloads = _fast_scan(reader, topic)
+    decoded = fastscan.decode_pose_stamped(payloads)
     if decoded is None:
-        return None
+        return None  # not one layout (or a damaged message): the general decoder names it
+    reader.report_loss(topic, len(payloads))
     ns, position, orientation, frame = decoded
     order = np.argsort(ns, kind='stable')
     pitch = convert.quaternions_to_pitch(orientation[order])
@@ -146,13 +147,15 @@ def read_floats(bag: Bag, topic: str) -> tuple[np.ndarray, np.ndarray]:
     """Reads a ``std_msgs/Float64`` topic as ``(log time s, value)`` arrays, sorted.
 
     Raises:
-        BagError: Missing topic, another type or corrupt messages.
+        BagError: Missing topic or another type (a message that does not decode is
+            skipped and counted).
     """
     reader = open_bag(bag)
     reader.require(topic, 'std_msgs/msg/Float64')
     scanned = _fast_scan(reader, topic)
-    values = None if scanned is None else fastscan.decode_float64(scanned[1])
-    if scanned is not None and values is not None:
+    values = fastscan.decode_float64(scanned[1])
+    if values is not None:
+        reader.report_loss(topic, len(scanned[1]))
         ns = np.asarray(scanned[0], dtype=np.int64)
         order = np.argsort(ns, kind='stable')
         return ns[order] / convert.NS_PER_S, values[order]
@@ -168,7 +171,8 @@ def read_load_events(bag: Bag, topic: str = TIP_LOAD) -> LoadSeries:
     """Reads ``/tip_load`` (kg at the tip, by log time); ``.changes()`` keeps the changes.
 
     Raises:
-        BagError: Missing topic, another type or corrupt messages.
+        BagError: Missing topic or another type (a message that does not decode is
+            skipped and counted).
     """
     t, kg = read_floats(bag, topic)
     return LoadSeries(t, kg)
@@ -178,7 +182,8 @@ def read_points(bag: Bag, topic: str = TRACKER_POINT) -> PointSeries:
     """Reads a ``geometry_msgs/PointStamped`` topic, sorted by stamp.
 
     Raises:
-        BagError: Missing topic, another type, corrupt messages or mixed frames.
+        BagError: Missing topic, another type or mixed frames (a message that does not
+            decode is skipped and counted).
     """
     reader = open_bag(bag)
     decoded = (convert.point_values(m) for _, m in reader.messages(topic, POINT_STAMPED))
@@ -218,7 +223,8 @@ def read_diagnostics(
     """Reads a ``diagnostic_msgs/DiagnosticArray`` topic as ``(stamp s, statuses)`` pairs.
 
     Raises:
-        BagError: Missing topic, another type or corrupt messages.
+        BagError: Missing topic or another type (a message that does not decode is
+            skipped and counted).
     """
     out = [
         (_stamp_s(msg), convert.diagnostic_statuses(msg))

@@ -1,9 +1,9 @@
 """Writing rosbag2 bags (MCAP storage, CDR) that survive a crash of their writer.
 
-rosbags' :class:`~rosbags.rosbag2.Writer` writes MCAP in chunks of ~1 MiB and writes
-``metadata.yaml`` only in ``close()``, so a writer killed mid-recording would leave a bag that
-no reader opens and up to a whole chunk (minutes of poses) only in memory. :class:`BagWriter`
-adds what a recorder needs on top of it:
+The MCAP file is written by the ``mcap`` package's :class:`~mcap.writer.Writer` with every
+integrity check MCAP has: a CRC-32 of each chunk's records, of the data section and of the
+summary, so that a reader (this package's, rosbags', the mcap tools) tells damaged bytes from
+data. :class:`BagWriter` adds what a rosbag2 recorder needs on top of it:
 
 - ``metadata.yaml`` is written when the bag is created and refreshed at every flush;
 - a flush, at most ``flush_period_s`` after a message arrives, closes the pending chunk and
@@ -18,6 +18,11 @@ adds what a recorder needs on top of it:
   what an earlier flush wrote cannot be put in order any more: it is written with a warning,
   so a writer whose sources are out of order merges them first.
 
+The file is what ``ros2 bag record -s mcap`` writes: the ``ros2`` profile, one ``ros2msg``
+schema per type, one ``cdr`` channel per topic with its offered QoS in the channel metadata,
+uncompressed chunks (a 180 fps camera stream does not wait for a compressor) and the
+``rosbag2`` metadata record at the end.
+
 Messages' log time is the recording time; for synthetic bags it equals the header stamp
 (doc/interfaces.md, 'Frames, units and time': stamps are measurement time).
 """
@@ -28,13 +33,18 @@ import logging
 import operator
 import time
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
-from rosbags.interfaces import Connection, Qos
-from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
+import yaml
+from mcap.writer import CompressionType
+from mcap.writer import Writer as McapWriter
+from rosbags.interfaces import Qos
+from rosbags.rosbag2.metadata import dump_qos_v9
 
+from lumpbeam_ros import __version__
 from lumpbeam_ros.bagio import convert, metadata
 from lumpbeam_ros.bagio.qos import default_profile
 from lumpbeam_ros.bagio.typestore import serialize, type_description
@@ -44,8 +54,23 @@ from lumpbeam_ros.interface import BASE_FRAME, CAMERA_FRAME, CLOCK
 
 _log = logging.getLogger(__name__)
 
-#: Bytes of pending messages that trigger a flush (rosbags closes its chunks at 1 MiB too).
+#: Bytes of pending messages that trigger a flush (a chunk of about 1 MiB, as rosbag2 writes).
 PENDING_LIMIT_BYTES = 1 << 20
+#: Log time a chunk spans at most, ns (but for messages that arrive later than this): a
+#: damaged chunk fails its CRC whole, so this bounds what one damaged spot costs a reader,
+#: whether the bag is recorded live (flushed every ``flush_period_s``) or written offline.
+CHUNK_SPAN_NS = 500_000_000
+
+
+@dataclass(frozen=True)
+class _Topic:
+    """A declared topic: its MCAP channel and what ``metadata.yaml`` lists of it."""
+
+    name: str
+    msgtype: str
+    channel_id: int
+    qos: list[Qos]
+    type_hash: str
 
 
 class BagWriter(ClosedOnExit):
@@ -72,28 +97,36 @@ class BagWriter(ClosedOnExit):
         if not flush_period_s > 0.0:
             raise BagError(f'flush period must be positive, got {flush_period_s!r}')
         self._flush_period = flush_period_s
-        self._writer = Writer(
-            self.path, version=metadata.VERSION, storage_plugin=StoragePlugin.MCAP
-        )
         try:
-            self._writer.open()
-        except WriterError as exc:
-            raise BagError(str(exc)) from None
+            self.path.mkdir(parents=True)
+            self._file: IO[bytes] = (self.path / f'{self.path.name}.mcap').open('xb')
         except OSError as exc:
             raise BagError(f'cannot create bag {self.path}: {exc.strerror or exc}') from None
-        self._connections: dict[str, Connection] = {}
-        self._qos: dict[str, list[Qos]] = {}
+        self._mcap = McapWriter(
+            self._file,
+            chunk_size=PENDING_LIMIT_BYTES,
+            compression=CompressionType.NONE,
+            enable_crcs=True,
+            enable_data_crcs=True,
+        )
+        self._topics: dict[str, _Topic] = {}
+        self._schemas: dict[str, int] = {}
+        self._counts: dict[str, int] = {}
+        self._start_ns = 2**63 - 1
+        self._end_ns = 0
         self._failed = False
         self._closed = False
-        # Messages since the last flush: (log time, sequence, connection, data).
-        self._pending: list[tuple[int, int, Connection, bytes | memoryview]] = []
+        # Messages since the last flush: (log time, sequence, topic, data).
+        self._pending: list[tuple[int, int, _Topic, bytes | memoryview]] = []
         self._pending_bytes = 0
         self._sequence = 0
         self._flushed_log_time = -1  # the latest log time in the file
         self._warned_order = False
         self._last_flush = time.monotonic()
         self._flushed_snapshot = self._metadata()
-        self._guard(self._flush_storage)  # the MCAP magic and header, so the file is one
+        library = f'lumpbeam_ros {__version__}'
+        self._guard(lambda: self._mcap.start(profile='ros2', library=library))
+        self._guard(self._mcap.flush)  # the MCAP magic and header, so the file is one
         self._guard(lambda: metadata.write(self.path, self._flushed_snapshot))
 
     # -- topics and raw messages ------------------------------------------------------------
@@ -118,8 +151,8 @@ class BagWriter(ClosedOnExit):
         Raises:
             BagError: A topic declared twice, a bad name, or a type neither known nor described.
         """
-        if not topic.startswith('/') or topic in self._connections:
-            problem = 'is declared twice' if topic in self._connections else 'must start with /'
+        if not topic.startswith('/') or topic in self._topics:
+            problem = 'is declared twice' if topic in self._topics else 'must start with /'
             raise BagError(f'topic {topic!r} {problem}')
         if msgdef is None or type_hash is None:
             known_def, known_hash = type_description(msgtype)
@@ -127,16 +160,26 @@ class BagWriter(ClosedOnExit):
             type_hash = known_hash if type_hash is None else type_hash
         profiles = list(qos) if qos is not None else [default_profile(topic, msgtype)]
         self._check_open()
-        self._connections[topic] = self._guard(
-            lambda: self._writer.add_connection(
-                topic, msgtype, msgdef=msgdef, rihs01=type_hash, offered_qos_profiles=profiles
+        schema_id = self._schemas.get(msgtype)
+        if schema_id is None:
+            # rosbag2 tells the two definition languages apart by the IDL separator line.
+            encoding = 'ros2idl' if msgdef.startswith('=' * 80 + '\nIDL: ') else 'ros2msg'
+            schema_id = self._guard(
+                lambda: self._mcap.register_schema(msgtype, encoding, msgdef.encode())
+            )
+            self._schemas[msgtype] = schema_id
+        qos_text = yaml.safe_dump(dump_qos_v9(profiles), default_flow_style=False).strip()
+        channel_id = self._guard(
+            lambda: self._mcap.register_channel(
+                topic, 'cdr', schema_id, {'offered_qos_profiles': qos_text}
             )
         )
-        self._qos[topic] = profiles
+        self._topics[topic] = _Topic(topic, msgtype, channel_id, profiles, type_hash)
+        self._counts[topic] = 0
 
     def has_topic(self, topic: str) -> bool:
         """Tells whether a topic has been declared."""
-        return topic in self._connections
+        return topic in self._topics
 
     def write_raw(self, topic: str, log_time_ns: int, data: bytes | memoryview) -> None:
         """Writes one serialized (CDR) message of a declared topic.
@@ -153,8 +196,8 @@ class BagWriter(ClosedOnExit):
             BagError: Undeclared topic, a closed bag, or an I/O error (what was flushed before
                 stays readable).
         """
-        connection = self._connections.get(topic)
-        if connection is None:
+        declared = self._topics.get(topic)
+        if declared is None:
             raise BagError(f'topic {topic!r} was not declared in {self.path}')
         if log_time_ns < 0:
             raise BagError(f'log time must be >= 0 ns, got {log_time_ns}')
@@ -172,7 +215,7 @@ class BagWriter(ClosedOnExit):
         self._check_open()
         # Held until the next flush: a view into a buffer its owner reuses must be copied.
         held = bytes(data) if isinstance(data, memoryview) else data
-        self._pending.append((int(log_time_ns), self._sequence, connection, held))
+        self._pending.append((int(log_time_ns), self._sequence, declared, held))
         self._sequence += 1
         self._pending_bytes += len(data)
         if (
@@ -180,6 +223,12 @@ class BagWriter(ClosedOnExit):
             or time.monotonic() - self._last_flush >= self._flush_period
         ):
             self.flush()
+        elif log_time_ns - self._pending[0][0] >= 2 * CHUNK_SPAN_NS:
+            # An offline writer outpaces the flush period: a chunk per CHUNK_SPAN_NS of log
+            # time, keeping the newest span pending so that what comes late still sorts in.
+            self._guard(lambda: self._write_pending(before=log_time_ns - CHUNK_SPAN_NS))
+            self._guard(self._mcap.flush)
+            self._refresh_metadata()
 
     def write_message(self, topic: str, message: Any, log_time_ns: int) -> None:
         """Serializes and writes a rosbags message, declaring its topic on first use.
@@ -193,10 +242,10 @@ class BagWriter(ClosedOnExit):
             BagError: As :meth:`write_raw`, or a topic declared with another type.
         """
         msgtype = message.__msgtype__
-        if topic not in self._connections:
+        if topic not in self._topics:
             self.add_topic(topic, msgtype)
-        elif self._connections[topic].msgtype != msgtype:
-            declared = self._connections[topic].msgtype
+        elif self._topics[topic].msgtype != msgtype:
+            declared = self._topics[topic].msgtype
             raise BagError(f'topic {topic} carries {declared}, not {msgtype}')
         self.write_raw(topic, log_time_ns, serialize(message))
 
@@ -222,6 +271,13 @@ class BagWriter(ClosedOnExit):
         """Writes a ``std_msgs/msg/Float64`` (e.g. ``/tip_load`` in kg) logged at ``stamp`` s."""
         ns = convert.seconds_to_ns(stamp)
         self.write_message(topic, convert.float64(value), ns)
+
+    def write_joint_state(
+        self, topic: str, stamp: float, names: Iterable[str], positions: np.ndarray
+    ) -> None:
+        """Writes a ``sensor_msgs/msg/JointState`` of joint angles (e.g. ``/joint_states``)."""
+        ns = convert.seconds_to_ns(stamp)
+        self.write_message(topic, convert.joint_state(ns, names, positions), ns)
 
     def write_point(
         self, topic: str, stamp: float, x: float, y: float, z: float, frame: str
@@ -264,7 +320,7 @@ class BagWriter(ClosedOnExit):
     @property
     def message_count(self) -> int:
         """Messages written so far (flushed or pending)."""
-        return sum(self._writer.counts.values()) + len(self._pending)
+        return sum(self._counts.values()) + len(self._pending)
 
     @property
     def flushed_log_time_ns(self) -> int:
@@ -284,9 +340,8 @@ class BagWriter(ClosedOnExit):
         if not self._pending:
             return
         self._guard(self._write_pending)
-        self._guard(self._flush_storage)
-        self._flushed_snapshot = self._metadata()
-        self._guard(lambda: metadata.write(self.path, self._flushed_snapshot))
+        self._guard(self._mcap.flush)
+        self._refresh_metadata()
         self._last_flush = time.monotonic()
 
     def close(self) -> None:
@@ -298,37 +353,50 @@ class BagWriter(ClosedOnExit):
         if self._closed or self._failed:
             return
         self._guard(self._write_pending)
-        self._guard(self._writer.close)
+        final = self._metadata()
+        info = yaml.safe_dump(final['rosbag2_bagfile_information'], sort_keys=False)
+        # rosbag2's MCAP storage keeps a copy of the metadata in the file itself.
+        self._guard(lambda: self._mcap.add_metadata('rosbag2', {'serialized_metadata': info}))
+        self._guard(self._mcap.finish)
+        self._guard(self._file.close)
+        self._guard(lambda: metadata.write(self.path, final))
         self._closed = True
 
     # -- internals --------------------------------------------------------------------------
 
-    def _write_pending(self) -> None:
-        """Hands the pending messages to the MCAP writer in log-time order."""
-        pending, self._pending, self._pending_bytes = self._pending, [], 0
-        pending.sort(key=operator.itemgetter(0, 1))
-        for log_time, _, connection, data in pending:
-            self._writer.write(connection, log_time, data)
+    def _write_pending(self, before: int | None = None) -> None:
+        """Hands the pending messages (logged before ``before`` ns) to the MCAP writer, sorted."""
+        self._pending.sort(key=operator.itemgetter(0, 1))
+        split = len(self._pending)
+        if before is not None:
+            split = next((i for i, m in enumerate(self._pending) if m[0] >= before), split)
+        pending, self._pending = self._pending[:split], self._pending[split:]
+        self._pending_bytes = sum(len(m[3]) for m in self._pending)
+        chunk_start = pending[0][0] if pending else 0
+        for log_time, _, topic, data in pending:
+            if log_time - chunk_start >= CHUNK_SPAN_NS:
+                # Closes the chunk: none spans more than CHUNK_SPAN_NS of log time.
+                self._mcap.flush()  # type: ignore[no-untyped-call]
+                chunk_start = log_time
+            self._mcap.add_message(topic.channel_id, log_time, bytes(data), log_time)
+            self._counts[topic.name] += 1
+            self._start_ns = min(self._start_ns, log_time)
+            self._end_ns = max(self._end_ns, log_time)
         if pending:
             self._flushed_log_time = max(self._flushed_log_time, pending[-1][0])
 
-    def _flush_storage(self) -> None:
-        # rosbags' McapWriter exposes its pending chunk and file object as public attributes;
-        # closing the chunk early is what its own writer does once a chunk passes 1 MiB.
-        storage = self._writer.storage
-        assert storage is not None
-        if storage.chunk.bio.tell():  # type: ignore[attr-defined]
-            storage.close_chunk()  # type: ignore[attr-defined]
-        storage.bio.flush()  # type: ignore[attr-defined]
+    def _refresh_metadata(self) -> None:
+        """Writes ``metadata.yaml`` for what the file holds now."""
+        self._flushed_snapshot = self._metadata()
+        self._guard(lambda: metadata.write(self.path, self._flushed_snapshot))
 
     def _metadata(self) -> dict[str, Any]:
-        w = self._writer
         topics = [
-            (c.topic, c.msgtype, w.counts[c.id], self._qos[c.topic], c.digest)
-            for c in self._connections.values()
+            (t.name, t.msgtype, self._counts[t.name], t.qos, t.type_hash)
+            for t in self._topics.values()
         ]
         data_file = f'{self.path.name}.mcap'
-        return metadata.build(data_file, topics, w.min_timestamp, w.max_timestamp)
+        return metadata.build(data_file, topics, self._start_ns, self._end_ns)
 
     def _check_open(self) -> None:
         if self._failed:
@@ -346,7 +414,10 @@ class BagWriter(ClosedOnExit):
                 metadata.write(self.path, self._flushed_snapshot)
             except OSError:
                 pass  # the metadata of the previous flush is already on disk
-            self._writer.abort()
+            try:
+                self._file.close()
+            except OSError:
+                pass  # the buffer that failed to go out is lost either way
             kept = self._flushed_snapshot['rosbag2_bagfile_information']['message_count']
             raise BagError(
                 f'writing {self.path} failed ({exc.strerror or exc}); '

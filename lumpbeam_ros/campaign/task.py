@@ -155,7 +155,7 @@ def process_bag(bag: str, settings: CampaignSettings) -> Row:
         if not analysis.result.ok:
             row['error'] = f'analyze: no estimate ({analysis.result.message})'
         if settings.diagnose:
-            from lumpbeam_ros.diagnose.record import read_record
+            from lumpbeam_ros.diagnose.measurement import read_record
             from lumpbeam_ros.diagnose.workflow import diagnose
 
             row.update(flatten(diagnose(read_record(path), settings.beam).as_dict()))

@@ -191,6 +191,15 @@ def add_synth(parser: argparse.ArgumentParser) -> None:
         help='image size with --images (2048x2048: 4 MB a frame, 8.6 GB for 12 s)',
     )
     parser.add_argument('--camera-config', help='camera file (default: config/camera.yaml)')
+    arm = parser.add_argument_group('a flexible arm moved along a trajectory (doc/arm.md)')
+    arm.add_argument(
+        '--arm',
+        metavar='FILE',
+        help='arm configuration file: write /joint_states, /tip_pose and /tip_pose_truth of '
+        'the arm following --trajectory (--duration: the whole record, at least the '
+        "trajectory's)",
+    )
+    arm.add_argument('--trajectory', metavar='FILE', help='joint trajectory file (CSV) with --arm')
 
 
 def tracker_pose(text: str) -> tuple[float, ...]:
@@ -316,6 +325,30 @@ def add_shape(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         '--json', metavar='FILE', help='write the impulses and the time added as JSON'
     )
+
+
+@_subcommand(
+    'modes',
+    help="an arm's modes at given joint angles",
+    description="The arm's linear modes about its static equilibrium at the joint angles "
+    '--q: natural frequency and damping ratio of every underdamped mode, slowest first.',
+)
+def add_modes(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam modes``."""
+    parser.add_argument('--arm', metavar='FILE', required=True, help='arm configuration file')
+    parser.add_argument(
+        '--q',
+        metavar='Q1,...,QN',
+        required=True,
+        help='joint angles, rad, one per joint (write --q=-0.5,1 for a negative first angle)',
+    )
+    parser.add_argument(
+        '--payload-kg',
+        type=non_negative_float,
+        metavar='M',
+        help="payload at the last link's free end, kg (default: the file's)",
+    )
+    parser.add_argument('--json', metavar='FILE', help='write the modes as JSON')
 
 
 @_subcommand(

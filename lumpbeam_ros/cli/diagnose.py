@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 from lumpbeam_ros.cli.output import write_json
-from lumpbeam_ros.diagnose.record import read_record
+from lumpbeam_ros.diagnose.measurement import read_record
 from lumpbeam_ros.diagnose.workflow import Diagnosis, diagnose
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.parameters import load_beam_config, write_beam_config

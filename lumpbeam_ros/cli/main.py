@@ -52,6 +52,7 @@ COMMANDS = (
     Command('track', arguments.add_track, 'lumpbeam_ros.cli.track:run'),
     Command('analyze', arguments.add_analyze, 'lumpbeam_ros.cli.analyze:run'),
     Command('shape', arguments.add_shape, 'lumpbeam_ros.cli.shape:run'),
+    Command('modes', arguments.add_modes, 'lumpbeam_ros.cli.modes:run'),
     Command('diagnose', arguments.add_diagnose, 'lumpbeam_ros.cli.diagnose:run'),
     Command('compare', arguments.add_compare, 'lumpbeam_ros.cli.compare:run'),
     Command('record', arguments.add_record, 'lumpbeam_ros.cli.record:run'),

@@ -28,6 +28,8 @@ def _reference_sensor_options(args: argparse.Namespace) -> ReferenceSensorOption
 
 def run(args: argparse.Namespace) -> int:
     """Simulates and writes the bag, then prints what it holds."""
+    if args.arm is not None or args.trajectory is not None:
+        return _write_arm(args)
     effects = dict(parse_effect(text) for text in args.effect)
     beam, drop = load_beam_config(args.config)
     options = SynthOptions(
@@ -76,5 +78,40 @@ def _write_campaign(
     print(
         f'wrote {len(bags)} bags into {args.out}: loads {", ".join(f"{x:g}" for x in loads)} kg '
         f'x {args.seeds} seeds from {args.seed}, {args.duration:g} s each'
+    )
+    return 0
+
+
+def _write_arm(args: argparse.Namespace) -> int:
+    """``--arm FILE --trajectory FILE``: the arm moved along the trajectory."""
+    from lumpbeam_ros.arm.config import load_arm_config
+    from lumpbeam_ros.motion.joint_trajectory import read_trajectory_csv
+    from lumpbeam_ros.synthetic.arm_bag import ArmSynthOptions, write_arm_bag
+
+    if args.arm is None or args.trajectory is None:
+        raise LumpbeamError('--arm and --trajectory go together')
+    beam_only = [
+        name
+        for name, given in (
+            ('--loads', args.loads is not None),
+            ('--config', args.config is not None),
+            ('--effect', bool(args.effect)),
+            ('--tracker', args.tracker),
+            ('--images', args.images),
+        )
+        if given
+    ]
+    if beam_only:
+        raise LumpbeamError(f'{", ".join(beam_only)}: not for an arm (--arm)')
+    config = load_arm_config(args.arm)
+    trajectory = read_trajectory_csv(args.trajectory)
+    options = ArmSynthOptions(
+        duration_s=args.duration, rate_hz=args.rate, noise_m=args.noise, seed=args.seed
+    )
+    motion = write_arm_bag(args.out, config, trajectory, options)
+    print(
+        f'wrote {args.out}: {config.n_joints}-link arm along {args.trajectory} '
+        f'({trajectory.duration_s:g} s), {motion.t.size} poses and joint states at '
+        f'{args.rate:g} Hz over {args.duration:g} s, noise {args.noise * 1e6:g} um'
     )
     return 0

@@ -433,7 +433,7 @@ def analyze(run: DemoRun) -> None:
 
 def diagnose(run: DemoRun) -> None:
     """Diagnoses the recording as ``lumpbeam diagnose`` does; its JSON and figures are kept."""
-    from lumpbeam_ros.diagnose.record import read_record
+    from lumpbeam_ros.diagnose.measurement import read_record
     from lumpbeam_ros.diagnose.workflow import diagnose as diagnose_record
     from lumpbeam_ros.plots.diagnosis import plot_diagnosis
 

@@ -8,7 +8,7 @@ when the data insist on it; otherwise the answer is ``none`` or ``unexplained``.
 
 Use::
 
-    from lumpbeam_ros.diagnose.record import read_record
+    from lumpbeam_ros.diagnose.measurement import read_record
     from lumpbeam_ros.diagnose.workflow import diagnose
 
     result = diagnose(read_record('drop_bag'), beam)
@@ -16,7 +16,7 @@ Use::
     result.gap_before, result.gap_after                 # Gap(rms_m, max_m, ...)
     result.as_dict()                                    # the JSON of ``lumpbeam diagnose``
 
-Modules: :mod:`.record` (the input), :mod:`.noise` (sigma from the data),
+Modules: :mod:`.measurement` (the input: the measured record), :mod:`.noise` (sigma from the data),
 :mod:`.candidates` (the models and their parameter ranges), :mod:`.fitting` (least
 squares), :mod:`.gap` (residual size, frequency and damping errors), :mod:`.signatures`
 (envelope shape, frequency drift, time shift, slope ratio, static offsets),

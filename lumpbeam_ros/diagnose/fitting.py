@@ -6,7 +6,7 @@ a chi-square and both channels count by their information: the pitch carries wha
 a compliant mount from a softer beam (the slope-to-displacement ratio of the tip).
 
 A tracker may take up a new constant bias after losing its target
-(:func:`~lumpbeam_ros.diagnose.record.tracked_segments`): every stretch after the first is
+(:func:`~lumpbeam_ros.diagnose.measurement.tracked_segments`): every stretch after the first is
 compared up to its own offset in each channel, projected out in closed form (its mean
 residual), so it costs no extra search dimension. The first stretch keeps the absolute
 level, so a record tracked throughout is compared as it is.
@@ -21,7 +21,7 @@ from typing import Protocol
 import numpy as np
 from scipy.optimize import least_squares
 
-from lumpbeam_ros.diagnose.record import Record
+from lumpbeam_ros.diagnose.measurement import Record
 from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.model.simulate import SimulationDivergedError, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory

@@ -6,7 +6,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from lumpbeam_ros.diagnose.record import Record
+from lumpbeam_ros.diagnose.measurement import Record
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.mode_estimate import ModeEstimate
 from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParams

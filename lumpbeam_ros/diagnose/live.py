@@ -5,11 +5,11 @@
 stretch is complete: a *ring-down* (from ``pre_release_s`` before a load change until the
 decay has lasted ``decay_s``, or earlier once its amplitude fell below ``min_amplitude_m``),
 or a fixed *window* of the latest ``window_s``. The stretch becomes the same
-:class:`~lumpbeam_ros.diagnose.record.Record` that ``lumpbeam diagnose`` builds from a bag
-(:func:`~lumpbeam_ros.diagnose.record.record_from_series`), and :func:`diagnose_live` runs the same
-workflow on it (:func:`~lumpbeam_ros.diagnose.workflow.diagnose`), reduced to the small,
-picklable :class:`LiveDiagnosis` a worker process sends back. :func:`status_values` turns that
-into the status level, message and key-value pairs of ``doc/interfaces.md``
+:class:`~lumpbeam_ros.diagnose.measurement.Record` that ``lumpbeam diagnose`` builds from a
+bag (:func:`~lumpbeam_ros.diagnose.measurement.record_from_series`), and :func:`diagnose_live`
+runs the same workflow on it (:func:`~lumpbeam_ros.diagnose.workflow.diagnose`), reduced to
+the small, picklable :class:`LiveDiagnosis` a worker process sends back. :func:`status_values`
+turns that into the status level, message and key-value pairs of ``doc/interfaces.md``
 ("/model_discrepancy").
 """
 
@@ -24,7 +24,7 @@ import numpy as np
 
 from lumpbeam_ros.bagio.tipbuffer import TipBuffer
 from lumpbeam_ros.bagio.tipseries import SampleCounts
-from lumpbeam_ros.diagnose.record import MIN_SAMPLES_AFTER_EVENT, Record, record_from_series
+from lumpbeam_ros.diagnose.measurement import MIN_SAMPLES_AFTER_EVENT, Record, record_from_series
 from lumpbeam_ros.diagnose.workflow import diagnose
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.interface import TIP_POSE

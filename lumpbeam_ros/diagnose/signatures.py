@@ -16,15 +16,20 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from scipy.signal import find_peaks
 
 from lumpbeam_ros.diagnose.gap import SETTLE_S, decay_mode
-from lumpbeam_ros.diagnose.record import Record
+from lumpbeam_ros.diagnose.measurement import Record
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ident.logdec import difference_noise_std
+from lumpbeam_ros.ident.peaks import lobe_peaks, vertices
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
 #: Largest time shift searched against the load event, s.
 MAX_SHIFT_S = 0.1
+
+#: Half width of the band about the level a lobe of the swing must leave, in noise sigmas
+#: (as the log decrement's).
+PEAK_HYSTERESIS = 4.0
 
 
 @dataclass(frozen=True)
@@ -116,6 +121,9 @@ def decay_peaks(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Times and heights of the swing's peaks (both signs) after ``start_s + SETTLE_S``.
 
+    The peaks of :mod:`~lumpbeam_ros.ident.peaks` (lobes beyond ``PEAK_HYSTERESIS`` noise
+    sigmas, each peak a parabola's vertex), those lost in the noise left out.
+
     Args:
         t: Stamps, s.
         z: Tip z, m.
@@ -127,16 +135,15 @@ def decay_peaks(
     """
     keep = t >= start_s + SETTLE_S
     tt, swing = t[keep], z[keep] - level
-    distance = max(1, int(0.3 / float(np.median(np.diff(tt)))))  # beams swing below 1.7 Hz
-    peaks = np.concatenate(
-        [find_peaks(swing, distance=distance)[0], find_peaks(-swing, distance=distance)[0]]
-    )
-    peaks.sort()
-    amplitude = np.abs(swing[peaks])
+    peaks = lobe_peaks(swing, PEAK_HYSTERESIS * difference_noise_std(swing), 'both')
+    if peaks.size == 0:
+        return np.empty(0), np.empty(0)
+    peak_t, height = vertices(tt, swing, peaks)
+    amplitude = np.abs(height)
     # Peaks lost in the noise are not an envelope.
     floor = 10.0 * float(np.median(np.abs(np.diff(swing)))) + 1e-12
     big = amplitude > floor
-    return tt[peaks][big], amplitude[big]
+    return peak_t[big], amplitude[big]
 
 
 def time_shift(record: Record, model: TipTrajectory) -> float:

@@ -31,8 +31,8 @@ from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.diagnose.candidates import Candidate, effect_candidates, nominal_candidate
 from lumpbeam_ros.diagnose.fitting import FitProblem
 from lumpbeam_ros.diagnose.gap import SETTLE_S, Gap, decay_fit, measure_gap
+from lumpbeam_ros.diagnose.measurement import Record
 from lumpbeam_ros.diagnose.noise import decay_error_std, noise_std
-from lumpbeam_ros.diagnose.record import Record
 from lumpbeam_ros.diagnose.scoring import (
     NONE,
     UNEXPLAINED,
@@ -304,14 +304,7 @@ def _diagnose(
             return sig.time_shift_s  # the delay seen at the load event
         return None
 
-    decay_s = _decay_length(record)
-    max_effects, limit = MAX_EFFECTS, ''
-    if decay_s < PAIR_MIN_DECAY_S:
-        max_effects = 1
-        limit = (
-            f'the decay ({decay_s:.1f} s) is too short for a pair of effects (at least '
-            f'{PAIR_MIN_DECAY_S:g} s): one effect at most'
-        )
+    max_effects, limit = _effects_allowed(record)
     selector = Selector(problem, train, train_end)
     selection = select(
         selector,
@@ -323,17 +316,9 @@ def _diagnose(
     )
     decision = _decision(selection, limit)
 
-    # The final models use the whole record: more data, and the gaps are over all of it.
-    final_nominal = problem.fit(nominal_model, nominal.x)
-    before = problem.simulate(final_nominal.beam)
-    augmented_beam, after = final_nominal.beam, before
-    named: tuple[NamedEffect, ...] = ()
-    if decision.missing_effect not in (NONE, UNEXPLAINED):
-        chosen = selection.model
-        final = problem.fit(chosen.model, chosen.fit.x)
-        augmented_beam, after = final.beam, problem.simulate(final.beam)
-        named = _named(chosen.model, final.x, selection.path, sigma_z, train)
-
+    final_nominal, before, augmented_beam, after, named = _final_models(
+        problem, nominal.x, selection, decision, train
+    )
     return Diagnosis(
         missing_effect=decision.missing_effect,
         effect_parameters={k: v for e in named for k, v in e.parameters.items()},
@@ -347,7 +332,7 @@ def _diagnose(
         noise_z_m=sigma_z,
         noise_pitch_rad=sigma_pitch,
         train_end_s=float(train_end),
-        nominal_beam=final_nominal.beam,
+        nominal_beam=final_nominal,
         augmented_beam=augmented_beam,
         record=record,
         before=before,
@@ -357,6 +342,46 @@ def _diagnose(
         confidence=selection.confidence,
         rounds=tuple(r.as_dict() for r in selection.rounds),
     )
+
+
+def _effects_allowed(record: Record) -> tuple[int, str]:
+    """The policy: how many effects the record's decay can tell apart, and why not more.
+
+    Returns:
+        The most effects to name, and the reason for a limit below ``MAX_EFFECTS`` (``''``).
+    """
+    decay_s = _decay_length(record)
+    if decay_s >= PAIR_MIN_DECAY_S:
+        return MAX_EFFECTS, ''
+    return 1, (
+        f'the decay ({decay_s:.1f} s) is too short for a pair of effects (at least '
+        f'{PAIR_MIN_DECAY_S:g} s): one effect at most'
+    )
+
+
+def _final_models(
+    problem: FitProblem,
+    nominal_x: np.ndarray,
+    selection: Selection,
+    decision: Decision,
+    train: np.ndarray,
+) -> tuple[BeamParameters, TipTrajectory, BeamParameters, TipTrajectory, tuple[NamedEffect, ...]]:
+    """The nominal and the augmented model refit on the whole record, and simulated.
+
+    The whole record: more data than the training part, and the gaps are over all of it.
+
+    Returns:
+        The nominal beam and its simulation, the augmented beam and its simulation (the
+        nominal ones when nothing is named), and the effects named.
+    """
+    final_nominal = problem.fit(nominal_candidate(), nominal_x)
+    before = problem.simulate(final_nominal.beam)
+    if decision.missing_effect in (NONE, UNEXPLAINED):
+        return final_nominal.beam, before, final_nominal.beam, before, ()
+    chosen = selection.model
+    final = problem.fit(chosen.model, chosen.fit.x)
+    named = _named(chosen.model, final.x, selection.path, problem.sigma_z, train)
+    return final_nominal.beam, before, final.beam, problem.simulate(final.beam), named
 
 
 def _decay_length(record: Record) -> float:

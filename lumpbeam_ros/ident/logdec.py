@@ -14,6 +14,7 @@ import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.mode_estimate import TWO_PI, damping_ratio_from_decrement
+from lumpbeam_ros.ident.peaks import lobe_peaks, vertices
 
 
 @dataclass(frozen=True)
@@ -57,8 +58,8 @@ class LogDecrement:
 
     Positive lobes are found with a hysteresis of ``hysteresis`` noise sigmas, so noise near
     the offset does not split a lobe; each peak is the vertex of a parabola fitted to the
-    samples within a tenth of a period of the highest one. ``A_1`` is the first peak and
-    ``A_{1+n}`` the last one above ``min_snr`` noise sigmas.
+    samples within a tenth of a period of the highest one (:mod:`~lumpbeam_ros.ident.peaks`).
+    ``A_1`` is the first peak and ``A_{1+n}`` the last one above ``min_snr`` noise sigmas.
 
     Args:
         min_snr: Smallest peak height, in noise sigmas, that may serve as ``A_{1+n}``.
@@ -97,21 +98,12 @@ class LogDecrement:
         s = y - level
         sigma = difference_noise_std(y) if noise_std is None else float(noise_std)
         threshold = self.hysteresis * sigma
-        marked = np.flatnonzero(np.abs(s) > threshold)
-        if marked.size < 4:
+        if np.count_nonzero(np.abs(s) > threshold) < 4:
             raise LumpbeamError('log decrement: no oscillation above the noise')
-        signs = s[marked] > 0.0
-        # A lobe is a run of same-sign samples among those beyond the hysteresis band.
-        starts = np.flatnonzero(np.r_[True, signs[1:] != signs[:-1]])
-        ends = np.r_[starts[1:], marked.size]
-        peaks = [
-            marked[lo] + int(np.argmax(s[marked[lo] : marked[hi - 1] + 1]))
-            for lo, hi in zip(starts, ends, strict=True)
-            if signs[lo]
-        ]
-        if len(peaks) < 2:
+        peaks = lobe_peaks(s, threshold, 'positive')
+        if peaks.size < 2:
             raise LumpbeamError('log decrement: fewer than two peaks above the noise')
-        peak_t, peak_a = _vertices(t, s, np.asarray(peaks))
+        peak_t, peak_a = vertices(t, s, peaks)
         usable = np.flatnonzero(peak_a > self.min_snr * sigma)
         if usable.size < 2:
             usable = np.arange(min(2, peak_t.size))
@@ -164,35 +156,6 @@ def difference_noise_std(y: np.ndarray) -> float:
     if d3.size == 0:
         return 0.0
     return float(1.4826 * np.median(np.abs(d3 - np.median(d3))) / math.sqrt(20.0))
-
-
-def _vertices(t: np.ndarray, s: np.ndarray, peaks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Peak times and heights: vertices of parabolas fitted around samples ``peaks``.
-
-    Each parabola spans a tenth of a period on each side of its peak, where it stays within
-    2 % of a cosine's top; the fits are solved together as one batch of 3 x 3 systems.
-    """
-    period = float(np.median(np.diff(t[peaks]))) if peaks.size > 1 else 0.0
-    dt = float(np.median(np.diff(t)))
-    half = max(1, int(round(0.1 * period / dt)))
-    idx = np.clip(peaks[:, None] + np.arange(-half, half + 1), 0, t.size - 1)
-    tc = t[idx] - t[peaks][:, None]
-    sv = s[idx]
-    powers = tc[:, :, None] ** np.arange(5)
-    moments = powers.sum(axis=1)
-    normal = np.stack([moments[:, i : i + 3] for i in range(3)], axis=1)
-    rhs = np.einsum('pk,pkj->pj', sv, powers[:, :, :3])
-    times = t[peaks].astype(float)
-    heights = s[peaks].astype(float)
-    try:
-        c0, c1, c2 = np.linalg.solve(normal, rhs[:, :, None])[:, :, 0].T
-    except np.linalg.LinAlgError:
-        return times, heights
-    shift = -c1 / (2.0 * np.where(c2 < 0.0, c2, -1.0))
-    good = (c2 < 0.0) & (np.abs(shift) <= np.ptp(tc, axis=1))
-    times[good] += shift[good]
-    heights[good] = (c0 - c1 * c1 / (4.0 * c2))[good]
-    return times, heights
 
 
 def _period(peak_times: np.ndarray) -> tuple[float, float]:

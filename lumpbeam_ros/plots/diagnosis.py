@@ -76,15 +76,6 @@ def _residual_figure(d: Diagnosis, path: Path) -> None:
     plt.close(fig)
 
 
-def _refined(t: np.ndarray, z: np.ndarray, peak_t: np.ndarray) -> np.ndarray:
-    """Peak times between samples: the vertex of the parabola through each peak's samples."""
-    i = np.clip(np.searchsorted(t, peak_t), 1, t.size - 2)
-    left, mid, right = z[i - 1], z[i], z[i + 1]
-    curvature = left - 2.0 * mid + right
-    step = np.where(curvature != 0.0, 0.5 * (left - right) / np.where(curvature, curvature, 1), 0)
-    return np.asarray(t[i] + np.clip(step, -1.0, 1.0) * (t[i + 1] - t[i - 1]) / 2.0)
-
-
 def _swing(
     t: np.ndarray, z: np.ndarray, event: float, level: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -94,10 +85,9 @@ def _swing(
     of the time between the first and the third, its amplitude the mean of the three
     weighted 1:2:1, which cancels an error in ``level``.
     """
-    peak_t, peak_a = decay_peaks(t, z, event, level)
+    peak_t, peak_a = decay_peaks(t, z, event, level)  # times between samples
     if peak_t.size < 3:
         return np.empty(0), np.empty(0), np.empty(0)
-    peak_t = _refined(t, z, peak_t)
     period = peak_t[2:] - peak_t[:-2]
     amplitude = 0.25 * (peak_a[:-2] + 2.0 * peak_a[1:-1] + peak_a[2:])
     ok = (period > 0.5 * np.median(period)) & (period < 2.0 * np.median(period))

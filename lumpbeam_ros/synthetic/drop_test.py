@@ -243,11 +243,13 @@ def write_drop_test_bag(
             loads = iter(load_messages(drop, options.duration_s))
             pending = next(loads, None)
             for i, stamp in enumerate(measured.t):
+                # In log-time order: the reference points since the last pose come before a
+                # load change at this stamp (a flush between the two would put them after).
+                if points is not None:
+                    written = write_reference_points(bag, points, written, stamp)
                 while pending is not None and pending[0] <= stamp:
                     bag.write_float(TIP_LOAD, pending[0], pending[1])
                     pending = next(loads, None)
-                if points is not None:
-                    written = write_reference_points(bag, points, written, stamp)
                 bag.write_pose(
                     TIP_POSE,
                     stamp,

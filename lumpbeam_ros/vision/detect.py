@@ -95,6 +95,7 @@ def detect_board(
     expected_axes: np.ndarray,
     max_side_px: int,
     half_window: int,
+    snap_to_grid: bool = False,
 ) -> np.ndarray | None:
     """Finds all inner corners of the board in a grey frame.
 
@@ -104,6 +105,10 @@ def detect_board(
         expected_axes: Image directions of the board's x and y axes (2 x 2).
         max_side_px: The detector's input is shrunk to at most this on its longer side.
         half_window: Refinement window half-size at full resolution, px.
+        snap_to_grid: Whether the detector's corners are first pulled in with a window
+            sized from the grid it found (:func:`snap_window`), for footage whose squares
+            the configuration does not foretell; otherwise with ``half_window`` (scaled to
+            the detector's image, 2 to 5 px), which a configured rig sizes for its squares.
 
     Returns:
         Sub-pixel corners (N x 2) in board order, or ``None`` when the whole board is not
@@ -121,7 +126,10 @@ def detect_board(
     if not found or corners is None or len(corners) != pattern_size[0] * pattern_size[1]:
         return None
     criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_MAX_ITER, 20, 0.01)
-    small_window = snap_window(corners.reshape(-1, 2), pattern_size)
+    if snap_to_grid:
+        small_window = snap_window(corners.reshape(-1, 2), pattern_size)
+    else:
+        small_window = max(2, min(5, round(half_window / scale)))
     corners = cv2.cornerSubPix(small, corners, (small_window, small_window), (-1, -1), criteria)
     # Pixel centres sit at integers, so a shrunk pixel i covers full pixels scale * i ...
     # scale * (i + 1) - 1, centred at scale * (i + 0.5) - 0.5.

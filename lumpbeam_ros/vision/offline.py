@@ -55,7 +55,7 @@ from lumpbeam_ros.vision.messages import (
 from lumpbeam_ros.vision.session import TrackingSession
 from lumpbeam_ros.vision.sources import FootageError, FootageFrame
 from lumpbeam_ros.vision.tracker import TrackResult
-from lumpbeam_ros.viz.marker_messages import write_scene
+from lumpbeam_ros.viz.marker_messages import write_scene_ns
 from lumpbeam_ros.viz.markers import (
     MARKERS_TOPIC,
     BeamScene,
@@ -259,17 +259,18 @@ class _Run:
         if result.ok:
             self.writer.write_message(POSE_TOPIC, pose_message(stamp_ns, result), log_time_ns)
             if stamp_ns >= self._next_markers_ns:
-                self._write_markers(stamp_ns, result)
+                self._write_markers(stamp_ns, log_time_ns, result)
         else:
             self._note(label, result.status.value, result.reason)
         self._tick()
 
-    def _write_markers(self, stamp_ns: int, result: TrackResult) -> None:
+    def _write_markers(self, stamp_ns: int, log_time_ns: int, result: TrackResult) -> None:
         assert result.pose is not None  # markers are drawn for tracked frames only
         x, z, _ = (float(v) for v in result.pose)  # the planar part, also of a 6-DoF fit
         scene = BeamScene(0.0, measured=TipPoint(x, z), board=self._board)
-        stamp = convert.ns_to_seconds(stamp_ns)
-        write_scene(self.writer, stamp, scene, lifetime_for_rate(MARKERS_RATE_HZ))
+        # The frame's own integer stamp and log time: the markers sort with its pose.
+        lifetime = lifetime_for_rate(MARKERS_RATE_HZ)
+        write_scene_ns(self.writer, stamp_ns, scene, lifetime, log_time_ns=log_time_ns)
         self._next_markers_ns = stamp_ns + convert.seconds_to_ns(1.0 / MARKERS_RATE_HZ)
 
     def reject(self, label: str, reason: str) -> None:

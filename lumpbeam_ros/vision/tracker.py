@@ -474,6 +474,8 @@ class TipTracker:
             self._expected_axes,
             self.settings.detect_max_side_px,
             self._half_window,
+            # The free model's rig says nothing of the squares' size in the footage.
+            snap_to_grid=self.pose_model == 'free',
         )
         if corners is None:
             self.reset()

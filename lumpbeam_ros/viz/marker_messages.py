@@ -94,8 +94,32 @@ def scene_cdr(scene: BeamScene, stamp_ns: int, lifetime_s: float) -> bytes:
 
 def write_scene(bag: BagWriter, stamp_s: float, scene: BeamScene, lifetime_s: float) -> None:
     """Writes a scene's markers on ``/beam_markers``, stamped and logged at ``stamp_s``."""
-    ns = convert.seconds_to_ns(stamp_s)
-    bag.write_message(MARKERS_TOPIC, marker_array(scene_markers(scene, lifetime_s), ns), ns)
+    write_scene_ns(bag, convert.seconds_to_ns(stamp_s), scene, lifetime_s)
+
+
+def write_scene_ns(
+    bag: BagWriter,
+    stamp_ns: int,
+    scene: BeamScene,
+    lifetime_s: float,
+    log_time_ns: int | None = None,
+) -> None:
+    """Writes a scene's markers stamped ``stamp_ns`` exactly, logged at ``log_time_ns``.
+
+    For markers drawn from a message of the bag (a tracked frame): its integer stamp and log
+    time, so the markers sort with it. A stamp passed through float seconds comes back up to
+    a few hundred ns off at today's epoch, which put markers out of log-time order.
+
+    Args:
+        bag: An open writer.
+        stamp_ns: Header stamp, ns.
+        scene: What to draw.
+        lifetime_s: Marker lifetime, s.
+        log_time_ns: Log time, ns (the stamp when ``None``).
+    """
+    log_time = stamp_ns if log_time_ns is None else log_time_ns
+    markers = marker_array(scene_markers(scene, lifetime_s), stamp_ns)
+    bag.write_message(MARKERS_TOPIC, markers, log_time)
 
 
 def marker_specs(message: Any) -> list[MarkerSpec]:

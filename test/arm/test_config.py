@@ -1,5 +1,7 @@
 """The arm's configuration file: the contract's keys, the spring rules, every bad value."""
 
+from pathlib import Path
+
 import pytest
 import yaml
 
@@ -117,3 +119,9 @@ def test_missing_and_broken_files(tmp_path):
     broken.write_text('arm: [unclosed\n')
     with pytest.raises(ConfigError, match='not valid YAML'):
         load_arm_config(broken)
+
+
+@pytest.mark.parametrize(('name', 'joints'), [('arm_rotary.yaml', 1), ('arm_3link.yaml', 3)])
+def test_the_example_configurations_load(name, joints):
+    arm = load_arm_config(Path(__file__).resolve().parents[2] / 'config' / name)
+    assert arm.n_joints == joints

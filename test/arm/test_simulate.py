@@ -16,12 +16,14 @@ from lumpbeam_ros.model.integrate import ChainState, solve_reference
 from lumpbeam_ros.model.parameters import load_beam_config
 
 BEAM, _ = load_beam_config(None)
+STILL_2 = SampledMotion.from_arrays(np.array([0.0, 1.0]), np.zeros((2, 2)))
+STILL_3 = SampledMotion.from_arrays(np.array([0.0, 1.0]), np.zeros((2, 3)))
 
 
 def test_an_arm_held_still_stays_at_rest():
     model = ArmModel.from_config(small_arm(3))
     q = np.array([0.3, -0.8, 0.5])
-    motion = SampledMotion(np.array([0.0]), q[None, :])
+    motion = SampledMotion.from_arrays(np.array([0.0, 0.1]), np.vstack([q, q]))
     result = simulate_arm(model, motion, np.linspace(0.0, 0.5, 11))
     assert result.phi == pytest.approx(np.tile(arm_equilibrium(model, q), (11, 1)), abs=1e-9)
     assert np.abs(result.phi_dot).max() < 1e-7
@@ -51,7 +53,7 @@ def test_the_sampled_drive_matches_the_smooth_one_it_samples():
     model = ArmModel.from_config(small_arm(2))
     move = smooth_move(np.array([0.4, -0.6]), 0.5)
     samples = np.linspace(0.0, 0.5, 501)
-    sampled = SampledMotion(samples, np.array([move.angles(s) for s in samples]))
+    sampled = SampledMotion.from_arrays(samples, np.array([move.angles(s) for s in samples]))
     t = np.linspace(0.0, 0.8, 81)
     a, b = simulate_arm(model, move, t), simulate_arm(model, sampled, t)
     # Linear interpolation at 1 kHz differs from the motion by q'' h^2 / 8 ~ 1e-6 rad.
@@ -61,11 +63,33 @@ def test_the_sampled_drive_matches_the_smooth_one_it_samples():
 @pytest.mark.parametrize(
     ('motion', 't', 'words'),
     [
-        (SampledMotion(np.array([0.0]), np.zeros((1, 2))), np.array([0.0, 1.0]), '3 joints'),
-        (SampledMotion(np.array([0.0]), np.zeros((1, 3))), np.array([1.0, 0.5]), 'increase'),
+        (
+            SampledMotion.from_arrays(np.array([0.0, 1.0]), np.zeros((2, 2))),
+            np.array([0.0, 1.0]),
+            '3 joints',
+        ),
+        (
+            SampledMotion.from_arrays(np.array([0.0, 1.0]), np.zeros((2, 3))),
+            np.array([1.0, 0.5]),
+            'increase',
+        ),
     ],
 )
 def test_bad_inputs_are_one_line(motion, t, words):
     model = ArmModel.from_config(small_arm(3))
     with pytest.raises(LumpbeamError, match=words):
         simulate_arm(model, motion, t)
+
+
+@pytest.mark.parametrize('links', [1, 3])
+def test_the_modal_ring_down_matches_integrating_on(links):
+    model = ArmModel.from_config(small_arm(links))
+    move = smooth_move(np.array([0.5, -0.7, 0.6][:links]), 0.4)
+    t = np.linspace(0.0, 1.5, 151)
+    modal = simulate_arm(model, move, t)
+    integrated = simulate_arm(model, move, t, modal_ring_down=False)
+    gap = np.hypot(modal.tip_x - integrated.tip_x, modal.tip_z - integrated.tip_z)
+    assert gap.max() < 2e-7
+    # Rates between the solver's grid points come from its cubic Hermite interpolation.
+    assert modal.phi_dot == pytest.approx(integrated.phi_dot, abs=1e-4)
+    assert np.ptp(integrated.tip_z[t > 0.4]) > 1e-4  # a ring-down worth comparing

@@ -128,3 +128,16 @@ def test_point_and_clock_round_trip():
     assert convert.point_values(msg) == (9, 1.0, 2.0, -3.0, 'tracker')
     clock = deserialize(serialize(convert.clock(12_000_000_001)), 'rosgraph_msgs/msg/Clock')
     assert convert.time_ns(clock.clock) == 12_000_000_001
+
+
+def test_joint_state_round_trip():
+    from lumpbeam_ros.bagio.convert import joint_state, joint_state_values
+    from lumpbeam_ros.bagio.typestore import serialize
+
+    msg = joint_state(1_500_000_000, ['joint_1', 'joint_2'], np.array([0.25, -1.5]))
+    assert msg.__msgtype__ == 'sensor_msgs/msg/JointState'
+    assert serialize(msg)  # the typestore knows the type
+    stamp, names, positions = joint_state_values(msg)
+    assert stamp == 1_500_000_000 and names == ['joint_1', 'joint_2']
+    assert positions.tolist() == [0.25, -1.5]
+    assert msg.velocity.size == 0 and msg.effort.size == 0

@@ -15,11 +15,11 @@ from lumpbeam_ros.synthetic.images import ImageOptions
 
 @pytest.fixture(scope='module')
 def filmed(tmp_path_factory):
-    """A 2.2 s synthetic drop test with 160 x 120 camera frames."""
+    """A 2.2 s synthetic drop test with 320 x 240 camera frames."""
     path = tmp_path_factory.mktemp('doctor') / 'filmed'
     beam, drop = load_beam_config()
     write_drop_test_bag(
-        path, beam, drop, SynthOptions(duration_s=2.2), images=ImageOptions(160, 120)
+        path, beam, drop, SynthOptions(duration_s=2.2), images=ImageOptions(320, 240)
     )
     return path
 

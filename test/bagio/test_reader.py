@@ -87,12 +87,20 @@ def test_an_unknown_message_type_is_read_raw_but_not_decoded(tmp_path):
         list(reader.messages('/custom', 'my_pkg/msg/Thing'))
 
 
-def test_a_corrupt_message_is_a_clear_error(tmp_path):
+@pytest.mark.parametrize('fast', [True, False])
+def test_an_undecodable_message_is_a_counted_named_loss(tmp_path, caplog, fast):
+    # One bad message among good ones: skipped and counted, not the whole bag rejected.
     with BagWriter(tmp_path / 'b') as bag:
-        bag.add_topic('/tip_pose', 'geometry_msgs/msg/PoseStamped')
-        bag.write_raw('/tip_pose', 5, b'\0\1\0\0\7')
-    with pytest.raises(BagError, match='corrupt geometry_msgs/msg/PoseStamped message'):
-        read_tip_poses(tmp_path / 'b')
+        for i in range(5):
+            bag.write_pose('/tip_pose', 1.0 + i, 2.3, -0.01 * i, 0.0)
+        bag.write_raw('/tip_pose', 6 * 10**9, b'\0\1\0\0\7')
+    with caplog.at_level(logging.WARNING):
+        poses = read_tip_poses(tmp_path / 'b', fast=fast)
+    np.testing.assert_array_equal(poses.t, 1.0 + np.arange(5))
+    [line] = [r.getMessage() for r in caplog.records]
+    assert line.startswith(f'{tmp_path / "b"}: /tip_pose: lost 1 of the 6 messages')
+    assert '1 undecodable: corrupt geometry_msgs/msg/PoseStamped message (5 bytes)' in line
+    assert BagReader(tmp_path / 'b').topics['/tip_pose'].count == 6
 
 
 def test_reindex_rebuilds_lost_metadata(drop):
@@ -122,8 +130,8 @@ def test_messages_lost_to_damaged_bytes_are_named_with_their_count(drop, caplog,
         poses = read_tip_poses(drop, fast=fast)
     lost = listed - len(poses.t)
     assert 0 < lost < listed
-    assert f'/tip_pose: read {len(poses.t)} of the {listed} messages' in caplog.text
-    assert f'{lost} lost' in caplog.text
+    assert f'/tip_pose: lost {lost} of the {listed} messages' in caplog.text
+    assert f'({lost} in damaged data)' in caplog.text
 
 
 def test_an_intact_bag_reads_without_a_loss_warning(drop, caplog):

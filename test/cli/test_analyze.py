@@ -5,13 +5,15 @@ from pathlib import Path
 
 import pytest
 
-from lumpbeam_ros.bagio import BagWriter, read_load_events, read_tip_poses
+from lumpbeam_ros.bagio import BagWriter
 from lumpbeam_ros.cli.analyze import CONTRACT_KEYS
 from lumpbeam_ros.cli.main import main
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.modes import chain_modes
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+
+from .helpers import rewritten
 
 #: ``lumpbeam analyze --json`` of the default synthetic drop test as it was before the result
 #: was nested (and its ``/beam_params`` pairs): the contract's keys, their order and values.
@@ -153,20 +155,6 @@ def test_bad_identifier_config_is_one_line(drop_bag, tmp_path, capsys):
     assert 'fit.max_modes: must be in [1, 2], got 7' in _error_line(capsys)
 
 
-def _rewritten(drop_bag, out, edit):
-    """The drop bag's /tip_pose and /tip_load, the poses' (t, x, z, pitch) rows edited."""
-    poses = read_tip_poses(drop_bag)
-    loads = read_load_events(drop_bag)
-    rows = edit([list(r) for r in zip(poses.t, poses.x, poses.z, poses.pitch, strict=True)])
-    with BagWriter(out) as bag:
-        for t, x, z, pitch in rows:
-            bag.write_pose('/tip_pose', t, x, z, pitch)
-        bag.add_topic('/tip_load', 'std_msgs/msg/Float64')
-        for t, kg in zip(loads.t, loads.kg, strict=True):
-            bag.write_float('/tip_load', float(t), float(kg))
-    return out
-
-
 def _warnings(err):
     return [line for line in err.splitlines() if line.startswith('lumpbeam analyze: warning: ')]
 
@@ -185,7 +173,7 @@ def test_a_nan_orientation_drops_that_pose_and_says_so(drop_bag, tmp_path, capsy
         rows[1000][3] = math.nan
         return rows
 
-    bag = _rewritten(drop_bag, tmp_path / 'nan', nan_pitch)
+    bag = rewritten(drop_bag, tmp_path / 'nan', nan_pitch)
     out = tmp_path / 'r.json'
     assert main(['analyze', str(bag), '--json', str(out)]) == 0
     warnings = _warnings(capsys.readouterr().err)
@@ -199,7 +187,7 @@ def test_duplicate_and_out_of_order_stamps_are_named(drop_bag, tmp_path, capsys)
         rows[500], rows[501] = rows[501], rows[500]
         return rows + [list(rows[700]), list(rows[701])]
 
-    bag = _rewritten(drop_bag, tmp_path / 'dup', shuffle)
+    bag = rewritten(drop_bag, tmp_path / 'dup', shuffle)
     out = tmp_path / 'r.json'
     assert main(['analyze', str(bag), '--json', str(out)]) == 0
     warnings = _warnings(capsys.readouterr().err)
@@ -218,7 +206,7 @@ def test_a_jump_in_the_stamps_keeps_the_release_segment(drop_bag, tmp_path, caps
                 row[0] += jump_s
         return rows
 
-    bag = _rewritten(drop_bag, tmp_path / 'jump', jump)
+    bag = rewritten(drop_bag, tmp_path / 'jump', jump)
     out = tmp_path / 'r.json'
     code = main(['analyze', str(bag), '--json', str(out)])
     captured = capsys.readouterr()

@@ -2,11 +2,13 @@ import json
 
 import pytest
 
-from lumpbeam_ros.bagio import BagWriter, read_load_events, read_tip_poses
+from lumpbeam_ros.bagio import BagWriter, read_tip_poses
 from lumpbeam_ros.cli.main import main
 from lumpbeam_ros.model.parameters import DropTestConfig, load_beam_config
 from lumpbeam_ros.plots.diagnosis import FIGURES
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+
+from .helpers import rewritten
 
 CONTRACT_KEYS = ['missing_effect', 'effect_parameters', 'gap_before', 'gap_after', 'candidates']
 
@@ -77,19 +79,6 @@ def test_a_bad_config_value_is_reported(tmp_path, late_bag, capsys):
     assert 'length_m' in capsys.readouterr().err
 
 
-def _rewritten(bag, out, edit):
-    """The bag's /tip_pose and /tip_load, the poses' (t, x, z, pitch) rows edited."""
-    poses, loads = read_tip_poses(bag), read_load_events(bag)
-    rows = edit([list(r) for r in zip(poses.t, poses.x, poses.z, poses.pitch, strict=True)])
-    with BagWriter(out) as writer:
-        for t, x, z, pitch in rows:
-            writer.write_pose('/tip_pose', t, x, z, pitch)
-        writer.add_topic('/tip_load', 'std_msgs/msg/Float64')
-        for t, kg in zip(loads.t, loads.kg, strict=True):
-            writer.write_float('/tip_load', float(t), float(kg))
-    return out
-
-
 def _damaged(rows):
     for row in rows[100:110]:
         row[2] = float('nan')
@@ -98,7 +87,7 @@ def _damaged(rows):
 
 
 def test_dropped_poses_are_counted_on_stderr_and_in_the_json(late_bag, tmp_path, capsys):
-    bag = _rewritten(late_bag, tmp_path / 'damaged', _damaged)
+    bag = rewritten(late_bag, tmp_path / 'damaged', _damaged)
     json_path = tmp_path / 'd.json'
     assert main(['diagnose', str(bag), '--json', str(json_path)]) == 0
     received = len(read_tip_poses(late_bag))
@@ -117,7 +106,7 @@ def test_a_bag_too_short_after_dropping_poses_says_why(late_bag, tmp_path, capsy
             row[2] = float('nan')
         return rows
 
-    bag = _rewritten(late_bag, tmp_path / 'lost', mostly_nan)
+    bag = rewritten(late_bag, tmp_path / 'lost', mostly_nan)
     assert main(['diagnose', str(bag)]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1

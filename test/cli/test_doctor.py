@@ -42,3 +42,10 @@ def test_a_folder_that_is_not_a_bag_is_one_line(tmp_path, capsys, make):
     assert main(['doctor', str(target)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and 'not a bag folder' in err[0], err
+
+
+def test_an_empty_folder_exits_2(tmp_path, capsys):
+    (tmp_path / 'empty').mkdir()
+    assert main(['doctor', str(tmp_path / 'empty')]) == 2
+    [err] = capsys.readouterr().err.strip().splitlines()
+    assert 'not a bag folder' in err

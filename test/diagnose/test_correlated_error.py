@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.signal import butter, sosfiltfilt
 
-from lumpbeam_ros.diagnose.record import Record, make_record
+from lumpbeam_ros.diagnose.measurement import Record, make_record
 from lumpbeam_ros.diagnose.workflow import diagnose
 from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.model.trajectory import TipTrajectory

@@ -6,7 +6,7 @@ import pytest
 
 from lumpbeam_ros.diagnose.candidates import effect_candidates, nominal_candidate
 from lumpbeam_ros.diagnose.fitting import DIVERGED_RESIDUAL, FitProblem
-from lumpbeam_ros.diagnose.record import make_record
+from lumpbeam_ros.diagnose.measurement import make_record
 from lumpbeam_ros.diagnose.selection import Model
 from lumpbeam_ros.diagnose.workflow import nominal_form
 from lumpbeam_ros.model.parameters import BeamParameters

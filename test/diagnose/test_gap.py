@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.diagnose.gap import SETTLE_S, decay_mode, measure_gap
-from lumpbeam_ros.diagnose.record import record_from_trajectory
+from lumpbeam_ros.diagnose.measurement import record_from_trajectory
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.trajectory import TipTrajectory
 

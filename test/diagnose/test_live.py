@@ -20,7 +20,7 @@ from lumpbeam_ros.diagnose.live import (
     named_effects,
     status_values,
 )
-from lumpbeam_ros.diagnose.record import make_record
+from lumpbeam_ros.diagnose.measurement import make_record
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, simulate_experiment

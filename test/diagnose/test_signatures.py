@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from lumpbeam_ros.diagnose.record import make_record
+from lumpbeam_ros.diagnose.measurement import make_record
 from lumpbeam_ros.diagnose.signatures import decay_peaks, envelope_law, envelope_terms, time_shift
 from lumpbeam_ros.model.trajectory import TipTrajectory
 

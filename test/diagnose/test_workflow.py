@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.diagnose.candidates import SEARCHED_EFFECTS
-from lumpbeam_ros.diagnose.record import record_from_trajectory
+from lumpbeam_ros.diagnose.measurement import record_from_trajectory
 from lumpbeam_ros.diagnose.workflow import diagnose
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, load_beam_config
 from lumpbeam_ros.model.trajectory import TipTrajectory

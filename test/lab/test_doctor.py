@@ -23,6 +23,7 @@ from mcap.writer import CompressionType, Writer
 
 from lumpbeam_lab import doctor
 from lumpbeam_lab.doctor import MAGIC, examine, examine_bag, examine_file
+from lumpbeam_ros.bagio import BagWriter
 from lumpbeam_ros.errors import BagError
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -347,7 +348,42 @@ def test_bad_input_is_one_clear_error(tmp_path: Path) -> None:
         examine_file(tmp_path / 'missing.mcap')
     with pytest.raises(BagError, match='not a bag folder'):
         examine_bag(tmp_path / 'nothing')
+    with pytest.raises(BagError, match='neither metadata.yaml nor an .mcap file'):
+        examine_bag(tmp_path)  # an empty folder: what doc/interfaces.md calls not a bag (2)
+    (tmp_path / 'metadata.yaml').write_text('x')
     assert examine_bag(tmp_path) == [
         f'{tmp_path}: no .mcap file',
-        f'{tmp_path}: not a rosbag2 bag (no metadata.yaml)',
+        f'{tmp_path}/metadata.yaml: not rosbag2 metadata (no rosbag2_bagfile_information)',
     ]
+
+
+def test_a_message_that_does_not_decode_is_a_problem(tmp_path: Path) -> None:
+    # Its chunk's CRC is right (the writer wrote the bad bytes): only decoding finds it.
+    with BagWriter(tmp_path / 'b') as bag:
+        bag.write_pose('/tip_pose', 1.0, 2.3, -0.01, 0.0)
+        bag.add_topic('/tip_load', 'std_msgs/msg/Float64')
+        bag.write_raw('/tip_load', 2 * 10**9, b'\0\1\0\0\7')
+    [problem] = examine_bag(tmp_path / 'b')
+    assert problem.startswith('b.mcap: Message at Chunk at offset ')
+    assert 'on "/tip_load" does not decode: corrupt std_msgs/msg/Float64 message (5 bytes)' in (
+        problem
+    )
+
+
+def test_bytes_overwritten_inside_a_message_fail_its_chunk_crc(writer_bag: Path, tmp_path):
+    bag = tmp_path / 'bag'
+    shutil.copytree(writer_bag, bag)
+    file = mcap_file(bag)
+    data = bytearray(file.read_bytes())
+    # 8 bytes of one pose's z: the message still decodes, to a wrong value.
+    at = data.index(b'beam_base\0', len(data) // 2) + 40
+    data[at : at + 8] = struct.pack('<d', 2.208)
+    file.write_bytes(bytes(data))
+    crc, data_crc = examine_bag(bag)
+    assert 'uncompressed_crc' in crc and 'DataEnd.data_section_crc' in data_crc
+
+
+def test_an_empty_folder_is_not_a_bag(tmp_path: Path) -> None:
+    (tmp_path / 'empty').mkdir()
+    with pytest.raises(BagError, match='not a bag folder'):
+        examine_bag(tmp_path / 'empty')

@@ -228,3 +228,14 @@ def test_a_window_without_a_release_is_reported_not_diagnosed(ros_graph):
 
     assert ros_graph.spin_until(said, 30.0)
     assert node.diagnoses == 0
+
+
+def test_repeated_and_late_poses_are_counted_not_dropped_silently(ros_graph):
+    node = _start(ros_graph)
+    for t in (1.0, 1.1, 1.1, 1.05, 1.2):  # one repeated stamp, one late one
+        node._on_pose(_pose(t, -0.07, 0.04))
+    assert node.buffer.measured_count == 3
+    assert _values(node.status())['samples_out_of_order'] == '2'
+    node._on_pose(_pose(1.2 - 1000.0, -0.07, 0.04))  # a loop back beyond keep_s: starts over
+    assert node.buffer.measured.counts.resets == 1 and len(node.buffer.measured) == 1
+    assert _values(node.status())['samples_out_of_order'] == '2'

@@ -13,7 +13,7 @@ import numpy as np
 from PIL import Image
 
 from lumpbeam_ros.bagio import BagWriter
-from lumpbeam_ros.diagnose.record import make_record
+from lumpbeam_ros.diagnose.measurement import make_record
 from lumpbeam_ros.diagnose.workflow import Diagnosis, diagnose
 from lumpbeam_ros.interface import TIP_LOAD, TIP_POSE
 from lumpbeam_ros.model.parameters import load_beam_config

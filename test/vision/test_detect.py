@@ -83,7 +83,7 @@ def test_real_photographs_give_opencvs_corners_seen_from_the_front(camera, half_
         gray = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
         reference = opencv_corners(gray)
         assert reference is not None, path.name
-        corners = detect_board(gray, PATTERN, AXES, 640, half_window)
+        corners = detect_board(gray, PATTERN, AXES, 640, half_window, snap_to_grid=True)
         assert corners is not None, path.name
         gap = min(
             np.max(np.linalg.norm(corners - reference, axis=1)),

@@ -16,6 +16,7 @@ from lumpbeam_ros.viz.marker_messages import (
     read_marker_arrays,
     scene_cdr,
     write_scene,
+    write_scene_ns,
 )
 from lumpbeam_ros.viz.markers import (
     FRAME_ID,
@@ -176,3 +177,16 @@ def test_the_points_keep_float64_precision():
     spec = MarkerSpec('beam', 0, Shape.LINE_STRIP, points=points)
     (back,) = marker_specs(deserialize(serialize(marker_array([spec], 0)), MARKER_ARRAY_TYPE))
     np.testing.assert_array_equal(back.points, points)
+
+
+def test_markers_of_a_frame_keep_its_integer_stamp_and_log_time(tmp_path):
+    # Through float seconds, 1_700_000_000_123_456_789 ns comes back 21 ns off, enough to
+    # put a tracked bag's markers out of log-time order.
+    stamp, log_time = 1_700_000_000_123_456_789, 1_700_000_000_125_000_001
+    with BagWriter(tmp_path / 'b') as bag:
+        write_scene_ns(bag, stamp, full_scene(), 0.3, log_time_ns=log_time)
+    [(logged, message)] = list(
+        BagReader(tmp_path / 'b').messages(MARKERS_TOPIC, MARKER_ARRAY_TYPE)
+    )
+    header = message.markers[0].header.stamp
+    assert (logged, header.sec * 1_000_000_000 + header.nanosec) == (log_time, stamp)

@@ -1,4 +1,8 @@
-"""The measured record a diagnosis works on: tip poses and the load schedule that drove them."""
+"""The measured record a diagnosis works on: tip poses and the load schedule that drove them.
+
+Not the recording of live topics into a bag: that is ``lumpbeam record``
+(:mod:`lumpbeam_ros.cli.record`).
+"""
 
 from __future__ import annotations
 

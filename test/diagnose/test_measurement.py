@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.bagio import BagWriter
-from lumpbeam_ros.diagnose.record import make_record, read_record, tracked_segments
+from lumpbeam_ros.diagnose.measurement import make_record, read_record, tracked_segments
 from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.model.parameters import DropTestConfig, load_beam_config
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
