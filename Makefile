@@ -16,7 +16,7 @@ export ROS_HOME := $(CURDIR)/.cache/ros
 export ROS_AUTOMATIC_DISCOVERY_RANGE ?= LOCALHOST
 export PYTHONDONTWRITEBYTECODE :=
 
-.PHONY: venv demo test test-slow lint typecheck bench docs clean
+.PHONY: venv demo test test-slow fuzz lint typecheck bench docs clean
 
 # One pip run: the venv's own pip installs these wheels as well as a newer one would, so it
 # is not upgraded first (about 5 s). --no-compile: Python compiles a module when it is first
@@ -52,6 +52,12 @@ test: venv
 test-slow: venv
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -m 'slow and not ros'
 	$(BIN)/python -m pytest -m 'slow and ros'
+
+# The bag fuzz campaign at length: random damage to a product-written bag through the
+# readers, doctor, repair, analyze and diagnose (test/bagio/test_fuzz.py; make test runs 200).
+FUZZ_CASES ?= 5000
+fuzz: venv
+	LUMPBEAM_FUZZ_CASES=$(FUZZ_CASES) $(BIN)/python -m pytest test/bagio/test_fuzz.py -n0 -q -p no:logging
 
 lint: venv
 	$(BIN)/ruff check .

@@ -8,6 +8,7 @@ jumps at each sample (:class:`SampledMotion`). A smooth motion given by function
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Protocol
@@ -128,14 +129,15 @@ class SmoothMotion:
         angle_function: ``t -> q(t)``, rad.
         rate_function: ``t -> q'(t)``, rad/s.
         n_joints: Number of joints.
-        end_time: When the motion stops, s (the ring-down after it is free vibration).
+        end_time: When the motion stops for good, s (the ring-down after it is free
+            vibration); infinite by default.
         corners: Times where the rates jump, s.
     """
 
     angle_function: Callable[[float], np.ndarray]
     rate_function: Callable[[float], np.ndarray]
     n_joints: int
-    end_time: float = 0.0
+    end_time: float = math.inf
     corners: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property

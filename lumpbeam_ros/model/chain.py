@@ -58,6 +58,8 @@ class LumpedChain:
         drag_c_q: Quadratic drag on the tip, N s^2/m^2.
         cubic_stiffness: k3 of joint 1's spring, torque ``k phi_1 + k3 phi_1^3``, N m/rad^3.
         tilt: The clamp's pitch below level, rad.
+        preload: Constant generalized forces added to :meth:`generalized_forces` (an arm's
+            springs held at fixed joint offsets, :meth:`drive_forces`); ``None``: none.
     """
 
     segment_lengths: np.ndarray
@@ -71,6 +73,7 @@ class LumpedChain:
     drag_c_q: float = 0.0
     cubic_stiffness: float = 0.0
     tilt: float = 0.0
+    preload: np.ndarray | None = None
 
     @classmethod
     def from_beam(cls, beam: BeamParameters, load_kg: float = 0.0) -> LumpedChain:
@@ -261,6 +264,7 @@ class LumpedChain:
             - phi @ self.stiffness_matrix
             - phi_dot @ self.damping_matrix
             + self.effect_forces(phi, phi_dot, friction)
+            + (0.0 if self.preload is None else self.preload)
         )
 
     def inertial_forces(self, phi: np.ndarray, phi_ddot: np.ndarray) -> np.ndarray:

@@ -5,7 +5,8 @@ One place for what each node's ``main`` did alike (:func:`run_node`):
 * a configuration error while the node is built is one line on stderr and exit code 2 (no
   traceback);
 * Ctrl-C, SIGTERM or an external shutdown ends the spin quietly, also when the shutdown cuts
-  into a callback that publishes;
+  into a callback that publishes; SIGINT and SIGTERM also interrupt a callback that computes
+  (a long solve), so the node stops within a fraction of a second whatever it is doing;
 * what the node published is written for the demo's per-topic counts
   (:mod:`lumpbeam_ros.nodes.counts`) however it stopped.
 
@@ -18,10 +19,11 @@ from __future__ import annotations
 
 import signal
 import sys
+import threading
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from types import FrameType
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import rclpy
 from rclpy.exceptions import (
@@ -68,6 +70,7 @@ def run_node(
         0 after a clean stop, :data:`CONFIG_ERROR` when the node cannot be built or ``run``
         fails on its configuration.
     """
+    previous = _interrupting_signals()
     rclpy.init(args=list(args) if args is not None else None)
     node: _N | None = None
     try:
@@ -88,7 +91,29 @@ def run_node(
             write_counts(name, published(node), received(node) if received else None)
             node.destroy_node()
         rclpy.try_shutdown()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     return 0
+
+
+def _interrupt(_signum: int, _frame: FrameType | None) -> None:
+    raise KeyboardInterrupt
+
+
+def _interrupting_signals() -> dict[int, Any]:
+    """Makes SIGINT and SIGTERM raise ``KeyboardInterrupt`` in the main thread.
+
+    Installed before ``rclpy.init``: rclpy's handler shuts the context down (which ends a
+    wait) and then calls the handler it found, this one, which interrupts a callback that
+    computes. Without it SIGTERM, and SIGINT in a process started with SIGINT ignored (a
+    background job), only shut the context down, and a callback busy in a long solve runs on.
+
+    Returns:
+        The handlers replaced, to restore (nothing outside the main thread).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return {}
+    return {s: signal.signal(s, _interrupt) for s in (signal.SIGINT, signal.SIGTERM)}
 
 
 def checked_namespace(namespace: str | None) -> str:

@@ -2,15 +2,30 @@
 
 from __future__ import annotations
 
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
 import pytest
 import rclpy
+from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import PoseStamped
+from harness import ros_env, start_process, stop_with
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from std_msgs.msg import Float64
 
 from lumpbeam_ros.errors import ConfigError, LumpbeamError
+from lumpbeam_ros.interface import BEAM_PARAMS, MODEL_DISCREPANCY, TIP_POSE, TIP_POSE_PREDICTED
+from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.nodes.counts import COUNTS_DIR_ENV, read_counts
 from lumpbeam_ros.nodes.lifecycle import CONFIG_ERROR, run_node
+from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+from lumpbeam_ros.synthetic.images import ImageOptions
+
+ROOT = Path(__file__).resolve().parents[2]
+SIGNALS = [signal.SIGINT, signal.SIGTERM]
 
 
 @pytest.fixture
@@ -95,3 +110,89 @@ def test_a_middleware_error_while_running_is_not_hidden(counts_dir):
     with pytest.raises(_rclpy.RCLError, match='failed to take'):
         run_node('counting_node', _Publishing, lambda n: {'/x': n.sent}, [], run=run)
     assert read_counts(counts_dir)['counting_node']['published'] == {'/x': 0}
+
+
+#: A node whose callback computes without end (a solve that never converges).
+BUSY_NODE = """
+import sys
+from rclpy.node import Node
+from lumpbeam_ros.nodes.lifecycle import run_node
+
+def run(node):
+    print('busy', flush=True)
+    while True:
+        pass
+
+sys.exit(run_node('busy_node', lambda: Node('busy_node'), lambda n: {}, [], run=run))
+"""
+
+
+@pytest.mark.parametrize('ignored', [False, True], ids=['', 'SIGINT ignored at start'])
+@pytest.mark.parametrize('sig', SIGNALS, ids=lambda s: s.name)
+def test_a_signal_interrupts_a_callback_that_computes(ros_domain_id, tmp_path, sig, ignored):
+    """SIGTERM, and SIGINT in a background job (started with SIGINT ignored), too."""
+    env = ros_env(ros_domain_id, tmp_path)
+    env['PYTHONPATH'] = str(ROOT)
+    handler = signal.SIG_IGN if ignored else signal.SIG_DFL
+    process = subprocess.Popen(
+        [sys.executable, '-c', BUSY_NODE],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, handler),
+    )
+    assert process.stdout is not None
+    assert process.stdout.readline() == 'busy\n'
+    code, _, stderr = stop_with(process, sig)
+    assert code == 0 and stderr == ''
+
+
+@pytest.fixture(scope='module')
+def filmed_bag(tmp_path_factory):
+    """A 2.3 s drop test filmed at 320 x 240: 415 frames for the camera node to track."""
+    path = tmp_path_factory.mktemp('filmed') / 'bag'
+    beam, drop = load_beam_config()
+    write_drop_test_bag(
+        path, beam, drop, SynthOptions(duration_s=2.3), images=ImageOptions(320, 240)
+    )
+    return path
+
+
+#: Each node, what it is given to work on, what it publishes while it works and whether it
+#: needs /tip_pose for that.
+NODES = {
+    'camera': (['-p', 'bag_path:={bag}'], TIP_POSE, PoseStamped, False),
+    'identifier': (['-p', 'publish_rate_hz:=20.0'], BEAM_PARAMS, DiagnosticArray, True),
+    'simulator': ([], TIP_POSE_PREDICTED, PoseStamped, False),
+    'diagnosis': (['-p', 'status_period_s:=0.2'], MODEL_DISCREPANCY, DiagnosticArray, True),
+}
+
+
+@pytest.mark.parametrize('sig', SIGNALS, ids=lambda s: s.name)
+@pytest.mark.parametrize('node', list(NODES))
+def test_a_node_stops_within_the_bound_while_it_works(ros_graph, filmed_bag, node, sig):
+    extra, topic, msgtype, fed = NODES[node]
+    got = ros_graph.collect(topic, msgtype, 100)
+    pose = PoseStamped()
+    pose.header.frame_id = 'beam_base'
+    pose.pose.orientation.w = 1.0
+
+    def working() -> bool:
+        if fed:
+            pose.header.stamp.nanosec = (pose.header.stamp.nanosec + 5_000_000) % 10**9
+            pose.header.stamp.sec += pose.header.stamp.nanosec == 0
+            ros_graph.publish(TIP_POSE, pose, 100)
+        return len(got) >= 3
+
+    env = ros_env(ros_graph.domain_id)
+    env['PYTHONPATH'] = str(ROOT)
+    argv = [a.format(bag=filmed_bag) for a in extra]
+    process = start_process(env, f'lumpbeam_ros.nodes.{node}_node', '--ros-args', *argv)
+    try:
+        worked = ros_graph.spin_until(working, 60.0)
+    finally:
+        code, _, stderr = stop_with(process, sig)
+    assert worked, stderr
+    assert code == 0, stderr
+    assert 'Traceback' not in stderr
