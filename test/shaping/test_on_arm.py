@@ -38,7 +38,7 @@ from lumpbeam_ros.shaping.apply import shape_trajectory
 from lumpbeam_ros.shaping.impulses import Mode
 from lumpbeam_ros.shaping.shapers import design_shaper
 
-pytestmark = pytest.mark.slow  # a validation matrix: about 2 min of CPU
+pytestmark = pytest.mark.slow  # a validation matrix: minutes of CPU
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config'
 
