@@ -136,3 +136,10 @@ def in_namespace(topic: str, namespace: str) -> str:
     if name.startswith('/'):
         return name
     return f'{namespace.rstrip("/")}/{name}'
+
+
+#: The pose rate of the camera the package is built around, and of synthetic and predicted
+#: poses by default, Hz.
+POSE_RATE_HZ = 180.0
+#: The rate of /beam_markers by default (the simulator node, synthetic bags), Hz.
+MARKERS_RATE_HZ = 30.0

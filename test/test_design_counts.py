@@ -5,6 +5,8 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -39,3 +41,56 @@ def test_parameters_are_declared_only_from_the_schemas():
         _tool()._grep(ROOT, r'\.declare_parameters?\(', ('lumpbeam_ros/nodes/ros_parameters.py',))
         == []
     )
+
+
+@pytest.fixture(scope='module')
+def tool():
+    return _tool()
+
+
+def test_node_parameter_defaults_and_bounds_are_written_once(tool):
+    assert tool.repeated_parameter_literals(ROOT) == []
+
+
+def test_every_declared_parameter_is_read(tool):
+    assert tool.unread_parameters(ROOT) == []
+
+
+def test_an_effect_is_one_record_plus_its_physics(tool):
+    assert tool.effect_places(ROOT) == []
+
+
+def test_the_core_imports_no_lab_module(tool):
+    assert tool.lab_imports(ROOT) == []
+
+
+def _package(tmp_path, files):
+    package = tmp_path / 'lumpbeam_ros'
+    for name, text in files.items():
+        path = package / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    (tmp_path / 'doc').mkdir()
+    (tmp_path / 'doc' / 'interfaces.md').write_text((ROOT / 'doc' / 'interfaces.md').read_text())
+    return tmp_path
+
+
+def test_the_counts_find_what_they_count(tool, tmp_path, monkeypatch):
+    repo = _package(
+        tmp_path,
+        {
+            'vision/config.py': "F = get_float(p, 'camera.focal_length_px', source, 2400.0)\n",
+            'vision/other.py': 'class C:\n    focal_length_px: float = 2400.0\n',
+            'model/table.py': "OFF = {'sensor_scale': 1.0}\n",
+            'viz/markers.py': 'from lumpbeam_ros.synthetic import images\n',
+            'bench/cases.py': "CASES = ({'added_mass': 0.3},)\n",  # the lab's examples
+        },
+    )
+    schemas = tool._schemas(ROOT)
+    monkeypatch.setattr(tool, '_schemas', lambda repo: schemas)
+    assert tool.repeated_parameter_literals(repo) == [
+        'camera_node camera.focal_length_px: '
+        'lumpbeam_ros/vision/config.py:1, lumpbeam_ros/vision/other.py:2'
+    ]
+    assert tool.effect_places(repo) == ['lumpbeam_ros/model/table.py:1: a table naming 1']
+    assert tool.lab_imports(repo) == ['lumpbeam_ros/viz/markers.py:1: lumpbeam_ros.synthetic']

@@ -140,17 +140,15 @@ def _sources(repo: Path) -> dict[str, ast.Module]:
 
 
 def _schemas(repo: Path) -> list[Any]:
-    """The nodes' parameter schemas (``lumpbeam_ros.params.reference.SCHEMAS``)."""
-    sys.path.insert(0, str(repo))
-    try:
-        for name in [
-            m for m in sys.modules if m == 'lumpbeam_ros' or m.startswith('lumpbeam_ros.')
-        ]:
+    """The nodes' parameter schemas (``lumpbeam_ros.params.reference.SCHEMAS``) of ``repo``."""
+    loaded = sys.modules.get('lumpbeam_ros')
+    if loaded is None or Path(str(loaded.__file__)).resolve().parents[1] != repo.resolve():
+        # Another tree's package (a stash, a worktree) is imported afresh from ``repo``.
+        for name in [m for m in sys.modules if m.split('.')[0] == 'lumpbeam_ros']:
             del sys.modules[name]
-        reference = importlib.import_module('lumpbeam_ros.params.reference')
-        return list(reference.SCHEMAS)
-    finally:
-        sys.path.remove(str(repo))
+        sys.path.insert(0, str(repo))
+    reference = importlib.import_module('lumpbeam_ros.params.reference')
+    return list(reference.SCHEMAS)
 
 
 def _field_names(sources: dict[str, ast.Module]) -> dict[str, str]:
@@ -277,8 +275,9 @@ def repeated_parameter_literals(repo: Path) -> list[str]:
                 flags = {k.arg for k in call.keywords} & {'positive', 'non_negative', 'minimum'}
                 if written & (values | limits) or flags:
                     places.add(f'{rel}:{call.lineno}')
+            # A zero default (none, off) is no chosen value: only others count by name.
             for rel, name, line, numbers in named:
-                if name in names and values and numbers <= values:
+                if name in names and values - {0.0} and numbers <= values:
                     places.add(f'{rel}:{line}')
             if len(places) > 1:
                 found.append(f'{schema.node} {spec.name}: {", ".join(sorted(places))}')
@@ -450,8 +449,12 @@ def effect_places(repo: Path) -> list[str]:
 
 
 def _names_effect(call: ast.Call, effects: set[str]) -> bool:
-    """Whether a call declares an effect record (its name among its literal arguments)."""
-    return any(isinstance(a, ast.Constant) and a.value in effects for a in call.args)
+    """Whether a call declares an effect record (its name a literal argument, maybe nested)."""
+    return any(
+        isinstance(a, ast.Constant) and a.value in effects
+        for arg in call.args
+        for a in ast.walk(arg)
+    )
 
 
 def lab_imports(repo: Path) -> list[str]:

@@ -108,7 +108,11 @@ def write(folder: Path, metadata: dict[str, Any]) -> None:
     """
     target = folder / FILENAME
     tmp = target.with_suffix('.yaml.tmp')
-    tmp.write_text(yaml.safe_dump(metadata, sort_keys=False), encoding='utf-8')
+    # libyaml's emitter when PyYAML has it: a recorder rewrites this file at every flush
+    # (every 1 MiB of images), and the pure-Python one took ~40 ms of each.
+    dumper = getattr(yaml, 'CSafeDumper', yaml.SafeDumper)
+    text = yaml.dump(metadata, Dumper=dumper, sort_keys=False)
+    tmp.write_text(text, encoding='utf-8')
     os.replace(tmp, target)
 
 

@@ -27,10 +27,13 @@ from lumpbeam_ros.bagio.tipseries import SampleCounts
 from lumpbeam_ros.diagnose.measurement import MIN_SAMPLES_AFTER_EVENT, Record, record_from_series
 from lumpbeam_ros.diagnose.workflow import diagnose
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.interface import TIP_POSE
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters
+from lumpbeam_ros.params.schema import Bounds, setting
 
 Trigger = Literal['ring_down', 'window']
+TRIGGERS: tuple[Trigger, ...] = ('ring_down', 'window')
 
 #: DiagnosticStatus levels (as numbers: the core does not import ROS messages).
 OK, WARN, ERROR, STALE = 0, 1, 2, 3
@@ -56,13 +59,48 @@ class LiveSettings:
             what they hold.
     """
 
-    trigger: Trigger = 'ring_down'
-    pre_release_s: float = 1.0
-    decay_s: float = 8.0
-    min_amplitude_m: float = 0.0
-    window_s: float = 10.0
-    keep_s: float = 60.0
-    max_rate_hz: float = 400.0
+    trigger: Trigger = setting(
+        'trigger',
+        'ring_down',
+        'ring_down: diagnose each load change once its decay is complete; window: '
+        'diagnose every window_s of data (it must hold a load change)',
+        choices=TRIGGERS,
+    )
+    pre_release_s: float = setting(
+        'ring_down.pre_release_s',
+        1.0,
+        'rest before the load change that a ring-down includes',
+        's',
+        Bounds(0.0, low_open=True),
+    )
+    decay_s: float = setting(
+        'ring_down.decay_s',
+        8.0,
+        'a ring-down is complete once the decay has lasted this long (at least 2 s of '
+        'poses at 180 Hz are needed after the change)',
+        's',
+        Bounds(2.0, 600.0),
+    )
+    min_amplitude_m: float = setting(
+        'ring_down.min_amplitude_m',
+        0.0,
+        'a ring-down is complete earlier once the tip z swings less than this (half '
+        'peak-to-peak over the last 0.5 s); 0: only decay_s ends it',
+        'm',
+        Bounds(0.0, 1.0),
+    )
+    window_s: float = setting(
+        'window_s', 10.0, 'length of a window (trigger window)', 's', Bounds(2.0, 600.0)
+    )
+    keep_s: float = setting(
+        'keep_s',
+        60.0,
+        'the node keeps this much of the latest data (longer than any ring-down)',
+        's',
+        Bounds(5.0, 3600.0),
+    )
+    # Not a parameter: the buffers are sized as the identifier's window is.
+    max_rate_hz: float = IdentifierConfig.max_rate_hz
 
 
 @dataclass(frozen=True)

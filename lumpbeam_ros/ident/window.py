@@ -42,7 +42,10 @@ class SlidingWindow:
     """
 
     def __init__(
-        self, length_s: float = 10.0, max_rate_hz: float = 400.0, reset_jump_back_s: float = 1.0
+        self,
+        length_s: float = IdentifierConfig.window_s,
+        max_rate_hz: float = IdentifierConfig.max_rate_hz,
+        reset_jump_back_s: float = IdentifierConfig.reset_jump_back_s,
     ):
         if not (length_s > 0.0 and max_rate_hz > 0.0 and reset_jump_back_s > 0.0):
             raise ValueError('window length, rate and jump must be positive')

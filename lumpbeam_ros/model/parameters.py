@@ -29,7 +29,7 @@ TipPlacement = Literal['free_end', 'segment_com']
 #: Where an effect enters the dynamics: the chain's masses, springs and forces
 #: (:meth:`~lumpbeam_ros.model.chain.LumpedChain.from_beam`), the stamps of the measurements
 #: (:func:`~lumpbeam_ros.model.simulate.simulate_loads`, the stream) or the measured position
-#: (:func:`~lumpbeam_ros.model.sensor.scaled_position`).
+#: (:func:`~lumpbeam_ros.model.sensor.measured_position`).
 EffectHook = Literal['chain', 'stamps', 'position']
 
 
@@ -74,6 +74,8 @@ class EffectRecord:
         signed: Its strength has a sign (searched on both sides of off).
         compliance: The diagnosis fits ``k_clamp / value`` (0: off) instead of the value, for
             an effect whose off value would be an infinite stiffness.
+        signature: The panel of the diagnosis's signature figure that speaks for it
+            (``'time_shift'``, ``'frequency'``, ``'envelope'``; empty: none).
     """
 
     name: str
@@ -86,6 +88,7 @@ class EffectRecord:
     search: SearchRange
     signed: bool = False
     compliance: bool = False
+    signature: str = ''
 
     def problem(self, value: float) -> str | None:
         """Why ``value`` is outside :attr:`limits` (``None``: inside).
@@ -126,6 +129,7 @@ class Effects:
             # own root (k_base < k_clamp / 20) is not "a beam on a mount".
             SearchRange(1.0, 1000.0, 20.0, 0.1),
             compliance=True,
+            signature='frequency',
         )
     )
     coulomb_torque_nm: float = _effect(
@@ -139,6 +143,7 @@ class Effects:
             'chain',
             # Dry friction beyond a tenth of the clamp's static moment would lock the beam.
             SearchRange(1.0, 1.0, 0.1, 0.1, ('', 'clamp_moment', 'clamp_moment', '')),
+            signature='envelope',
         )
     )
     drag_c_q: float = _effect(
@@ -152,6 +157,7 @@ class Effects:
             'chain',
             # c_q = rho C_d A / 2: 20 N s^2/m^2 is a plate of ~30 m^2; a tip body is far less.
             SearchRange(1.0, 1e3, 20.0, 0.05),
+            signature='envelope',
         )
     )
     added_mass_kg: float = _effect(
@@ -165,6 +171,7 @@ class Effects:
             'chain',
             # More than twice what the beam already carries is not an unnoticed bracket.
             SearchRange(1.0, 20.0, 2.0, 0.03, ('', 'carried_kg', 'carried_kg', '')),
+            signature='frequency',
         )
     )
     latency_s: float = _effect(
@@ -178,6 +185,7 @@ class Effects:
             'stamps',
             # Beyond a quarter of a second a camera pipeline is broken, not late.
             SearchRange(0.01, 2.0, 0.25, 0.002),
+            signature='time_shift',
         )
     )
     k3_nm_per_rad3: float = _effect(
@@ -199,6 +207,7 @@ class Effects:
             # nonlinearity.
             SearchRange(1.0, 500.0, 50.0, 1.0, ('k3_unit',) * 4),
             signed=True,
+            signature='frequency',
         )
     )
     scale: float = _effect(
@@ -227,6 +236,23 @@ class Effects:
             'chain',
             # A clamp tilted more than 10 degrees is a different setup, not an unnoticed tilt.
             SearchRange(0.01, 1.2, 0.175, 0.002),
+            signed=True,
+        )
+    )
+
+    creep_rate_mps: float = _effect(
+        EffectRecord(
+            'mount_creep',
+            'rate_mps',
+            'm/s',
+            'the clamp creeps vertically at a constant rate (a mount settling, thermal drift): '
+            'the measured tip z moves by rate times the time since the record began',
+            # A centimetre a second is a clamp coming loose, not a creep.
+            Bounds(-0.01, 0.01),
+            0.0,
+            'position',
+            # A millimetre a second (6 cm a minute) is beyond any creep that goes unnoticed.
+            SearchRange(1e-4, 0.01, 1e-3, 1e-5),
             signed=True,
         )
     )

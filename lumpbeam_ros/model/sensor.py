@@ -48,3 +48,29 @@ def scaled_position(
         return x, z
     x0, z0 = rest_position(beam)
     return x0 + scale * (np.asarray(x) - x0), z0 + scale * (np.asarray(z) - z0)
+
+
+def measured_position(
+    beam: BeamParameters, elapsed_s: np.ndarray, x: np.ndarray, z: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The tip position as the sensor reports it: scaled, and moved by a creeping mount.
+
+    A clamp creeping at a constant rate (``mount_creep``) moves the beam with it at a
+    constant velocity, which loads it with no inertial force: its motion relative to the
+    clamp is unchanged, and only the measured z (taken against the fixed board) moves by
+    ``rate * elapsed``.
+
+    Args:
+        beam: The beam (its ``sensor_scale`` and ``mount_creep`` effects are applied).
+        elapsed_s: Time of each sample since the record (or the stream) began, s.
+        x: True x of the free end, m.
+        z: True z, same shape.
+
+    Returns:
+        The measured x and z.
+    """
+    x, z = scaled_position(beam, x, z)
+    rate = beam.effects.creep_rate_mps
+    if rate == 0.0:
+        return x, z
+    return x, np.asarray(z) + rate * np.asarray(elapsed_s)

@@ -15,10 +15,11 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import POSE_RATE_HZ
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.integrate import ChainState, ModalSolver, solve_reference
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
-from lumpbeam_ros.model.sensor import scaled_position
+from lumpbeam_ros.model.sensor import measured_position
 from lumpbeam_ros.model.statics import static_equilibrium
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
@@ -145,7 +146,8 @@ def simulate_loads(
     The sensor effects of ``beam`` are applied to the result: with ``sensor_latency`` the
     sample stamped ``t`` shows the beam at ``t - latency`` (before the start, at rest), with
     ``sensor_scale`` the position's displacement from rest is scaled
-    (:func:`~lumpbeam_ros.model.sensor.scaled_position`).
+    (:func:`~lumpbeam_ros.model.sensor.measured_position`), and with ``mount_creep`` z moves
+    by the rate times the time since ``t[0]``.
 
     Args:
         beam: The beam.
@@ -187,7 +189,7 @@ def simulate_loads(
         if lo >= t.size:
             break
     x, z, pitch = simulation.chain.tip_pose(phi)
-    x, z = scaled_position(beam, x, z)
+    x, z = measured_position(beam, t - t[0] if t.size else t, x, z)
     return TipTrajectory(t=t, x=x, z=z, pitch=pitch, load_kg=loads, q=phi)
 
 
@@ -199,7 +201,7 @@ def drop_test_events(drop: DropTestConfig) -> list[tuple[float, float]]:
 def simulate_drop_test(
     beam: BeamParameters,
     drop: DropTestConfig | None = None,
-    rate_hz: float = 180.0,
+    rate_hz: float = POSE_RATE_HZ,
     step: float = DEFAULT_STEP_S,
 ) -> TipTrajectory:
     """The paper's drop test (section B.3): at rest with ``m_d + m_l``, ``m_l`` released.

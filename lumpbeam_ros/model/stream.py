@@ -20,9 +20,10 @@ import math
 
 import numpy as np
 
+from lumpbeam_ros.interface import POSE_RATE_HZ
 from lumpbeam_ros.model.integrate import ChainState
 from lumpbeam_ros.model.parameters import BeamParameters
-from lumpbeam_ros.model.sensor import scaled_position
+from lumpbeam_ros.model.sensor import measured_position, scaled_position
 from lumpbeam_ros.model.simulate import DEFAULT_STEP_S, BeamSimulation
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
@@ -57,7 +58,7 @@ class PredictionStream:
         beam: BeamParameters,
         load_kg: float,
         t0: float,
-        rate_hz: float = 180.0,
+        rate_hz: float = POSE_RATE_HZ,
         step: float = DEFAULT_STEP_S,
     ):
         self.step = step
@@ -119,6 +120,7 @@ class PredictionStream:
         self._simulation = BeamSimulation(self._beam, load, t0=start, step=self.step)
         self._events.clear()
         self._time = float(t)
+        self._origin = float(t)  # mount_creep counts from here
         self._next_index = first_index
 
     def set_beam(self, beam: BeamParameters) -> None:
@@ -206,7 +208,7 @@ class PredictionStream:
         phi[lo:], _ = simulation.advance(physical[lo:])
         loads[lo:] = simulation.load_kg
         x, z, pitch = simulation.chain.tip_pose(phi)
-        x, z = scaled_position(self._beam, x, z)
+        x, z = measured_position(self._beam, stamps - self._origin, x, z)
         return TipTrajectory(t=stamps, x=x, z=z, pitch=pitch, load_kg=loads, q=phi)
 
 

@@ -66,6 +66,7 @@ from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
 from lumpbeam_ros.params.diagnosis_params import DIAGNOSIS_SCHEMA
+from lumpbeam_ros.params.schema import settings_from_parameters
 
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0
@@ -105,14 +106,7 @@ class DiagnosisNode(SchemaNode):
         self.hardware_id = str(values['hardware_id'])
         self.beam: BeamParameters = load_beam_config(values['beam_config'] or None)[0]
         self.buffer = LiveBuffer(
-            LiveSettings(
-                trigger=values['trigger'],
-                pre_release_s=values['ring_down.pre_release_s'],
-                decay_s=values['ring_down.decay_s'],
-                min_amplitude_m=values['ring_down.min_amplitude_m'],
-                window_s=values['window_s'],
-                keep_s=values['keep_s'],
-            )
+            settings_from_parameters(LiveSettings, values, f'{self.get_name()} parameters')
         )
         self.wrong_frame = 0
         self.non_finite = 0

@@ -1,9 +1,14 @@
-"""The diagnosis node's parameters (values in ``config/diagnosis.yaml``, documented there)."""
+"""The diagnosis node's parameters (values in ``config/diagnosis.yaml``, documented there).
+
+When a diagnosis runs: :class:`~lumpbeam_ros.diagnose.live.LiveSettings`' fields, declared there
+once; the rest is the node's own.
+"""
 
 from __future__ import annotations
 
+from lumpbeam_ros.diagnose.live import LiveSettings
 from lumpbeam_ros.interface import DIAGNOSIS_NODE, SIMULATOR_NODE
-from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec
+from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec, settings_specs
 
 _POSITIVE = Bounds(0.0, low_open=True)
 
@@ -16,56 +21,7 @@ DIAGNOSIS_SCHEMA = ParameterSchema(
     ),
     config_file='diagnosis.yaml',
     parameters=(
-        ParameterSpec(
-            'trigger',
-            'string',
-            'ring_down',
-            'ring_down: diagnose each load change once its decay is complete; window: '
-            'diagnose every window_s of data (it must hold a load change)',
-            choices=('ring_down', 'window'),
-        ),
-        ParameterSpec(
-            'ring_down.pre_release_s',
-            'double',
-            1.0,
-            'rest before the load change that a ring-down includes',
-            's',
-            _POSITIVE,
-        ),
-        ParameterSpec(
-            'ring_down.decay_s',
-            'double',
-            8.0,
-            'a ring-down is complete once the decay has lasted this long (at least 2 s of '
-            'poses at 180 Hz are needed after the change)',
-            's',
-            Bounds(2.0, 600.0),
-        ),
-        ParameterSpec(
-            'ring_down.min_amplitude_m',
-            'double',
-            0.0,
-            'a ring-down is complete earlier once the tip z swings less than this (half '
-            'peak-to-peak over the last 0.5 s); 0: only decay_s ends it',
-            'm',
-            Bounds(0.0, 1.0),
-        ),
-        ParameterSpec(
-            'window_s',
-            'double',
-            10.0,
-            'length of a window (trigger window)',
-            's',
-            Bounds(2.0, 600.0),
-        ),
-        ParameterSpec(
-            'keep_s',
-            'double',
-            60.0,
-            'the node keeps this much of the latest data (longer than any ring-down)',
-            's',
-            Bounds(5.0, 3600.0),
-        ),
+        *settings_specs(LiveSettings),
         ParameterSpec(
             'worker',
             'string',

@@ -281,7 +281,7 @@ _T = TypeVar('_T', bound=ParameterValue)
 
 
 class Settings(Protocol):
-    """A dataclass whose every field is declared with :func:`setting`."""
+    """A dataclass whose fields are declared with :func:`setting` (others are no parameter)."""
 
     __dataclass_fields__: ClassVar[dict[str, Field[Any]]]
 
@@ -335,7 +335,7 @@ def setting(
 
 def settings_specs(cls: type[Settings]) -> tuple[ParameterSpec, ...]:
     """The parameters a settings class declares, in field order."""
-    return tuple(f.metadata['parameter'] for f in fields(cls))
+    return tuple(f.metadata['parameter'] for f in fields(cls) if 'parameter' in f.metadata)
 
 
 def _typed(spec: ParameterSpec, value: object) -> object:
@@ -366,6 +366,8 @@ def settings_from_parameters(cls: type[_S], params: Mapping[str, Any], source: s
     """
     values = {}
     for f in fields(cls):
+        if 'parameter' not in f.metadata:
+            continue  # not a parameter: its default stands
         spec: ParameterSpec = f.metadata['parameter']
         value = params.get(spec.name, spec.default)
         problem = spec.problem(value)
@@ -382,4 +384,8 @@ def settings_from_parameters(cls: type[_S], params: Mapping[str, Any], source: s
 
 def settings_to_parameters(settings: Settings) -> dict[str, Any]:
     """The flat parameters that read back as ``settings``."""
-    return {f.metadata['parameter'].name: getattr(settings, f.name) for f in fields(settings)}
+    return {
+        f.metadata['parameter'].name: getattr(settings, f.name)
+        for f in fields(settings)
+        if 'parameter' in f.metadata
+    }

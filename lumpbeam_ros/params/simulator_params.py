@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from lumpbeam_ros.interface import SIMULATOR_NODE
+from lumpbeam_ros.interface import MARKERS_RATE_HZ, POSE_RATE_HZ, SIMULATOR_NODE
 from lumpbeam_ros.model.parameters import EFFECTS, EffectRecord
 from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec
 
@@ -45,7 +45,7 @@ SIMULATOR_SCHEMA = ParameterSchema(
         ParameterSpec(
             'rate_hz',
             'double',
-            180.0,
+            POSE_RATE_HZ,
             'rate of /tip_pose_predicted; samples are stamped k / rate_hz',
             'Hz',
             Bounds(1.0, 2000.0),
@@ -97,7 +97,7 @@ SIMULATOR_SCHEMA = ParameterSchema(
         ParameterSpec(
             'markers_rate_hz',
             'double',
-            30.0,
+            MARKERS_RATE_HZ,
             'rate of /beam_markers (the beam, its tip, the measured tip, the load, the board), '
             'independent of rate_hz; 0 publishes none',
             'Hz',

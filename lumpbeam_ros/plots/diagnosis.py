@@ -21,6 +21,7 @@ from lumpbeam_ros.diagnose.live import named_effects  # noqa: E402
 from lumpbeam_ros.diagnose.signatures import decay_peaks  # noqa: E402
 from lumpbeam_ros.diagnose.workflow import Diagnosis  # noqa: E402
 from lumpbeam_ros.errors import LumpbeamError  # noqa: E402
+from lumpbeam_ros.model.parameters import EFFECTS  # noqa: E402
 from lumpbeam_ros.model.trajectory import TipTrajectory  # noqa: E402
 
 #: The files :func:`plot_diagnosis` writes.
@@ -33,9 +34,8 @@ FIGURES = (
 
 #: Which effects each signature panel speaks for.
 SIGNATURE_EFFECTS = {
-    'time_shift': ('sensor_latency',),
-    'frequency': ('cubic_stiffness', 'added_mass', 'base_compliance'),
-    'envelope': ('coulomb_friction', 'quadratic_drag'),
+    panel: tuple(name for name, record in EFFECTS.items() if record.signature == panel)
+    for panel in ('time_shift', 'frequency', 'envelope')
 }
 
 

@@ -21,7 +21,7 @@ from lumpbeam_ros.arm.model import ArmModel
 from lumpbeam_ros.arm.simulate import ArmMotion, simulate_arm
 from lumpbeam_ros.bagio import BagWriter
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.interface import JOINT_STATES, TIP_POSE, TIP_POSE_TRUTH
+from lumpbeam_ros.interface import JOINT_STATES, POSE_RATE_HZ, TIP_POSE, TIP_POSE_TRUTH
 from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
 from lumpbeam_ros.synthetic.drop_test import PITCH_NOISE_PER_M, check_sample_count
 
@@ -40,7 +40,7 @@ class ArmSynthOptions:
     """
 
     duration_s: float
-    rate_hz: float = 180.0
+    rate_hz: float = POSE_RATE_HZ
     noise_m: float = 20e-6
     seed: int = 0
 

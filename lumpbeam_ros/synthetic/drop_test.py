@@ -19,7 +19,13 @@ import numpy as np
 
 from lumpbeam_ros.bagio import BagWriter
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.interface import TIP_LOAD, TIP_POSE, TIP_POSE_TRUTH
+from lumpbeam_ros.interface import (
+    MARKERS_RATE_HZ,
+    POSE_RATE_HZ,
+    TIP_LOAD,
+    TIP_POSE,
+    TIP_POSE_TRUTH,
+)
 from lumpbeam_ros.model.parameters import (
     EFFECT_PARAMETERS,
     BeamParameters,
@@ -73,11 +79,11 @@ class SynthOptions:
     """
 
     duration_s: float = 12.0
-    rate_hz: float = 180.0
+    rate_hz: float = POSE_RATE_HZ
     noise_m: float = 20e-6
     seed: int = 0
     effects: Mapping[str, float] = field(default_factory=dict)
-    markers_rate_hz: float = 30.0
+    markers_rate_hz: float = MARKERS_RATE_HZ
 
 
 def parse_effect(text: str) -> tuple[str, float]:

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import POSE_RATE_HZ
 from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.model.simulate import simulate_drop_test
 from lumpbeam_ros.model.trajectory import TipTrajectory
@@ -30,7 +31,7 @@ DEFAULT_RIG_ERROR = (0.0, 0.0, 0.005)
 
 
 def drop_test_trajectory(
-    rate_hz: float = 180.0, beam_config: str | Path | None = None
+    rate_hz: float = POSE_RATE_HZ, beam_config: str | Path | None = None
 ) -> TipTrajectory:
     """The model's drop test, the truth the synthetic camera films.
 

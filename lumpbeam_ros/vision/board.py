@@ -23,10 +23,10 @@ class Checkerboard:
             needs a light quiet zone around the outer dark squares.
     """
 
-    squares_x: int = 9
-    squares_y: int = 7
-    square_size_m: float = 0.06
-    margin_squares: float = 1.0
+    squares_x: int
+    squares_y: int
+    square_size_m: float
+    margin_squares: float
 
     @property
     def pattern_size(self) -> tuple[int, int]:

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.model.parameters import BeamParameters, Effects
-from lumpbeam_ros.model.sensor import rest_position, scaled_position
+from lumpbeam_ros.model.sensor import measured_position, rest_position, scaled_position
 from lumpbeam_ros.model.simulate import simulate_loads
 from lumpbeam_ros.model.statics import static_tip_deflection
 
@@ -33,3 +33,21 @@ def test_scale_one_is_off_and_is_stored_as_zero():
     assert Effects().value('sensor_scale') == 1.0
     x = np.array([1.0, 2.0])
     assert scaled_position(BEAM, x, x) == (x, x)
+
+
+@pytest.mark.parametrize('rate', [-2e-4, 5e-5])
+def test_a_creeping_mount_moves_only_the_measured_z_by_rate_times_elapsed_time(rate):
+    # A clamp moving at constant velocity is an inertial frame: the beam's motion relative
+    # to it is that of a still clamp (Galileo), so the angles are unchanged and the measured
+    # z, taken against the fixed board, moves by the distance crept since the start.
+    t = np.arange(0.5, 3.0, 1 / 180)
+    still = simulate_loads(BEAM, t, EVENTS, 4.5)
+    crept = simulate_loads(
+        replace(BEAM, effects=Effects().with_effect('mount_creep', rate)), t, EVENTS, 4.5
+    )
+    np.testing.assert_allclose(crept.z - still.z, rate * (t - t[0]), rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(crept.x, still.x)
+    np.testing.assert_array_equal(crept.pitch, still.pitch)
+    np.testing.assert_array_equal(crept.q, still.q)
+    x = np.array([2.3, 2.3])
+    assert measured_position(BEAM, np.array([0.0, 1.0]), x, x) == (x, x)  # off: untouched

@@ -31,6 +31,7 @@ def _run(stream, until, seed=0, start=None):
         {},
         {'sensor_latency': 0.013},
         {'sensor_scale': 1.05, 'mount_tilt': 0.1, 'cubic_stiffness': 5e7},
+        {'mount_creep': 3e-4},  # counted from the stream's start, as from the record's
     ],
 )
 @pytest.mark.parametrize('t0', [0.0, 1_700_000_000.25])

@@ -9,7 +9,7 @@ from lumpbeam_ros.vision.synthetic import SyntheticCamera
 
 
 def test_object_points_are_row_major_and_centred():
-    board = Checkerboard(9, 7, 0.06)
+    board = Checkerboard(9, 7, 0.06, 1.0)
     points = board.object_points()
     assert board.pattern_size == (8, 6)
     assert points.shape == (48, 3)
