@@ -33,3 +33,11 @@ class ConfigError(LumpbeamError):
 
 class BagError(LumpbeamError):
     """A bag is missing, unreadable, truncated or lacks a required topic."""
+
+
+class SolverBudgetError(LumpbeamError):
+    """An integration spent its budget of work before reaching its end time.
+
+    The beam's parameters make its equations too stiff or unstable to simulate (a strongly
+    softening spring, say): the reference integrator's steps shrink without end.
+    """

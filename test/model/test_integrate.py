@@ -1,3 +1,5 @@
+import subprocess
+import sys
 from dataclasses import replace
 
 import numpy as np
@@ -148,3 +150,36 @@ def test_sliding_stretches_in_one_go_match_the_step_by_step_friction(torque):
     assert np.ptp(angles) > 1e-3 and 0 < np.count_nonzero(stuck) < 0.5 * stuck.size
     np.testing.assert_allclose((fast @ angle_row).real, angles, rtol=0, atol=1e-14)
     np.testing.assert_allclose(fast, loop, rtol=0, atol=1e-12 * np.max(np.abs(loop)))
+
+
+#: An unstable beam (a strongly softening spring, k3 = -1e10 N m/rad^3, outside the
+#: parameter ranges): the modal solver gives up and Radau's steps shrink without end.
+RUNAWAY = """
+import numpy as np
+from lumpbeam_ros.errors import SolverBudgetError
+from lumpbeam_ros.model.chain import LumpedChain
+from lumpbeam_ros.model.integrate import ChainState, solve_reference
+from lumpbeam_ros.model.parameters import load_beam_config
+from lumpbeam_ros.model.statics import static_equilibrium
+from lumpbeam_ros.synthetic.drop_test import with_effects
+
+nominal = load_beam_config()[0]
+beam = with_effects(nominal, {'cubic_stiffness': K3})
+phi = static_equilibrium(LumpedChain.from_beam(nominal, 4.5))
+chain = LumpedChain.from_beam(beam, 0.0)
+try:
+    solve_reference(chain, ChainState(phi, 0 * phi), np.linspace(0, 2, 361))
+except SolverBudgetError as exc:
+    print('refused:', exc)
+"""
+
+
+@pytest.mark.parametrize('k3', [-1e10, -1e12])
+def test_the_reference_integrator_stops_at_its_budget(k3):
+    code = RUNAWAY.replace('K3', repr(k3))
+    # In a process of its own: without a budget it would run for hours.
+    run = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.startswith('refused: the reference integrator spent ')
+    assert 'too stiff or unstable to simulate' in run.stdout
+    assert run.stderr == ''  # no numpy warnings on the way
