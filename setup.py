@@ -24,6 +24,8 @@ EXTRAS['all'] = sorted({req for reqs in EXTRAS.values() for req in reqs})
 setup(
     name=PACKAGE,
     version='0.1.0',
+    # Two packages: lumpbeam_ros (the product) and lumpbeam_lab (benchmarks, validation, the
+    # MCAP doctor: what proves it; only `lumpbeam bench` and `lumpbeam doctor` import it).
     packages=find_packages(exclude=['test', 'test.*']),
     data_files=[
         ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE}']),

@@ -82,8 +82,8 @@ def test_the_counts_find_what_they_count(tool, tmp_path, monkeypatch):
             'vision/config.py': "F = get_float(p, 'camera.focal_length_px', source, 2400.0)\n",
             'vision/other.py': 'class C:\n    focal_length_px: float = 2400.0\n',
             'model/table.py': "OFF = {'sensor_scale': 1.0}\n",
-            'viz/markers.py': 'from lumpbeam_ros.synthetic import images\n',
-            'bench/cases.py': "CASES = ({'added_mass': 0.3},)\n",  # the lab's examples
+            'viz/markers.py': 'from lumpbeam_lab.camera import accuracy\n',
+            'synthetic/cases.py': "CASES = ({'added_mass': 0.3},)\n",  # example cases
         },
     )
     schemas = tool._schemas(ROOT)
@@ -93,4 +93,23 @@ def test_the_counts_find_what_they_count(tool, tmp_path, monkeypatch):
         'lumpbeam_ros/vision/config.py:1, lumpbeam_ros/vision/other.py:2'
     ]
     assert tool.effect_places(repo) == ['lumpbeam_ros/model/table.py:1: a table naming 1']
-    assert tool.lab_imports(repo) == ['lumpbeam_ros/viz/markers.py:1: lumpbeam_ros.synthetic']
+    assert tool.lab_imports(repo) == ['lumpbeam_ros/viz/markers.py:1: lumpbeam_lab.camera']
+
+
+def test_a_lab_import_by_the_product_is_found_and_the_cli_may_run_the_lab(tmp_path):
+    tool = _tool()
+    for folder in ('vision', 'nodes', 'cli'):
+        (tmp_path / 'lumpbeam_ros' / folder).mkdir(parents=True)
+    (tmp_path / 'lumpbeam_ros' / 'vision' / 'scores.py').write_text(
+        'from lumpbeam_lab.camera.accuracy import score\n'
+    )
+    (tmp_path / 'lumpbeam_ros' / 'nodes' / 'node.py').write_text(
+        'def f():\n    import lumpbeam_lab.doctor\n'
+    )
+    (tmp_path / 'lumpbeam_ros' / 'cli' / 'bench.py').write_text(
+        'from lumpbeam_lab.bench.runner import run_suites\n'
+    )
+    assert tool.lab_imports(tmp_path) == [
+        'lumpbeam_ros/nodes/node.py:2: lumpbeam_lab.doctor',
+        'lumpbeam_ros/vision/scores.py:1: lumpbeam_lab.camera.accuracy',
+    ]

@@ -24,7 +24,7 @@ from urllib.parse import unquote
 
 import pytest
 
-from lumpbeam_ros.bench.bench_result import BenchResult
+from lumpbeam_lab.bench.bench_result import BenchResult
 from lumpbeam_ros.campaign.task import ID_COLUMNS
 from lumpbeam_ros.cli.analyze import CONTRACT_KEYS
 from lumpbeam_ros.cli.main import COMMANDS, build_parser
@@ -418,6 +418,14 @@ def test_every_core_package_has_an_api_page(site):
         page = site / 'api' / name / 'index.html'
         assert page.is_file(), f'no API page for lumpbeam_ros.{name}'
         assert f'id="lumpbeam_ros.{name}' in page.read_text(encoding='utf-8')
+
+
+@pytest.mark.parametrize('name', ['bench', 'camera', 'top_level'])
+def test_the_lab_has_its_api_pages(site, name):
+    page = site / 'api' / 'lab' / name / 'index.html'
+    assert page.is_file(), f'no API page for the lab: {name}'
+    anchor = 'lumpbeam_lab.doctor' if name == 'top_level' else f'lumpbeam_lab.{name}'
+    assert f'id="{anchor}' in page.read_text(encoding='utf-8')
 
 
 def test_every_doc_page_is_on_the_site(site):

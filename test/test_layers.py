@@ -1,9 +1,15 @@
-"""Layers point one way: core <- nodes, core <- cli, core <- demo (doc/architecture.md).
+"""Layers point one way: core <- nodes, core <- demo, core <- cli <- lab (doc/architecture.md).
 
-Two checks. Every core module is imported in a fresh interpreter whose import system refuses
-ROS, the upper layers and, per package, OpenCV and matplotlib, so an import that drags one of
-them in fails here. And the source of every module is read for the imports that only run
-later (inside functions), so a lazy import of ROS or of an upper layer is caught as well.
+The product (``lumpbeam_ros``) and the lab that proves it (``lumpbeam_lab``: benchmarks, the
+validation renderer, scoring against truth, the MCAP doctor) are separate packages: the lab
+may import the product, the product never the lab, except the commands that run it
+(``lumpbeam bench``, ``lumpbeam doctor``).
+
+Two checks. Every core module (and every ROS-free module of the lab) is imported in a fresh
+interpreter whose import system refuses ROS, the upper layers, the lab and, per package,
+OpenCV and matplotlib, so an import that drags one of them in fails here. And the source of
+every module of both packages is read for the imports that only run later (inside
+functions), so a lazy import of ROS, of an upper layer or of the lab is caught as well.
 """
 
 from __future__ import annotations
@@ -21,9 +27,13 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / 'lumpbeam_ros'
+LAB = ROOT / 'lumpbeam_lab'
 
 #: The layers above the core: they may import the core, the core never imports them.
-UPPER_LAYERS = ('nodes', 'cli', 'demo', 'bench')
+UPPER_LAYERS = ('nodes', 'cli', 'demo')
+
+#: What the core's imports refuse besides libraries: the product's upper layers and the lab.
+REFUSED_ABOVE = (*(f'lumpbeam_ros.{layer}' for layer in UPPER_LAYERS), 'lumpbeam_lab')
 
 #: Top-level names of ROS 2: the client library, its middleware and every interface package.
 _ROS = re.compile(
@@ -54,7 +64,6 @@ REFUSED: dict[str, frozenset[str]] = {
     '': frozenset({ROS, OPENCV, MATPLOTLIB}),  # the top-level modules (errors, paramfile, ...)
     'synthetic': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'synthetic.images': frozenset({ROS, MATPLOTLIB}),
-    'synthetic.raycast_camera': frozenset({ROS, MATPLOTLIB}),
     'vision': frozenset({ROS, MATPLOTLIB}),
     # The rig's configuration and the camera model: read by params, viz and the pose-only
     # synthetic drop test, which run without OpenCV.
@@ -65,6 +74,14 @@ REFUSED: dict[str, frozenset[str]] = {
     'vision.geometry': frozenset({ROS, OPENCV, MATPLOTLIB}),
     'plots': frozenset({ROS, OPENCV}),
     'report': frozenset({ROS, OPENCV}),
+}
+
+
+#: The lab's ROS-free modules, and what each may not need: the ray caster, the validation
+#: matrix and the scoring render and track frames with OpenCV; the doctor reads bytes.
+LAB_REFUSED: dict[str, frozenset[str]] = {
+    'lumpbeam_lab.camera': frozenset({ROS, MATPLOTLIB}),
+    'lumpbeam_lab.doctor': frozenset({ROS, OPENCV, MATPLOTLIB}),
 }
 
 
@@ -90,13 +107,34 @@ def _refusals(module: str) -> frozenset[str]:
     return REFUSED[relative]
 
 
-def _core_groups() -> dict[frozenset[str], list[str]]:
-    """The core's modules, grouped by what they may not import."""
-    groups: dict[frozenset[str], list[str]] = {}
+def _lab_modules(prefix: str) -> list[str]:
+    """Dotted names of the lab's modules under a dotted prefix (a package or a module)."""
+    path = ROOT.joinpath(*prefix.split('.'))
+    files = sorted(path.rglob('*.py')) if path.is_dir() else [path.with_suffix('.py')]
+    return [
+        '.'.join(f.relative_to(ROOT).with_suffix('').parts).removesuffix('.__init__')
+        for f in files
+    ]
+
+
+#: A group of modules imported together: the libraries and the packages they refuse.
+Group = tuple[frozenset[str], tuple[str, ...]]
+
+
+def _core_groups() -> dict[Group, list[str]]:
+    """The core's modules and the lab's ROS-free ones, grouped by what they may not import.
+
+    The core refuses the upper layers and the lab; the lab's ROS-free modules the product's
+    upper layers (they need the core only).
+    """
+    groups: dict[Group, list[str]] = {}
     packages = sorted({key.partition('.')[0] for key in REFUSED})
     for package in packages:
         for module in _modules(package):
-            groups.setdefault(_refusals(module), []).append(module)
+            groups.setdefault((_refusals(module), REFUSED_ABOVE), []).append(module)
+    upper = tuple(f'lumpbeam_ros.{layer}' for layer in UPPER_LAYERS)
+    for prefix, refused in LAB_REFUSED.items():
+        groups.setdefault((refused, upper), []).extend(_lab_modules(prefix))
     return groups
 
 
@@ -117,7 +155,7 @@ def is_refused(name):
         return True
     if top in refused:
         return True
-    return any(name == f'lumpbeam_ros.{u}' or name.startswith(f'lumpbeam_ros.{u}.') for u in upper)
+    return any(name == u or name.startswith(f'{u}.') for u in upper)
 
 
 class Refuse(importlib.abc.MetaPathFinder):
@@ -140,7 +178,7 @@ print(json.dumps({'already': already, 'failures': failures}))
 
 
 def _import_refusing(
-    refused: frozenset[str], modules: list[str], upper: tuple[str, ...] = UPPER_LAYERS
+    refused: frozenset[str], modules: list[str], upper: tuple[str, ...] = REFUSED_ABOVE
 ) -> dict[str, Any]:
     env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND='Agg')
     argument = json.dumps([sorted(refused), modules, list(upper)])
@@ -160,9 +198,14 @@ def _import_refusing(
 _GROUPS = _core_groups()
 
 
-@pytest.mark.parametrize('refused', list(_GROUPS), ids=lambda r: 'without-' + '-'.join(sorted(r)))
-def test_core_imports_without_refused_libraries(refused):
-    report = _import_refusing(refused, _GROUPS[refused])
+def _group_id(group: Group) -> str:
+    lab = '' if 'lumpbeam_lab' in group[1] else 'lab-'
+    return lab + 'without-' + '-'.join(sorted(group[0]))
+
+
+@pytest.mark.parametrize('group', list(_GROUPS), ids=_group_id)
+def test_core_imports_without_refused_libraries(group):
+    report = _import_refusing(group[0], _GROUPS[group], group[1])
     assert report['already'] == [], 'imported before the test could refuse them'
     assert report['failures'] == {}, '\n'.join(
         f'{m}: {why}' for m, why in report['failures'].items()
@@ -175,7 +218,8 @@ def test_core_imports_without_refused_libraries(refused):
         (frozenset({ROS}), (), 'lumpbeam_ros.nodes.recorder', 'rclpy'),
         (frozenset({OPENCV}), (), 'lumpbeam_ros.vision.detect', 'cv2'),
         (frozenset({MATPLOTLIB}), (), 'lumpbeam_ros.plots.analysis', 'matplotlib'),
-        (frozenset(), ('cli',), 'lumpbeam_ros.cli.output', 'lumpbeam_ros.cli'),
+        (frozenset(), ('lumpbeam_ros.cli',), 'lumpbeam_ros.cli.output', 'lumpbeam_ros.cli'),
+        (frozenset(), ('lumpbeam_lab',), 'lumpbeam_ros.cli.bench', 'lumpbeam_lab'),
     ],
 )
 def test_the_refusal_catches_what_it_refuses(refused, upper, module, blocked):
@@ -199,6 +243,8 @@ def _imported_names(path: Path) -> set[str]:
 
 def _layer(module: str) -> str:
     parts = module.split('.')
+    if parts[0] == 'lumpbeam_lab':
+        return 'lab'
     return parts[1] if len(parts) > 2 and parts[1] in UPPER_LAYERS else 'core'
 
 
@@ -207,19 +253,24 @@ def _layer(module: str) -> str:
 OPTIONAL_ROS = {'lumpbeam_ros.resources': {'ament_index_python.packages'}}
 
 #: Which layers each layer may import: the core none above it; the nodes and the demo the
-#: core (the demo starts nodes as processes, by name); the CLI and the benchmarks anything.
+#: core (the demo starts nodes as processes, by name); the CLI anything, the lab (for
+#: ``lumpbeam bench`` and ``lumpbeam doctor``) included; the lab anything of the product.
 ALLOWED = {
     'core': {'core'},
     'nodes': {'core', 'nodes'},
     'demo': {'core', 'demo', 'nodes'},
-    'cli': {'core', 'nodes', 'demo', 'cli', 'bench'},
-    'bench': {'core', 'nodes', 'demo', 'cli', 'bench'},
+    'cli': {'core', 'nodes', 'demo', 'cli', 'lab'},
+    'lab': {'core', 'nodes', 'demo', 'cli', 'lab'},
 }
+
+
+def _ours(name: str) -> bool:
+    return name.partition('.')[0] in {'lumpbeam_ros', 'lumpbeam_lab'}
 
 
 def _all_modules() -> list[tuple[str, Path]]:
     found = []
-    for path in sorted(PACKAGE.rglob('*.py')):
+    for path in sorted([*PACKAGE.rglob('*.py'), *LAB.rglob('*.py')]):
         parts = path.relative_to(ROOT).with_suffix('').parts
         found.append(('.'.join(parts).removesuffix('.__init__'), path))
     return found
@@ -230,9 +281,32 @@ def test_imports_point_down_the_layers(module, path):
     layer = _layer(module)
     wrong = []
     for name in sorted(_imported_names(path)):
-        if name.startswith('lumpbeam_ros.') and _layer(name) not in ALLOWED[layer]:
+        if _ours(name) and _layer(name) not in ALLOWED[layer]:
             wrong.append(f'{name} ({_layer(name)})')
         optional = name in OPTIONAL_ROS.get(module, set())
         if layer == 'core' and _ROS.match(name.partition('.')[0]) and not optional:
             wrong.append(f'{name} (ROS)')
     assert not wrong, f'{module} ({layer}) imports ' + ', '.join(wrong)
+
+
+@pytest.mark.parametrize(
+    ('module', 'layer'),
+    [
+        ('lumpbeam_ros.vision.tracker', 'core'),
+        ('lumpbeam_ros.nodes.camera_node', 'nodes'),
+        ('lumpbeam_ros.cli.bench', 'cli'),
+        ('lumpbeam_lab', 'lab'),
+        ('lumpbeam_lab.bench.runner', 'lab'),
+    ],
+)
+def test_each_module_is_in_its_layer(module, layer):
+    assert _layer(module) == layer
+
+
+def test_the_core_and_the_lab_are_both_read():
+    # The lab's imports are checked too, and the product's core never imports the lab.
+    modules = {m for m, _ in _all_modules()}
+    assert {'lumpbeam_lab.bench.runner', 'lumpbeam_lab.doctor'} <= modules
+    assert 'lab' not in ALLOWED['core'] | ALLOWED['nodes'] | ALLOWED['demo']
+    grouped = {m for ms in _GROUPS.values() for m in ms}
+    assert {'lumpbeam_lab.doctor', 'lumpbeam_lab.camera.raycast_camera'} <= grouped

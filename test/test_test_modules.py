@@ -30,6 +30,11 @@ def test_every_core_module_has_a_test_module_or_is_listed():
     )
 
 
+def test_every_ros_free_lab_module_has_a_test_module():
+    tool = _tool()
+    assert tool.missing_tests(ROOT, tool.LAB) == []
+
+
 def test_the_tool_finds_the_mirrored_path():
     tool = _tool()
     assert tool.mirror_test_path(Path('model/chain.py')) == Path('test/model/test_chain.py')
@@ -37,3 +42,16 @@ def test_the_tool_finds_the_mirrored_path():
     modules = {m.as_posix() for m in tool.core_modules(ROOT)}
     assert 'model/chain.py' in modules and 'nodes/recorder.py' not in modules
     assert not any(m.endswith('__init__.py') for m in modules)
+
+
+def test_the_lab_is_mirrored_under_test_lab():
+    tool = _tool()
+    assert tool.mirror_test_path(Path('camera/validation.py'), tool.LAB) == Path(
+        'test/lab/camera/test_validation.py'
+    )
+    assert tool.mirror_test_path(Path('doctor.py'), tool.LAB) == Path('test/lab/test_doctor.py')
+    modules = {m.as_posix() for m in tool.core_modules(ROOT, tool.LAB)}
+    assert {'doctor.py', 'camera/raycast_camera.py'} <= modules
+    assert not any(m.startswith('bench/') for m in modules)
+    core = {m.as_posix() for m in tool.core_modules(ROOT)}
+    assert 'bench/runner.py' not in core and 'vision/accuracy.py' not in core

@@ -1,16 +1,18 @@
-"""MkDocs hooks: the README is the site's home page, and every core package gets an API page.
+"""MkDocs hooks: the README is the site's home page; every core and lab package an API page.
 
 Both are derived, never written twice. The home page is README.md with its links into
 ``doc/`` made relative to the site (and the pages' links back to ``../README.md`` pointed at
 it), so the same Markdown reads right on a Git host and on the site. The API pages follow
 the core's package list in ``tools/test_modules.py``: a new core package gets its page
-without an edit here.
+without an edit here. The lab (``lumpbeam_lab``: benchmarks, validation, the MCAP doctor) gets
+a page per subpackage and one for its top-level modules, under their own heading.
 """
 
 from __future__ import annotations
 
 import importlib.util
 import re
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +22,7 @@ from mkdocs.structure.pages import Page
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = 'lumpbeam_ros'
+LAB = 'lumpbeam_lab'
 HOME = 'index.md'
 API_SECTION = 'API reference'
 
@@ -40,20 +43,33 @@ def core_packages() -> tuple[str, ...]:
     return tuple(module.CORE_PACKAGES)
 
 
-def top_level_modules() -> list[str]:
-    """The modules at the top of the package (errors, paramfile, ...), ``__init__`` aside."""
-    return sorted(p.stem for p in (ROOT / PACKAGE).glob('*.py') if p.stem != '__init__')
+def top_level_modules(package: str = PACKAGE) -> list[str]:
+    """The modules at the top of a package (errors, paramfile, ...), ``__init__`` aside."""
+    return sorted(p.stem for p in (ROOT / package).glob('*.py') if p.stem != '__init__')
+
+
+def lab_packages() -> list[str]:
+    """The lab's subpackages (each folder of ``lumpbeam_lab`` with an ``__init__.py``)."""
+    return sorted(p.parent.name for p in (ROOT / LAB).glob('*/__init__.py'))
+
+
+def _package_pages(package: str, names: Iterable[str], folder: str) -> dict[str, str]:
+    pages = {
+        f'{folder}/{name}.md': f'# `{package}.{name}`\n\n::: {package}.{name}\n' for name in names
+    }
+    modules = '\n'.join(f'::: {package}.{name}\n' for name in top_level_modules(package))
+    pages[f'{folder}/top_level.md'] = f'# Top-level modules of `{package}`\n\n{modules}'
+    return pages
 
 
 def api_pages() -> dict[str, str]:
     """Site path -> Markdown of each API page: one per core package, one for the top level."""
-    pages = {
-        f'api/{name}.md': f'# `{PACKAGE}.{name}`\n\n::: {PACKAGE}.{name}\n'
-        for name in core_packages()
-    }
-    modules = '\n'.join(f'::: {PACKAGE}.{name}\n' for name in top_level_modules())
-    pages['api/top_level.md'] = f'# Top-level modules\n\n{modules}'
-    return pages
+    return _package_pages(PACKAGE, core_packages(), 'api')
+
+
+def lab_api_pages() -> dict[str, str]:
+    """Site path -> Markdown of the lab's API pages (``api/lab/``)."""
+    return _package_pages(LAB, lab_packages(), 'api/lab')
 
 
 def _listed(nav: Any) -> set[str]:
@@ -78,7 +94,9 @@ def on_config(config: MkDocsConfig, **_: Any) -> MkDocsConfig:
     docs = Path(config.docs_dir)
     pages = (p.relative_to(docs).as_posix() for p in docs.rglob('*.md'))
     nav += sorted(page for page in pages if page not in listed | {HOME})
-    nav.append({API_SECTION: [{Path(path).stem: path} for path in api_pages()]})
+    product = [{Path(path).stem: path} for path in api_pages()]
+    lab = [{Path(path).stem: path} for path in lab_api_pages()]
+    nav.append({API_SECTION: [*product, {f'{LAB} (the lab)': lab}]})
     config.nav = nav
     return config
 
@@ -87,7 +105,7 @@ def on_files(files: Files, config: MkDocsConfig, **_: Any) -> Files:
     """Adds the generated pages: the home page from the README, and the API pages."""
     readme = (ROOT / 'README.md').read_text(encoding='utf-8')
     files.append(File.generated(config, HOME, content=_README_DOC_LINK.sub('](', readme)))
-    for path, content in api_pages().items():
+    for path, content in {**api_pages(), **lab_api_pages()}.items():
         files.append(File.generated(config, path, content=content))
     return files
 

@@ -1,8 +1,10 @@
 """Lists the core modules that have no test module of their own (test/<pkg>/test_<mod>.py).
 
 Usage: ``python tools/test_modules.py [REPO]``; prints the counts, then one missing module a
-line. The core is every package that imports no ROS (doc/architecture.md); the nodes, the CLI,
-the demo and the benchmarks are left out.
+line. The core is every package that imports no ROS (doc/architecture.md); the nodes, the CLI
+and the demo are left out. The lab (``lumpbeam_lab``) is held the same way for its ROS-free
+modules (its top-level modules and :data:`LAB_PACKAGES`), mirrored under ``test/lab/``; its
+benchmarks talk to rclpy and are left out like the nodes.
 """
 
 from __future__ import annotations
@@ -30,36 +32,52 @@ CORE_PACKAGES = (
 )
 
 
-def core_modules(repo: Path) -> list[Path]:
-    """The core's module files, relative to ``repo/lumpbeam_ros`` (no ``__init__.py``)."""
-    package = repo / 'lumpbeam_ros'
-    files = [p for p in package.glob('*.py')]
-    for name in CORE_PACKAGES:
-        files += (package / name).rglob('*.py')
-    return sorted(p.relative_to(package) for p in files if p.name != '__init__.py')
+#: The lab's ROS-free packages (beside its top-level modules): held like the core.
+LAB_PACKAGES = ('camera',)
+
+PRODUCT = 'lumpbeam_ros'
+LAB = 'lumpbeam_lab'
+
+#: Each package's checked subpackages and the folder under ``test/`` that mirrors it.
+PACKAGES = {PRODUCT: (CORE_PACKAGES, Path('test')), LAB: (LAB_PACKAGES, Path('test', 'lab'))}
 
 
-def mirror_test_path(module: Path) -> Path:
-    """Where a module's tests live: ``test/`` mirrors the package."""
-    return Path('test', *module.parts[:-1], f'test_{module.stem}.py')
+def core_modules(repo: Path, package: str = PRODUCT) -> list[Path]:
+    """The checked module files, relative to ``repo/<package>`` (no ``__init__.py``)."""
+    folder = repo / package
+    files = [p for p in folder.glob('*.py')]
+    for name in PACKAGES[package][0]:
+        files += (folder / name).rglob('*.py')
+    return sorted(p.relative_to(folder) for p in files if p.name != '__init__.py')
 
 
-def missing_tests(repo: Path) -> list[Path]:
-    """The core modules whose test module does not exist."""
-    return [m for m in core_modules(repo) if not (repo / mirror_test_path(m)).is_file()]
+def mirror_test_path(module: Path, package: str = PRODUCT) -> Path:
+    """Where a module's tests live: ``test/`` mirrors the product, ``test/lab/`` the lab."""
+    return Path(PACKAGES[package][1], *module.parts[:-1], f'test_{module.stem}.py')
+
+
+def missing_tests(repo: Path, package: str = PRODUCT) -> list[Path]:
+    """The checked modules of a package whose test module does not exist."""
+    return [
+        m
+        for m in core_modules(repo, package)
+        if not (repo / mirror_test_path(m, package)).is_file()
+    ]
 
 
 def main(argv: list[str]) -> int:
-    """Prints the counts and the modules without a test module."""
+    """Prints the counts and the modules without a test module, for the product and the lab."""
     repo = Path(argv[1]) if len(argv) > 1 else Path(__file__).resolve().parents[1]
-    modules = core_modules(repo)
-    missing = missing_tests(repo)
-    print(
-        f'core modules: {len(modules)}, with a test module: {len(modules) - len(missing)}, '
-        f'without: {len(missing)}'
-    )
-    for module in missing:
-        print(f'  lumpbeam_ros/{module.as_posix()}  (no {mirror_test_path(module).as_posix()})')
+    for package, label in ((PRODUCT, 'core'), (LAB, 'lab')):
+        modules = core_modules(repo, package)
+        missing = missing_tests(repo, package)
+        print(
+            f'{label} modules: {len(modules)}, with a test module: '
+            f'{len(modules) - len(missing)}, without: {len(missing)}'
+        )
+        for module in missing:
+            test = mirror_test_path(module, package).as_posix()
+            print(f'  {package}/{module.as_posix()}  (no {test})')
     return 0
 
 

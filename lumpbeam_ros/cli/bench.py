@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from lumpbeam_ros.bench.runner import available_suites, format_table, run_suites
+from lumpbeam_lab.bench.runner import available_suites, format_table, run_suites
 from lumpbeam_ros.cli.output import write_json
 from lumpbeam_ros.errors import LumpbeamError
 

@@ -17,7 +17,7 @@ def run(args: argparse.Namespace) -> int:
     Raises:
         BagError: A folder that is not a bag, or a file that cannot be opened.
     """
-    from lumpbeam_ros.bagio.doctor import examine_bag
+    from lumpbeam_lab.doctor import examine_bag
 
     unclean = 0
     for bag in args.bags:

@@ -25,8 +25,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from lumpbeam_lab.doctor import examine_bag
 from lumpbeam_ros.bagio import BagReader, repair_bag
-from lumpbeam_ros.bagio.doctor import examine_bag
 from lumpbeam_ros.diagnose.measurement import read_record
 from lumpbeam_ros.diagnose.workflow import diagnose
 from lumpbeam_ros.errors import LumpbeamError

@@ -1,4 +1,4 @@
-"""Every kind of bag the product writes passes the MCAP doctor (`bagio.doctor`) without a warning.
+"""Every kind of bag the product writes passes the MCAP doctor (`lumpbeam_lab.doctor`) cleanly.
 
 The live kinds are checked where they are made: a recording in test/cli/test_record.py, the
 demo's recorded and sim-time bags in test/cli/test_demo.py, a sim-time copy in

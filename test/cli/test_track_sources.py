@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from footage import PATTERNS, grey_scene_mosaic, write_calibration, write_timestamps, write_video
 
+from lumpbeam_lab.camera.accuracy import drop_test_trajectory, render_frames
 from lumpbeam_ros.bagio import BagReader, BagWriter, convert, read_camera_info, read_tip_poses
 from lumpbeam_ros.bagio.convert import seconds_to_ns
 from lumpbeam_ros.cli.main import main
-from lumpbeam_ros.vision.accuracy import drop_test_trajectory, render_frames
 from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.vision.messages import camera_info_to_data
 

@@ -13,11 +13,11 @@ from rclpy.qos import QoSProfile
 from sensor_msgs.msg import CameraInfo as CameraInfoMsg
 from sensor_msgs.msg import Image
 
+from lumpbeam_lab.camera.accuracy import drop_test_trajectory, render_frames
 from lumpbeam_ros.bagio import BagWriter, convert
 from lumpbeam_ros.bagio.typestore import serialize
 from lumpbeam_ros.errors import ConfigError, LumpbeamError
 from lumpbeam_ros.nodes.camera_node import CameraNode
-from lumpbeam_ros.vision.accuracy import drop_test_trajectory, render_frames
 from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.vision.messages import camera_info_to_data
 from lumpbeam_ros.vision.sources import FootageError

@@ -1,13 +1,13 @@
 import numpy as np
 import pytest
 
+from lumpbeam_lab.camera.accuracy import drop_test_trajectory
 from lumpbeam_ros.bagio import BagWriter, iter_images, read_camera_info, read_tip_poses
 from lumpbeam_ros.cli.main import main
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 from lumpbeam_ros.synthetic.images import ImageOptions, ImageStream, parse_image_size
-from lumpbeam_ros.vision.accuracy import drop_test_trajectory
 from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.vision.messages import camera_info_from_data
 from lumpbeam_ros.vision.synthetic import SyntheticCamera

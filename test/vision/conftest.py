@@ -7,8 +7,8 @@ import dataclasses
 import numpy as np
 import pytest
 
+from lumpbeam_lab.camera.accuracy import drop_test_trajectory
 from lumpbeam_ros.model.trajectory import TipTrajectory
-from lumpbeam_ros.vision.accuracy import drop_test_trajectory
 from lumpbeam_ros.vision.config import CameraConfig, load_camera_config
 
 

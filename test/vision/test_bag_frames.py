@@ -3,9 +3,9 @@ import dataclasses
 import numpy as np
 import pytest
 
+from lumpbeam_lab.camera.accuracy import render_frames
 from lumpbeam_ros.bagio import BagReader, BagWriter, convert
 from lumpbeam_ros.interface import CAMERA_INFO, IMAGE, IMAGE_TYPE, TIP_LOAD
-from lumpbeam_ros.vision.accuracy import render_frames
 from lumpbeam_ros.vision.bag_frames import bag_frames
 from lumpbeam_ros.vision.messages import camera_info_to_data
 from lumpbeam_ros.vision.session import TrackingSession

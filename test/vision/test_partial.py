@@ -109,7 +109,7 @@ def _blob(image, centre, axes, value):
 
 @pytest.fixture(scope='module')
 def drop_frames(config, drop_test):
-    from lumpbeam_ros.vision.accuracy import render_frames
+    from lumpbeam_lab.camera.accuracy import render_frames
 
     return render_frames(config, drop_test.between(1.95, 2.3), 40)
 

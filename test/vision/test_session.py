@@ -6,9 +6,9 @@ import math
 import numpy as np
 import pytest
 
+from lumpbeam_lab.camera.accuracy import render_frames
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.interface import COMPRESSED_IMAGE_TYPE
-from lumpbeam_ros.vision.accuracy import render_frames
 from lumpbeam_ros.vision.session import SessionStats, TrackingSession
 from lumpbeam_ros.vision.tracker import TrackStatus
 

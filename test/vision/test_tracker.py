@@ -4,7 +4,7 @@ import cv2
 import numpy as np
 import pytest
 
-from lumpbeam_ros.vision.accuracy import render_frames, tracker_config
+from lumpbeam_lab.camera.accuracy import render_frames, tracker_config
 from lumpbeam_ros.vision.pose import PlaneModel
 from lumpbeam_ros.vision.tracker import TipTracker, TrackStatus
 

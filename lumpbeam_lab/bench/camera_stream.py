@@ -1,0 +1,373 @@
+"""End to end through ROS topics: a camera publisher process, the camera node in another.
+
+The publisher offers ``/camera/image_raw`` (mono8) and ``/camera/camera_info`` at a fixed
+rate, stamped with the wall clock at publication; the bench process subscribes to
+``/tip_pose`` and takes, per pose, receive time minus image stamp (same machine, same
+clock) as the latency. The baseline is an echo node in the same position: it decodes each
+image and publishes a pose with its stamp, without tracking, so the ratio shows what the
+tracking costs on top of the transport.
+
+Fast DDS's default shared-memory segment (512 kB) is smaller than a 1 MB frame, and the UDP
+fallback drops most of a 180 fps stream of them; :data:`LARGE_FRAMES_PROFILE` gives the
+processes a 32 MB segment. The bench runs both transports and reports both.
+
+Run as ``python -m lumpbeam_lab.bench.camera_stream publish|echo ...`` for the processes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from lumpbeam_ros.interface import (
+    BASE_FRAME,
+    BEAM_PARAMS,
+    CAMERA_FRAME,
+    CAMERA_INFO,
+    IMAGE,
+    TIP_POSE,
+)
+from lumpbeam_ros.resources import large_frames_profile
+from lumpbeam_ros.ros_domain import claim_domain_id
+
+#: Longest wait for the consumer processes to start and be discovered, s (a node importing
+#: OpenCV and scipy on a busy machine takes a while).
+STARTUP_TIMEOUT_S = 60.0
+
+
+@dataclass(frozen=True)
+class StreamFigures:
+    """One run: what was offered and what came back.
+
+    Attributes:
+        published: Images published.
+        received: Poses received.
+        duration_s: Publishing time, s.
+        latency_ms: Per received pose, receive time minus image stamp, ms.
+        params_latency_ms: Per ``/beam_params`` message with a newer frame than the message
+            before it (when an identifier node runs), its publication stamp minus the stamp
+            of the newest frame in its window (``window_end_s``), ms.
+        params_repeated: ``/beam_params`` messages whose window had no newer frame: their
+            age measures a pause in the poses (the stream's end, a stalled camera), not the
+            chain, so they are counted here and not timed.
+    """
+
+    published: int
+    received: int
+    duration_s: float
+    latency_ms: np.ndarray
+    params_latency_ms: np.ndarray = field(default_factory=lambda: np.empty(0))
+    params_repeated: int = 0
+
+    def percentile_ms(self, q: float) -> float:
+        """A latency percentile, ms (NaN without poses)."""
+        return float(np.percentile(self.latency_ms, q)) if self.latency_ms.size else float('nan')
+
+
+#: Fast DDS profile: shared memory with a 32 MB segment, UDP beside it.
+LARGE_FRAMES_PROFILE = large_frames_profile()
+
+
+def _env(domain_id: int, large_frames: bool) -> dict[str, str]:
+    env = dict(os.environ)
+    env.pop('FASTRTPS_DEFAULT_PROFILES_FILE', None)
+    if large_frames:
+        env['FASTRTPS_DEFAULT_PROFILES_FILE'] = str(LARGE_FRAMES_PROFILE)
+    root = Path.cwd() / '.cache' / 'ros'
+    env.update(
+        ROS_DOMAIN_ID=str(domain_id),
+        ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
+        ROS_LOG_DIR=str(root / 'log'),
+        ROS_HOME=str(root),
+    )
+    return env
+
+
+def _frames(width: int, height: int) -> list[np.ndarray]:
+    """A half swing of the drop test, extreme to extreme, played forth and back.
+
+    The tip is at rest at both ends, so the loop never jumps: the tracker tracks it as it
+    would a real oscillation.
+    """
+    from lumpbeam_lab.camera.accuracy import drop_test_trajectory, render_frames
+    from lumpbeam_ros.vision.config import load_camera_config
+
+    trajectory = drop_test_trajectory()
+    after = trajectory.between(4.0, 5.0)
+    top = int(np.argmax(after.z))
+    bottom = top + int(np.argmin(after.z[top : top + 40]))
+    config = load_camera_config().with_resolution(width, height)
+    swing = render_frames(config, after.between(after.t[top], after.t[bottom] + 1e-6))
+    images = [f.image for f in swing]
+    return images + images[-2:0:-1]
+
+
+def publish(width: int, height: int, rate_hz: float, duration_s: float) -> int:
+    """The publisher process: offers frames at ``rate_hz`` and prints what it published."""
+    import rclpy
+    from sensor_msgs.msg import CameraInfo, Image
+
+    from lumpbeam_ros.bagio import convert
+    from lumpbeam_ros.bagio.typestore import serialize
+    from lumpbeam_ros.nodes.endpoints import publisher
+    from lumpbeam_ros.vision.config import load_camera_config
+    from lumpbeam_ros.vision.messages import camera_info_to_data
+
+    # Serialized once; only the stamp (bytes 4..12, after the CDR header) changes.
+    messages = [
+        bytearray(serialize(convert.image(0, im, CAMERA_FRAME))) for im in _frames(width, height)
+    ]
+    info = load_camera_config().with_resolution(width, height).camera_info
+    info_message = bytearray(serialize(convert.camera_info(0, camera_info_to_data(info))))
+    rclpy.init()
+    node = rclpy.create_node('bench_camera')
+    images = publisher(node, Image, IMAGE)
+    infos = publisher(node, CameraInfo, CAMERA_INFO)
+    deadline = time.monotonic() + 20.0
+    while images.get_subscription_count() < 1 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.5)  # let the subscriber's side of discovery settle too
+    period = 1.0 / rate_hz
+    count = int(round(duration_s * rate_hz))
+    start = time.perf_counter()
+    for i in range(count):
+        delay = start + i * period - time.perf_counter()
+        if delay > 0:
+            time.sleep(delay)
+        sec, nanosec = divmod(time.time_ns(), 1_000_000_000)
+        stamp = int(sec).to_bytes(4, 'little') + int(nanosec).to_bytes(4, 'little')
+        message = messages[i % len(messages)]
+        message[4:12] = stamp
+        info_message[4:12] = stamp
+        infos.publish(bytes(info_message))
+        images.publish(bytes(message))
+    elapsed = time.perf_counter() - start
+    print(json.dumps({'published': count, 'duration_s': elapsed}), flush=True)
+    node.destroy_node()
+    rclpy.shutdown()
+    return 0
+
+
+def echo() -> int:
+    """The baseline process: decode each image, publish a pose with its stamp, no tracking."""
+    import rclpy
+    from geometry_msgs.msg import PoseStamped
+    from sensor_msgs.msg import Image
+
+    from lumpbeam_ros.nodes.endpoints import publisher, subscription
+    from lumpbeam_ros.vision.messages import decode_image
+
+    rclpy.init()
+    node = rclpy.create_node('bench_echo')
+    poses = publisher(node, PoseStamped, TIP_POSE)
+
+    def on_image(data: bytes) -> None:
+        frame = decode_image(data)
+        msg = PoseStamped()
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(frame.stamp_ns, 1_000_000_000)
+        msg.header.frame_id = BASE_FRAME
+        poses.publish(msg)
+
+    subscription(node, Image, IMAGE, on_image, raw=True)
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
+        pass
+    return 0
+
+
+class ParamsAges:
+    """The age of each ``/beam_params`` message that brings a newer frame than the last.
+
+    The identifier publishes on a timer, so while no pose comes in (the stream has ended, the
+    camera stalled) it repeats the same window, and that message's age grows with the pause,
+    not with the chain's latency: such messages are counted, not timed.
+
+    Attributes:
+        latencies_ms: Per timed message, its publication stamp minus the stamp of the newest
+            frame in its window, ms.
+        repeated: Messages whose newest frame was not newer than the last timed one's.
+    """
+
+    def __init__(self) -> None:
+        self.latencies_ms: list[float] = []
+        self.repeated = 0
+        self._newest_s = -math.inf
+
+    def add(self, published_ns: int, window_end_s: float) -> None:
+        """Takes one message.
+
+        Args:
+            published_ns: Its header stamp, ns.
+            window_end_s: The stamp of the newest frame in its window (``window_end_s``), s;
+                a message without one (NaN: no window yet) is ignored.
+        """
+        if not math.isfinite(window_end_s):
+            return
+        if window_end_s <= self._newest_s:
+            self.repeated += 1
+            return
+        self._newest_s = window_end_s
+        self.latencies_ms.append(published_ns * 1e-6 - window_end_s * 1e3)
+
+
+def measure(
+    consumer: Sequence[str],
+    width: int,
+    height: int,
+    rate_hz: float,
+    duration_s: float,
+    large_frames: bool = True,
+    downstream: Sequence[str] = (),
+) -> StreamFigures:
+    """Runs a consumer process (the camera node or the echo) against the publisher process.
+
+    Args:
+        consumer: The consumer's command line.
+        width: Image width, px.
+        height: Image height, px.
+        rate_hz: Offered frame rate, Hz.
+        duration_s: Publishing time, s.
+        large_frames: Give the publisher and the consumer :data:`LARGE_FRAMES_PROFILE`.
+        downstream: A process fed by the consumer that publishes ``/beam_params`` (the
+            identifier node); empty for none.
+
+    Returns:
+        The figures.
+
+    Raises:
+        RuntimeError: A process failed or discovery never completed.
+    """
+    import rclpy
+    from diagnostic_msgs.msg import DiagnosticArray
+    from geometry_msgs.msg import PoseStamped
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+
+    from lumpbeam_ros.nodes.endpoints import subscription
+
+    claim = claim_domain_id()  # held until every process of the run is gone
+    domain = claim.domain_id
+    env = _env(domain, large_frames)
+    context = Context()
+    rclpy.init(context=context, domain_id=domain)
+    node = rclpy.create_node('bench_sink', context=context)
+    latencies: list[float] = []
+
+    def on_pose(msg: PoseStamped) -> None:
+        stamp_ns = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+        latencies.append((time.time_ns() - stamp_ns) * 1e-6)
+
+    params = ParamsAges()
+
+    def on_params(msg: DiagnosticArray) -> None:
+        published_ns = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+        for status in msg.status:
+            values = {kv.key: kv.value for kv in status.values}
+            try:
+                params.add(published_ns, float(values['window_end_s']))
+            except (KeyError, ValueError):
+                continue
+
+    subscription(node, PoseStamped, TIP_POSE, on_pose)
+    subscription(node, DiagnosticArray, BEAM_PARAMS, on_params)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    stop = threading.Event()
+
+    def spin() -> None:
+        while not stop.is_set():
+            executor.spin_once(timeout_sec=0.05)
+
+    spinner = threading.Thread(target=spin, daemon=True)
+    spinner.start()
+    processes = []
+    try:
+        processes.append(subprocess.Popen(consumer, env=env, stdout=subprocess.DEVNULL))
+        if downstream:
+            processes.append(subprocess.Popen(downstream, env=env, stdout=subprocess.DEVNULL))
+        deadline = time.monotonic() + STARTUP_TIMEOUT_S
+        wanted = [TIP_POSE, BEAM_PARAMS] if downstream else [TIP_POSE]
+        while unheard := [t for t in wanted if node.count_publishers(t) < 1]:
+            if time.monotonic() > deadline or any(p.poll() is not None for p in processes):
+                raise RuntimeError(f'no publisher of {", ".join(unheard)} appeared')
+            time.sleep(0.05)
+        args = ['publish', str(width), str(height), str(rate_hz), str(duration_s)]
+        publisher = subprocess.Popen(
+            [sys.executable, '-m', __name__, *args], env=env, stdout=subprocess.PIPE, text=True
+        )
+        processes.append(publisher)
+        out, _ = publisher.communicate(timeout=duration_s + 60.0)
+        if publisher.returncode != 0:
+            raise RuntimeError(f'publisher exited with {publisher.returncode}')
+        result = json.loads(out.strip().splitlines()[-1])
+        time.sleep(0.5)  # the last frames in flight
+    finally:
+        for process in processes:
+            if process.poll() is None:
+                process.terminate()
+                try:
+                    process.wait(timeout=10.0)
+                except subprocess.TimeoutExpired:
+                    process.kill()
+        stop.set()
+        spinner.join(timeout=5.0)
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.shutdown(context=context)
+        claim.release()
+    return StreamFigures(
+        int(result['published']),
+        len(latencies),
+        float(result['duration_s']),
+        np.array(latencies),
+        np.array(params.latencies_ms),
+        params.repeated,
+    )
+
+
+def camera_node_command() -> list[str]:
+    """The camera node as a process, taking its intrinsics from the stream."""
+    return [sys.executable, '-m', 'lumpbeam_ros.nodes.camera_node']
+
+
+def identifier_command(publish_rate_hz: float) -> list[str]:
+    """The identifier node as a process, on wall time, publishing at ``publish_rate_hz``."""
+    from lumpbeam_ros.demo.graph import node_command
+
+    return node_command(
+        'lumpbeam_ros.nodes.identifier_node', '-p', f'publish_rate_hz:={publish_rate_hz}'
+    )
+
+
+def echo_command() -> list[str]:
+    """The echo baseline as a process."""
+    return [sys.executable, '-m', __name__, 'echo']
+
+
+def _main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog='camera_stream')
+    sub = parser.add_subparsers(dest='role', required=True)
+    pub = sub.add_parser('publish')
+    for name, kind in (('width', int), ('height', int), ('rate', float), ('duration', float)):
+        pub.add_argument(name, type=kind)
+    sub.add_parser('echo')
+    args = parser.parse_args(argv)
+    if args.role == 'echo':
+        return echo()
+    return publish(args.width, args.height, args.rate, args.duration)
+
+
+if __name__ == '__main__':
+    sys.exit(_main())

@@ -1,0 +1,86 @@
+"""Input shaping: a 10,000-point trajectory shaped, against ``scipy.signal.fftconvolve``.
+
+Ours sums one linear interpolation of each joint per impulse
+(:func:`~lumpbeam_ros.shaping.apply.shape_trajectory`). The baseline convolves the same 1 kHz
+samples, held at their last value for the shaper's duration, with the impulse train placed
+on the nearest 1 kHz sample (so it differs from ours by the impulses' rounding, reported as
+``max_difference_rad``). Both are timed per joint, best of several runs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.signal import fftconvolve
+
+from lumpbeam_lab.bench.bench_result import BenchResult, best_time
+from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
+from lumpbeam_ros.shaping.apply import shape_trajectory
+from lumpbeam_ros.shaping.impulses import Impulses, Mode
+from lumpbeam_ros.shaping.shapers import design_shaper
+
+BASELINE = 'scipy.signal.fftconvolve'
+STEP_S = 1e-3
+JOINTS = 3
+
+
+def _trajectory(points: int) -> JointTrajectory:
+    """A 1 kHz trajectory of ``points`` samples: three joints in smooth back-and-forth moves."""
+    t = np.arange(points) * STEP_S
+    phase = 2 * np.pi * t / t[-1]
+    angles = np.column_stack([np.sin(k * phase) * (1 - np.cos(phase)) / k for k in (1, 2, 3)])
+    return JointTrajectory(t, angles)
+
+
+def _fft_shaped(trajectory: JointTrajectory, impulses: Impulses) -> np.ndarray:
+    """The baseline: each joint convolved with the impulse train on the 1 kHz grid."""
+    index = np.rint(impulses.time_s / STEP_S).astype(int)
+    train = np.zeros(index[-1] + 1)
+    np.add.at(train, index, impulses.amplitude)
+    held = np.concatenate(
+        [trajectory.angles_rad, np.repeat(trajectory.angles_rad[-1:], index[-1], axis=0)]
+    )
+    count = held.shape[0]
+    return np.column_stack([fftconvolve(column, train)[:count] for column in held.T])
+
+
+def shaping_speed(name: str, modes: list[Mode], points: int, repeat: int) -> BenchResult:
+    """Shapes a ``points``-sample trajectory for ``modes`` (ZVD); the time per joint."""
+    trajectory = _trajectory(points)
+    impulses = design_shaper('zvd', modes)
+    ours, shaped = best_time(lambda: shape_trajectory(trajectory, impulses), repeat)
+    theirs, baseline = best_time(lambda: _fft_shaped(trajectory, impulses), repeat)
+    rows = min(shaped.time_s.size, baseline.shape[0])
+    value, baseline_value = ours / JOINTS * 1e3, theirs / JOINTS * 1e3
+    return BenchResult(
+        name=name,
+        value=value,
+        unit='ms per joint',
+        baseline=BASELINE,
+        baseline_value=baseline_value,
+        ratio=baseline_value / value,
+        details={
+            'points': points,
+            'joints': JOINTS,
+            'impulses': int(impulses.time_s.size),
+            'shaped_samples': int(shaped.time_s.size),
+            'max_difference_rad': float(np.abs(shaped.angles_rad[:rows] - baseline[:rows]).max()),
+        },
+    )
+
+
+def run(quick: bool = False) -> list[BenchResult]:
+    """Runs the shaping suite.
+
+    Args:
+        quick: 1,000 points, one run each.
+
+    Returns:
+        A ZVD shaper for one mode (3 impulses), then for two modes (9 impulses).
+    """
+    points, repeat = (1_000, 1) if quick else (10_000, 20)
+    one = [Mode(2.0, 0.02)]
+    two = [Mode(2.0, 0.02), Mode(7.3, 0.03)]
+    return [
+        shaping_speed(f'shape_zvd_1mode_{points}pts', one, points, repeat),
+        shaping_speed(f'shape_zvd_2modes_{points}pts', two, points, repeat),
+    ]

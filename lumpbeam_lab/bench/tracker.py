@@ -1,0 +1,261 @@
+"""Tracker speed and accuracy against per-frame full detection, on the same frames.
+
+Frames are rendered first; only the tracking is timed, on one OpenCV thread. The baseline is
+what a calibration script does to every frame: ``findChessboardCorners`` on the full image,
+``cornerSubPix`` with the usual 11 x 11 window, and a free 6-DoF ``solvePnP``.
+
+Accuracy is scored on the model's whole drop test (every frame; every 20th in quick mode),
+and the camera node is run end to end through ROS topics between processes
+(:mod:`lumpbeam_lab.bench.camera_stream`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import replace
+
+import cv2
+import numpy as np
+
+from lumpbeam_lab.bench import camera_stream
+from lumpbeam_lab.bench.bench_result import BenchResult
+from lumpbeam_lab.camera.accuracy import (
+    drop_test_trajectory,
+    measure_accuracy,
+    render_frames,
+    tracker_config,
+)
+from lumpbeam_ros.vision.config import CameraConfig, load_camera_config
+from lumpbeam_ros.vision.pose import tip_pose_from_board_pose
+from lumpbeam_ros.vision.synthetic import SyntheticFrame
+from lumpbeam_ros.vision.tracker import TipTracker, TrackResult
+
+_BASELINE = 'findChessboardCorners + cornerSubPix + solvePnP per frame'
+
+
+#: The speed target of the 2048 x 2048 row with a distorting lens: frames per second and
+#: times the baseline's.
+TARGET_FPS = 180.0
+TARGET_RATIO = 10.0
+
+
+def _track_pass(
+    tracker: TipTracker, frames: Sequence[SyntheticFrame], offset: float
+) -> tuple[float, float, list[TrackResult]]:
+    """One timed pass from a cold start: wall time, s, CPU time, s, and the results."""
+    tracker.reset()
+    cpu = time.process_time()
+    start = time.perf_counter()
+    results = [tracker.process(f.image, f.stamp + offset) for f in frames]
+    return time.perf_counter() - start, time.process_time() - cpu, results
+
+
+def _baseline_pass(
+    frames: Sequence[SyntheticFrame], config: CameraConfig
+) -> tuple[float, float, list[np.ndarray | None]]:
+    """One timed pass of the baseline: wall time, s, CPU time, s, and the free poses."""
+    board = config.rig.board
+    objects = board.object_points()
+    k = config.camera_info.k
+    d = config.camera_info.d
+    criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_MAX_ITER, 30, 0.001)
+    flags = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
+    poses: list[np.ndarray | None] = []
+    cpu = time.process_time()
+    start = time.perf_counter()
+    for frame in frames:
+        found, corners = cv2.findChessboardCorners(frame.image, board.pattern_size, flags=flags)
+        if not found:
+            poses.append(None)
+            continue
+        corners = cv2.cornerSubPix(frame.image, corners, (11, 11), (-1, -1), criteria)
+        ok, rvec, tvec = cv2.solvePnP(objects, corners, k, d)
+        poses.append(np.hstack([rvec.ravel(), tvec.ravel()]) if ok else None)
+    return time.perf_counter() - start, time.process_time() - cpu, poses
+
+
+def _baseline_z_rms_um(
+    poses: Sequence[np.ndarray | None], frames: Sequence[SyntheticFrame], config: CameraConfig
+) -> float:
+    """z RMS error (bias in) of free PnP, each frame converted with the true rig."""
+    from lumpbeam_ros.vision.geometry import Transform
+
+    errors = []
+    for pose, frame in zip(poses, frames, strict=True):
+        if pose is None:
+            continue
+        camera_board = Transform(cv2.Rodrigues(pose[:3])[0], pose[3:])
+        errors.append(tip_pose_from_board_pose(config.rig, camera_board)[1] - frame.truth[1])
+    return float(np.sqrt(np.mean(np.square(errors))) * 1e6) if errors else float('nan')
+
+
+#: A modest plumb_bob lens for the speed rows with distortion on.
+LENS_DISTORTION = (-0.08, 0.02, 5e-4, -5e-4, 0.0)
+
+
+def speed(
+    width: int,
+    height: int,
+    n_frames: int,
+    repeat: int,
+    distortion: tuple[float, ...] = (0.0,) * 5,
+) -> BenchResult:
+    """In-process tracker fps against per-frame full detection, from just before the release.
+
+    Args:
+        width: Image width, px.
+        height: Image height, px.
+        n_frames: Frames held in memory and timed.
+        repeat: Timed passes (the fastest counts).
+        distortion: plumb_bob coefficients of the lens (rendered and given to both sides).
+
+    Returns:
+        The result; details hold both sides' CPU time per frame (of their fastest passes)
+        and z RMS error on the same frames and, with a lens, whether the speed target
+        (:data:`TARGET_FPS` and :data:`TARGET_RATIO`) is met.
+    """
+    config = load_camera_config().with_resolution(width, height)
+    config = replace(config, camera_info=replace(config.camera_info, d=np.asarray(distortion)))
+    trajectory = drop_test_trajectory().between(1.9, 12.0)
+    frames = render_frames(config, trajectory, n_frames)
+    threads = cv2.getNumThreads()
+    cv2.setNumThreads(1)
+    try:
+        tracker = TipTracker(config.camera_info, tracker_config(config))
+        # The first pass calibrates the rig; the timed passes then run the calibrated
+        # tracker from a cold start (full detection on frame 1).
+        duration = frames[-1].stamp - frames[0].stamp + 1.0
+        _, _, first = _track_pass(tracker, frames, 0.0)
+        passes = [_track_pass(tracker, frames, duration * (i + 1))[:2] for i in range(repeat)]
+        baseline_passes = []
+        for _ in range(max(1, repeat - 1)):
+            elapsed, cpu, baseline_poses = _baseline_pass(frames, config)
+            baseline_passes.append((elapsed, cpu))
+    finally:
+        cv2.setNumThreads(threads)
+    fps = n_frames / min(t for t, _ in passes)
+    baseline_fps = n_frames / min(t for t, _ in baseline_passes)
+    cpu_ms = 1e3 * min(c for _, c in passes) / n_frames
+    baseline_cpu_ms = 1e3 * min(c for _, c in baseline_passes) / n_frames
+    z_error = [r.pose[1] - f.truth[1] for r, f in zip(first, frames, strict=True) if r.ok]
+    details: dict[str, object] = {
+        'frames': n_frames,
+        'frames_lost': sum(not r.ok for r in first),
+        'z_rms_um': float(np.sqrt(np.mean(np.square(z_error))) * 1e6),
+        'baseline_frames_found': sum(p is not None for p in baseline_poses),
+        'baseline_z_rms_um': _baseline_z_rms_um(baseline_poses, frames, config),
+        'cpu_ms_per_frame': cpu_ms,
+        'baseline_cpu_ms_per_frame': baseline_cpu_ms,
+        'cpu_ratio': baseline_cpu_ms / cpu_ms,
+    }
+    lens = '_distorted' if any(distortion) else ''
+    if lens:
+        met = fps >= TARGET_FPS and fps / baseline_fps >= TARGET_RATIO
+        details['target'] = (
+            f'{"pass" if met else "FAIL"} (>= {TARGET_FPS:g} fps and >= {TARGET_RATIO:g}x)'
+        )
+    return BenchResult(
+        f'tracker_fps_{width}x{height}{lens}', fps, 'frames/s', _BASELINE, baseline_fps,
+        fps / baseline_fps, details,
+    )  # fmt: skip
+
+
+def accuracy(width: int, height: int, frame_step: int) -> BenchResult:
+    """z RMS error (every pose, bias in) on the drop test, against the 10 um target."""
+    report = measure_accuracy(width, height, frame_step=frame_step)
+    details = {
+        'frames': report.frames,
+        'frame_step': frame_step,
+        'frames_lost': report.frames_lost,
+        'frames_calibrating (scored)': report.frames_calibrating,
+        'z_bias_um': report.z_um.bias,
+        'z_std_um': report.z_um.std,
+        'z_p99_um': report.z_um.p99,
+        'z_max_um': report.z_um.max,
+        'x_rms_um': report.x_um.rms,
+        'pitch_rms_mrad': report.pitch_mrad.rms,
+        'z_sigma_claimed_um': report.z_sigma_um,
+        'within_1sigma': report.within_1sigma,
+    }
+    return BenchResult(
+        f'tracker_z_rms_{width}x{height}', report.z_rms_um, 'um', 'target 10 um', 10.0,
+        10.0 / report.z_rms_um, details,
+    )  # fmt: skip
+
+
+def end_to_end(
+    width: int, height: int, rate_hz: float, duration_s: float, default_transport: bool = True
+) -> list[BenchResult]:
+    """The camera node in its own process against an echo node.
+
+    Args:
+        width: Image width, px.
+        height: Image height, px.
+        rate_hz: Offered frame rate, Hz.
+        duration_s: Publishing time, s.
+        default_transport: Also run with Fast DDS's default transports (after the 32 MB
+            shared-memory profile).
+
+    Returns:
+        One result per transport.
+    """
+    results = []
+    transports = ((True, 'shm32mb'), (False, 'default'))
+    for large, label in transports if default_transport else transports[:1]:
+        node = camera_stream.measure(
+            camera_stream.camera_node_command(), width, height, rate_hz, duration_s, large
+        )
+        echo = camera_stream.measure(
+            camera_stream.echo_command(), width, height, rate_hz, duration_s, large
+        )
+        value = node.received / node.duration_s
+        baseline = echo.received / echo.duration_s
+        details = {
+            'offered_fps': rate_hz,
+            'published': node.published,
+            'poses_received': node.received,
+            'latency_p50_ms': node.percentile_ms(50),
+            'latency_p99_ms': node.percentile_ms(99),
+            'echo_published': echo.published,
+            'echo_received': echo.received,
+            'echo_latency_p50_ms': echo.percentile_ms(50),
+            'echo_latency_p99_ms': echo.percentile_ms(99),
+        }
+        results.append(
+            BenchResult(
+                f'camera_node_e2e_{width}x{height}_{label}',
+                value,
+                'poses/s',
+                'echo node: decode + publish, no tracking',
+                baseline,
+                value / baseline if baseline > 0 else float('nan'),
+                details,
+            )  # fmt: skip
+        )
+    return results
+
+
+def run(quick: bool) -> list[BenchResult]:
+    """Runs the suite.
+
+    Args:
+        quick: A smoke test: 640 x 480, 45 timed frames, every 20th frame scored, 1 s of
+            320 x 240 end to end (shared memory only).
+
+    Returns:
+        Speed at 2048 x 2048 with a distorting lens, and without at 2048, 1024 and 640,
+        accuracy at the three sizes on the whole
+        drop test, then the end-to-end figures at 1024 x 1024 offered at 180 fps.
+    """
+    if quick:
+        return [
+            speed(640, 480, 45, repeat=2, distortion=LENS_DISTORTION),
+            accuracy(640, 480, frame_step=20),
+            *end_to_end(320, 240, 180.0, 1.0, default_transport=False),
+        ]
+    results = [speed(2048, 2048, 150, repeat=5, distortion=LENS_DISTORTION)]
+    results += [speed(w, h, 150, repeat=3) for w, h in ((2048, 2048), (1024, 1024), (640, 480))]
+    results += [accuracy(w, h, 1) for w, h in ((2048, 2048), (1024, 1024), (640, 480))]
+    results += end_to_end(1024, 1024, 180.0, 4.0)
+    return results

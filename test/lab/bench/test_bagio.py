@@ -1,0 +1,12 @@
+from lumpbeam_lab.bench import bagio
+
+
+def test_quick_run_reports_both_figures():
+    write, play = bagio.run(quick=True)
+    assert write.name == 'bag_write_1mp_180fps' and write.unit == 'MB/s'
+    assert write.details['messages_written'] == 72 and write.details['dropped'] == 0
+    assert write.value > 0 and write.baseline_value > 0
+    assert write.ratio == write.value / write.baseline_value
+    assert play.name == 'play_timing_p99' and play.unit == 'ms'
+    assert play.details['messages'] == 180  # 90 poses and 90 /clock ticks
+    assert 0 <= play.details['p50_ms'] <= play.value <= play.details['max_ms']

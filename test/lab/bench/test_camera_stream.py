@@ -1,0 +1,34 @@
+"""ParamsAges: which /beam_params messages time the chain, and their ages."""
+
+import math
+
+import pytest
+
+from lumpbeam_lab.bench.camera_stream import ParamsAges
+
+
+def _ages(messages):
+    ages = ParamsAges()
+    for published_s, window_end_s in messages:
+        ages.add(round(published_s * 1e9), window_end_s)
+    return ages
+
+
+def test_each_newer_frame_is_timed_from_its_stamp():
+    ages = _ages([(1.010, 1.000), (1.112, 1.100), (1.215, 1.200)])
+    assert ages.latencies_ms == pytest.approx([10.0, 12.0, 15.0])
+    assert ages.repeated == 0
+
+
+def test_a_window_repeated_while_no_pose_comes_is_counted_not_timed():
+    # The stream ended at 2.0 s; the timer goes on publishing the same window at 10 Hz.
+    ages = _ages([(2.010, 2.000), (2.110, 2.000), (2.210, 2.000), (2.310, 1.995)])
+    assert ages.latencies_ms == pytest.approx([10.0])
+    assert ages.repeated == 3
+
+
+@pytest.mark.parametrize('window_end_s', [math.nan, math.inf, -math.inf])
+def test_a_message_without_a_window_is_ignored(window_end_s):
+    ages = _ages([(1.0, window_end_s), (1.2, 1.19)])
+    assert ages.latencies_ms == pytest.approx([10.0])
+    assert ages.repeated == 0

@@ -1,0 +1,24 @@
+from lumpbeam_lab.bench import cli
+from lumpbeam_lab.bench.runner import available_suites
+from lumpbeam_ros.cli.main import main
+
+
+def test_quick_run_times_the_help_against_the_bare_interpreter():
+    results = cli.run(quick=True)
+    assert [r.name for r in results] == ['cli_start_help', 'cli_start_analyze_help']
+    for result in results:
+        assert result.unit == 's' and result.baseline == 'python -c pass'
+        assert result.value > 0 and result.baseline_value > 0
+        assert result.ratio == result.baseline_value / result.value
+        assert result.details['runs'] == 3
+        assert result.details['cli_own_s'] == result.value - result.baseline_value
+        assert result.value <= result.details['max_s']
+    assert results[1].details['command'] == 'lumpbeam analyze --help'
+
+
+def test_bench_only_cli_prints_both_rows(capsys):
+    assert 'cli' in available_suites()
+    assert main(['bench', '--only', 'cli', '--quick']) == 0
+    table = capsys.readouterr().out
+    assert 'cli_start_help ' in table and 'cli_start_analyze_help ' in table
+    assert table.count('python -c pass') == 2

@@ -1,0 +1,14 @@
+from lumpbeam_lab.bench.runner import available_suites
+from lumpbeam_lab.bench.shaping import run
+
+
+def test_quick_suite_measures_against_fftconvolve():
+    assert 'shaping' in available_suites()
+    one, two = run(quick=True)
+    assert one.baseline == 'scipy.signal.fftconvolve' and one.unit == 'ms per joint'
+    assert one.value > 0 and one.baseline_value > 0
+    assert one.ratio == one.baseline_value / one.value
+    assert (one.details['impulses'], two.details['impulses']) == (3, 9)
+    # Both compute the same convolution, up to the baseline's impulses rounded to 1 ms.
+    assert one.details['max_difference_rad'] < 0.01
+    assert two.details['max_difference_rad'] < 0.01
