@@ -148,7 +148,8 @@ class BagReader:
     ) -> Iterator[RawMessage]:
         """Iterates over the serialized messages whose chunks are intact, in file order.
 
-        The product's files are in log-time order (:class:`~.writer.BagWriter` sorts them).
+        The product's files are in log-time order (:class:`~.writer.BagWriter` sorts them);
+        in a complete file each chunk's messages come sorted by log time (:class:`FileWalk`).
 
         Args:
             topics: Topics to read; all when ``None``.
@@ -339,7 +340,9 @@ class FileWalk:
     """One pass over an MCAP file's data section that skips what is damaged.
 
     Iterating yields ``(schema, channel, message)`` for every message of the wanted topics
-    found in an intact chunk (or outside chunks), in file order.
+    found in an intact chunk (or outside chunks), in file order; with a summary, each chunk's
+    messages in log-time order (chunks themselves stay in file order, which is log-time
+    order for every writer that closes a chunk before it starts the next).
 
     Args:
         file: The ``.mcap`` file.
@@ -354,6 +357,8 @@ class FileWalk:
     Attributes:
         damaged: One line per damaged stretch skipped.
         cut: Whether the file ends in an incomplete record (a cut recording).
+        sort_chunks: Whether each chunk's messages are sorted by log time (a summary was
+            given: the file is complete).
     """
 
     def __init__(
@@ -374,6 +379,7 @@ class FileWalk:
         self.damaged: list[str] = []
         self.cut = False
         self.messages = 0
+        self.sort_chunks = summary is not None
         if summary is not None:
             for schema in summary.schemas.values():
                 self.schemas[schema.id] = schema
@@ -425,7 +431,13 @@ class FileWalk:
                 offset = self._skip(offset, resume, size, what)
                 continue
             if records is not None:
-                yield from self._records(records, offset)
+                chunk = self._records(records, offset)
+                if self.sort_chunks:
+                    # As mcap's own reader does with a summary: a chunk's messages in log
+                    # time, so that a file written out of order (rosbags' writer keeps the
+                    # order it is given) replays with a clock that never turns back.
+                    chunk = iter(sorted(chunk, key=lambda record: record[2].log_time))
+                yield from chunk
             elif opcode in (_OP_DATA_END, _OP_FOOTER):
                 return
             elif not chunked and not self.damaged:

@@ -38,7 +38,9 @@ def test_campaign_rows_errors_and_resume(bags_with_a_cut_one, settings, tmp_path
     table = pq.read_table(tmp_path / 'out' / 'results.parquet').to_pylist()
     rows = {r['path']: r for r in table}
     cut = rows[str(bags_with_a_cut_one[-1])]
-    assert 'cut' in cut['error'] and cut['natural_frequency_hz'] is None
+    # The reader keeps the 2 s before the cut (it warns on stderr), which end at the release:
+    # no oscillation to identify, so the row is an error without an estimate.
+    assert 'no estimate' in cut['error'] and cut['natural_frequency_hz'] is None
     good = [rows[str(b)] for b in bags_with_a_cut_one[:-1]]
     assert [r['error'] for r in good] == ['', '', '']
     assert [r['load_kg'] for r in good] == pytest.approx(LOADS)

@@ -58,7 +58,7 @@ def test_demo_runs_the_graph_end_to_end(tmp_path, capsys, mcap_doctor):
         (['--domain-id', '500'], '--domain-id must be in 1..101'),
         (['--config', '/no/such.yaml'], 'no such file'),
         (['--effect', 'gravity_wave=1'], 'unknown effect'),
-        (['--effect', 'sensor_latency=-0.01'], 'zero or positive'),
+        (['--effect', 'sensor_latency=-0.01'], 'latency_s must be in [0, 1]'),
         (['--image-size', '640by480'], 'expected WIDTHxHEIGHT'),
         (['--image-size', '8x8'], 'at least'),
     ],

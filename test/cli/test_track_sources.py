@@ -265,10 +265,11 @@ def test_the_board_comes_from_the_options(board, tmp_path, footage):
     other = render_frames(config, drop_test_trajectory().between(START_S, 2.0), 8)
     src = _bag(tmp_path / 'in', other, 'mono8', info)
     options = [] if board is None else ['--board', board[0], '--square-m', board[1]]
-    assert main(['track', str(src), str(tmp_path / 'out'), '--quiet', *options]) == 0
-    if board is None:
-        assert len(read_tip_poses(tmp_path / 'out').t) == 0  # no 8 x 6 pattern there
+    code = main(['track', str(src), str(tmp_path / 'out'), '--quiet', *options])
+    if board is None:  # no 8 x 6 pattern there: no pose at all is an error, and no OUT
+        assert code == 2 and not (tmp_path / 'out').exists()
     else:
+        assert code == 0
         poses, error = _errors(tmp_path / 'out', other)
         assert len(poses.t) == 8 and np.max(np.abs(error[:, 1])) < 20e-6
 
