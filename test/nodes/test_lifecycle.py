@@ -150,11 +150,16 @@ def test_a_signal_interrupts_a_callback_that_computes(ros_domain_id, tmp_path, s
 
 @pytest.fixture(scope='module')
 def filmed_bag(tmp_path_factory):
-    """A 2.3 s drop test filmed at 320 x 240: 415 frames for the camera node to track."""
+    """An 8 s drop test filmed at 320 x 240: 1441 frames for the camera node to track.
+
+    The node tracks a bag as fast as it can (about 400 frames/s on an idle machine) and then
+    exits: the bag must last longer than the test's subscription takes to match the node's
+    publisher, or the signal finds it done rather than working.
+    """
     path = tmp_path_factory.mktemp('filmed') / 'bag'
     beam, drop = load_beam_config()
     write_drop_test_bag(
-        path, beam, drop, SynthOptions(duration_s=2.3), images=ImageOptions(320, 240)
+        path, beam, drop, SynthOptions(duration_s=8.0), images=ImageOptions(320, 240)
     )
     return path
 
