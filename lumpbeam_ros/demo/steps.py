@@ -587,7 +587,8 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
     if summary.get('prediction_lag_s') is not None and math.isfinite(summary['prediction_lag_s']):
         lines.append(
             f'  of which timing: the prediction runs {summary["prediction_lag_s"] * 1e3:.1f} ms '
-            f'late (the /tip_load delivery delay); shifted by it, RMS '
+            f'late (the /tip_load delivery delay, and any latency the camera hides); '
+            f'shifted by it, RMS '
             f'{summary["prediction_rms_aligned_m"] * 1e3:.3f} mm after the release'
         )
     if summary.get('camera_rms_m') is not None:

@@ -11,7 +11,6 @@ from pathlib import Path
 import pytest
 
 from lumpbeam_ros.bagio import BagReader, BagWriter
-from lumpbeam_ros.demo import steps
 from lumpbeam_ros.resources import config_path
 from lumpbeam_ros.viz.layouts import (
     check_uses,
@@ -28,15 +27,10 @@ PLANNED = set(re.findall(r'`(/[\w/]+)` \(planned\)', (ROOT / 'doc' / 'interfaces
 
 
 @pytest.fixture(scope='module')
-def demo_bag(tmp_path_factory):
-    """The demo's sim-time recording of a short run: synthesize, replay, normalize."""
-    out = tmp_path_factory.mktemp('demo')
-    options = steps.DemoOptions(out=out, duration_s=3.5, image_size=None, effects={})
-    wanted = [
-        (n, f) for n, f in steps.default_steps() if n in ('synthesize', 'replay', 'normalize')
-    ]
-    run = steps.run_demo(options, wanted, echo=lambda _line: None)
-    return run.normalized_bag
+def demo_bag(demo_results):
+    """The demo's sim-time recording (the session's one demo run)."""
+    assert demo_results.exit_code == 0, demo_results.printed
+    return demo_results.out / 'bags' / 'recorded_sim_time'
 
 
 def _uses():

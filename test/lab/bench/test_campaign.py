@@ -4,6 +4,8 @@ from lumpbeam_lab.bench import campaign
 from lumpbeam_lab.bench.runner import available_suites
 
 
+# Two Dask clusters and a plain loop over the same bags: make test-slow runs it.
+@pytest.mark.slow
 def test_quick_run_compares_workers_with_a_plain_loop():
     one, two = campaign.run(quick=True)
     assert (one.name, two.name) == ('campaign_dask_1_worker', 'campaign_dask_2_workers')

@@ -1,9 +1,15 @@
 import math
 
+import pytest
+
 from lumpbeam_lab.bench.live_graph import run
 from lumpbeam_lab.bench.runner import available_suites, format_table
 
 
+# A live graph at its rate (best-effort frames): make test-slow runs it on a machine no other
+# worker keeps busy.
+@pytest.mark.slow
+@pytest.mark.ros
 def test_quick_run_reports_the_demo_latency_against_the_camera_hop():
     assert 'live_graph' in available_suites()
     (row,) = run(quick=True)

@@ -1,9 +1,13 @@
 import math
 
+import pytest
+
 from lumpbeam_lab.bench.runner import available_suites
 from lumpbeam_lab.bench.tracker import run
 
 
+# Three timed tracking runs and a camera node over shared memory: make test-slow runs it.
+@pytest.mark.slow
 def test_quick_run_reports_speed_accuracy_and_end_to_end_against_same_run_baselines():
     assert 'tracker' in available_suites()
     speed, accuracy, shm = run(quick=True)
