@@ -1,0 +1,73 @@
+"""The package builds as an ament_python package with colcon, as a ROS 2 workspace builds it.
+
+Debian's ``colcon`` and ``python3-colcon-ros`` (``.ci/run`` installs them) build a copy of
+the repository's files in a fresh workspace; the install space must hold every console
+script that ``setup.py`` declares, the package's data and its shared configuration files.
+"""
+
+import importlib.metadata
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = 'lumpbeam_ros'
+
+
+def _declared_scripts() -> set[str]:
+    """The console scripts of the installed distribution (setup.py's entry points)."""
+    entry_points = importlib.metadata.distribution(PACKAGE).entry_points
+    return {ep.name for ep in entry_points if ep.group == 'console_scripts'}
+
+
+def _copy_repository(dest: Path) -> None:
+    listed = subprocess.run(
+        ['git', 'ls-files', '-co', '--exclude-standard'],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.splitlines()
+    for name in listed:
+        source = ROOT / name
+        if source.is_file():
+            (dest / name).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(source, dest / name)
+
+
+@pytest.fixture(scope='module')
+def install_space(tmp_path_factory):
+    colcon = shutil.which('colcon')
+    if colcon is None:
+        pytest.skip('colcon missing (apt-get install colcon python3-colcon-ros)')
+    workspace = tmp_path_factory.mktemp('ws')
+    _copy_repository(workspace / 'src' / PACKAGE)
+    built = subprocess.run(
+        [colcon, 'build', '--event-handlers', 'console_direct-'],
+        cwd=workspace,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert built.returncode == 0, built.stdout[-2000:] + built.stderr[-2000:]
+    return workspace / 'install' / PACKAGE
+
+
+def test_colcon_installs_every_console_script(install_space):
+    scripts = {p.name for p in (install_space / 'lib' / PACKAGE).iterdir()}
+    assert _declared_scripts() <= scripts
+    assert {'camera_node', 'identifier_node', 'simulator_node', 'lumpbeam'} <= scripts
+
+
+def test_colcon_installs_the_package_index_configs_and_data(install_space):
+    share = install_space / 'share'
+    assert (share / 'ament_index' / 'resource_index' / 'packages' / PACKAGE).is_file()
+    assert (share / PACKAGE / 'package.xml').is_file()
+    shipped = {p.name for p in (share / PACKAGE / 'config').iterdir()}
+    assert {p.name for p in (ROOT / 'config').iterdir()} <= shipped
+    (site,) = (install_space / 'lib').glob('python3*/site-packages')
+    data = {p.name for p in (site / PACKAGE / 'data').iterdir()}
+    assert {p.name for p in (ROOT / PACKAGE / 'data').iterdir()} <= data
+    assert (site / 'lumpbeam_lab' / '__init__.py').is_file()
