@@ -26,6 +26,9 @@ _POSITIVE = Bounds(0.0, low_open=True)
 _NON_NEGATIVE = Bounds(0.0)
 _FRACTION = Bounds(0.0, 1.0, low_open=True)
 
+#: The most modes ``fit.max_modes`` (and ``lumpbeam analyze --max-modes``) may ask for: a
+#: camera at 180 fps sees a beam's first few modes, not ten.
+MAX_MODES_LIMIT = 8
 #: Choices of ``fit.nonlinear``.
 NONLINEAR_CHOICES = ('auto', 'always', 'never')
 
@@ -111,10 +114,18 @@ class IdentifierConfig:
     )
     max_modes: int = setting(
         'fit.max_modes',
-        2,
-        'damped modes the least-squares model may hold: 1, or 2 to also fit a second '
-        'mode the matrix pencil finds above the noise',
-        bounds=Bounds(1, 2),
+        3,
+        'damped modes the least-squares model may hold: each mode after the first is kept '
+        'only when it stands out of the noise (fit.mode_false_alarm)',
+        bounds=Bounds(1, MAX_MODES_LIMIT),
+    )
+    mode_false_alarm: float = setting(
+        'fit.mode_false_alarm',
+        1e-3,
+        'a mode after the first is kept when its amplitude exceeds k of its standard '
+        'deviations, k = sqrt(2 ln(N / this)) for N samples fitted: the chance that noise '
+        'alone gives a mode',
+        bounds=Bounds(0.0, 0.5, low_open=True),
     )
     drift: bool = setting(
         'fit.drift', False, 'add a linear drift to the decay model (a creeping mount)'
@@ -161,6 +172,14 @@ class IdentifierConfig:
         40.0,
         "highest frequency taken as the beam's first mode (above fit.min_frequency_hz)",
         'Hz',
+        _POSITIVE,
+    )
+    rest_tolerance_rad: float = setting(
+        'ring_down.rest_tolerance_rad',
+        1e-3,
+        'an arm (with /joint_states) is at rest while every joint stays within this of its '
+        'angle when it stopped; the free vibration is fitted from that stop',
+        'rad',
         _POSITIVE,
     )
     beam_mass_fraction: float = setting(

@@ -277,7 +277,7 @@ def test_parameters_are_validated():
     try:
         for overrides, problem in [
             ({'window.length_s': -1.0}, 'window.length_s: must be positive'),
-            ({'fit.max_modes': 3}, 'fit.max_modes'),
+            ({'fit.max_modes': 9}, 'fit.max_modes'),
             ({'fit.nonlinear': 'maybe'}, 'fit.nonlinear'),
             ({'beam_config': '/nonexistent.yaml'}, 'nonexistent'),
         ]:
