@@ -32,7 +32,7 @@ from lumpbeam_ros.ident.identification import (
 )
 from lumpbeam_ros.ident.logdec import LogDecrement, LogDecrementResult
 from lumpbeam_ros.ident.mode_estimate import TWO_PI, ModeEstimate
-from lumpbeam_ros.ident.modes import choose_modes
+from lumpbeam_ros.ident.modes import choose_modes, structural_modes
 from lumpbeam_ros.ident.pencil import MatrixPencil
 from lumpbeam_ros.ident.release import Release, detect_release
 from lumpbeam_ros.ident.samples import PoseWindow
@@ -116,6 +116,7 @@ def identify_from(
     *,
     strict: bool = False,
     previous: FitState | None = None,
+    release: Release | None = None,
 ) -> tuple[Identification, FitState | None]:
     """:func:`identify`, started from the state of an earlier, overlapping window.
 
@@ -132,6 +133,9 @@ def identify_from(
         config: As for :func:`identify`.
         strict: As for :func:`identify`.
         previous: The state the last call returned, or ``None``.
+        release: Where the free vibration starts when it is known otherwise, e.g. where an
+            arm's joints stopped (:func:`~lumpbeam_ros.ident.ring_down.ring_down_release`);
+            ``None``: the load release found in the window.
 
     Returns:
         The identification and the state for the next call (``None`` after an ERROR).
@@ -140,7 +144,7 @@ def identify_from(
         LumpbeamError: As for :func:`identify`.
     """
     with single_threaded_blas():
-        return _identify(window, beam, config or IdentifierConfig(), strict, previous)
+        return _identify(window, beam, config or IdentifierConfig(), strict, previous, release)
 
 
 def _identify(
@@ -149,6 +153,7 @@ def _identify(
     config: IdentifierConfig,
     strict: bool,
     previous: FitState | None,
+    given: Release | None = None,
 ) -> tuple[Identification, FitState | None]:
     span = AnalysedWindow(window.start_s, window.end_s)
     dropped = window.counts.dropped
@@ -169,7 +174,7 @@ def _identify(
             f'{len(window)} valid pose samples, need at least {config.min_samples}',
             unusable=True,
         )
-    release = detect_release(window, config)
+    release = detect_release(window, config) if given is None else given
     found = ReleaseFigures(
         time_s=Estimate(release.time_s), confidence=release.confidence, source=release.source
     )
@@ -291,14 +296,13 @@ def _fit_decay(
 
 def lowest_mode(params: DampedSinusoidParams) -> int:
     """The index of the fitted mode of lowest frequency: the first mode of the report."""
-    frequencies = [params.mode(m).natural_frequency_hz for m in range(params.n_modes)]
-    return int(np.argmin(frequencies))
+    return min(structural_modes(params), key=lambda m: params.mode(m).natural_frequency_hz)
 
 
 def identified_modes(params: DampedSinusoidParams) -> tuple[IdentifiedMode, ...]:
-    """Every fitted mode with its standard deviations, ordered by frequency."""
+    """Every fitted mode (not a harmonic) with its standard deviations, by frequency."""
     modes = sorted(
-        (params.mode(m) for m in range(params.n_modes)), key=lambda m: m.natural_frequency_hz
+        (params.mode(m) for m in structural_modes(params)), key=lambda m: m.natural_frequency_hz
     )
     return tuple(
         IdentifiedMode(
@@ -416,12 +420,16 @@ def _derive(
     tip_mass = beam.tip_mass_kg + (
         release.load_after_kg if math.isfinite(release.load_after_kg) else 0.0
     )
-    k_freq = stiffness.from_frequency(
-        mode.natural_frequency_hz,
-        mode.natural_frequency_hz_std,
-        tip_mass,
-        beam.mass_kg,
-        config.beam_mass_fraction,
+    k_freq = (
+        stiffness.from_frequency(
+            mode.natural_frequency_hz,
+            mode.natural_frequency_hz_std,
+            tip_mass,
+            beam.mass_kg,
+            config.beam_mass_fraction,
+        )
+        if release.load_kg != 0.0
+        else (NAN, NAN)  # an arm's ring-down: the clamped beam's effective mass does not apply
     )
     level_after, level_after_std = params.offset, params.offset_std
     deflection = level_after - release.level_before_m
@@ -569,9 +577,12 @@ def _report(
 
 def _second_mode_hz(params: DampedSinusoidParams) -> float:
     """Damped frequency of the second-lowest fitted mode (NaN with one mode)."""
-    if params.n_modes < 2:
+    modes = identified_modes(params)
+    if len(modes) < 2:
         return NAN
-    return sorted(params.mode(m).damped_frequency_hz for m in range(params.n_modes))[1]
+    mode = modes[1]
+    f_n, zeta = mode.natural_frequency_hz.value, mode.damping_ratio.value
+    return f_n * math.sqrt(1.0 - zeta * zeta)
 
 
 def _check_rel(warnings: list[str], name: str, value: float, std: float, limit: float) -> None:

@@ -11,7 +11,8 @@ rings in several). The number of modes is chosen by forward selection:
    ``[a b] C^-1 [a b]^T > k^2``, ``(a, b)`` its cosine and sine amplitudes and ``C`` their
    correlation-robust covariance (:mod:`~lumpbeam_ros.ident.covariance`), with
    ``k = sqrt(2 ln(N / alpha))`` for ``N`` samples and false-alarm probability ``alpha``
-   (``fit.mode_false_alarm``).
+   (``fit.mode_false_alarm``);
+5. a harmonic of a stronger mode (:func:`harmonic_of`) stays in the fit but is not a mode.
 
 Why this test and not an information criterion: under noise alone the statistic of one trial
 frequency and decay is chi-square with 2 degrees of freedom, ``P(> k^2) = e^{-k^2/2}``;
@@ -43,11 +44,43 @@ _NYQUIST_FRACTION = 0.9
 _MAX_DAMPING = 0.5
 #: Two modes closer than this many frequency-resolution cells (1 / record length) are one.
 _RESOLUTION_CELLS = 2.0
+#: The harmonics of a mode that are fitted as such (:func:`harmonic_of`), and how close
+#: their frequency (relative) and decay rate (relative to n times the mode's) must be.
+_HARMONICS = (2, 3)
+_HARMONIC_FREQUENCY_TOL = 0.01
+_HARMONIC_DECAY_TOL = 0.3
 #: Grid points the residual's pencil sees at most (its cost is linear in them).
 _PENCIL_MAX_POINTS = 4096
 #: A candidate whose fixed-pole statistic is below this fraction of the threshold is refused
 #: without a refit: the refit frees its pole, which raises the statistic, but not twofold.
 _SCREEN_FRACTION = 0.5
+
+
+def harmonic_of(params: DampedSinusoidParams, index: int) -> int | None:
+    """The stronger mode whose harmonic the fitted mode ``index`` is, or ``None``.
+
+    A large swing puts harmonics of a mode into the tip's motion (the tip's arc, a stiffening
+    spring): at ``n`` times its frequency (n = 2, 3), decaying ``n`` times as fast (they go
+    with the n-th power of its amplitude). The fit keeps them, so that they leave nothing
+    behind for the next mode's search, but they are not modes of the structure.
+    """
+    mode = params.mode(index)
+    for m in range(params.n_modes):
+        base = params.mode(m)
+        if m == index or not base.amplitude > mode.amplitude:
+            continue
+        for n in _HARMONICS:
+            frequency_gap = abs(mode.damped_frequency_hz / (n * base.damped_frequency_hz) - 1.0)
+            decay_gap = abs(mode.decay_rate - n * base.decay_rate)
+            allowed = max(_HARMONIC_DECAY_TOL * n * base.decay_rate, 3.0 * mode.decay_rate_std)
+            if frequency_gap < _HARMONIC_FREQUENCY_TOL and decay_gap <= allowed:
+                return m
+    return None
+
+
+def structural_modes(params: DampedSinusoidParams) -> list[int]:
+    """The indices of the fitted modes that are not harmonics of another."""
+    return [m for m in range(params.n_modes) if harmonic_of(params, m) is None]
 
 
 @dataclass(frozen=True)
@@ -117,7 +150,9 @@ def choose_modes(
     band = (config.min_frequency_hz, _NYQUIST_FRACTION * 0.5 * rate)
     resolution = _RESOLUTION_CELLS / float(t[-1] - t[0])
     refused = ''
-    while params.n_modes < config.max_modes:
+    while len(
+        structural_modes(params)
+    ) < config.max_modes and params.n_modes < config.max_modes + len(_HARMONICS):
         guess = _next_mode(t, z, params, band, resolution)
         if guess is None:
             refused = 'no further mode in the band'

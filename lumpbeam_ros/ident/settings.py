@@ -8,10 +8,11 @@ the fields below.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.paramfile import check_known_keys, read_parameter_file
 from lumpbeam_ros.params.schema import (
     Bounds,
@@ -264,6 +265,31 @@ def config_from_parameters(params: Mapping[str, Any], source: str | Path) -> Ide
     """
     check_known_keys(params, frozenset(spec.name for spec in IDENTIFIER_SETTINGS), source)
     return settings_from_parameters(IdentifierConfig, params, source)
+
+
+def with_max_modes(config: IdentifierConfig, text: str) -> IdentifierConfig:
+    """The settings with ``fit.max_modes`` from a command line's ``--max-modes``.
+
+    Args:
+        config: The settings.
+        text: The option's value as typed.
+
+    Returns:
+        The settings with that many modes at most.
+
+    Raises:
+        LumpbeamError: Not a whole number within the parameter's bounds, naming the option.
+    """
+    spec = next(spec for spec in IDENTIFIER_SETTINGS if spec.name == 'fit.max_modes')
+    value: object
+    try:
+        value = int(text)
+    except ValueError:
+        value = text
+    problem = spec.problem(value)
+    if problem:
+        raise LumpbeamError(f'--max-modes: {problem}')
+    return replace(config, max_modes=int(text))
 
 
 def config_to_parameters(config: IdentifierConfig) -> dict[str, Any]:
