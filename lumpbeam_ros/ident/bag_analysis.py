@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from lumpbeam_ros.bagio import BagReader, read_load_events, read_tip_poses
-from lumpbeam_ros.bagio.series import read_joint_states
+from lumpbeam_ros.bagio.series import JointSeries, read_joint_states
 from lumpbeam_ros.bagio.tipseries import LoadSeries
 from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.ident.identification import Identification, IdentifiedMode
@@ -190,6 +190,39 @@ def analyze_bag(
     return BagAnalysis(Path(bag), window, result, fit, notes)
 
 
+def identify_ring_down(
+    window: PoseWindow,
+    joints: JointSeries,
+    beam: BeamParameters,
+    config: IdentifierConfig,
+) -> tuple[Identification, FitState | None, JointRest, PoseWindow]:
+    """The modes of an arm's free vibration after its last move (the core of ``--arm``).
+
+    Args:
+        window: The tip poses (x and z).
+        joints: The joint angles (``/joint_states``).
+        beam: Passed through to the identification (no load leaves: its B.12 figures stay
+            undetermined).
+        config: Identifier settings (``ring_down.rest_tolerance_rad``, the fit's).
+
+    Returns:
+        The identification, its fit, the joints' rest after the last move and the window
+        analysed (z: the tip along its swing).
+
+    Raises:
+        LumpbeamError: The joints never move, or rest for fewer than ``quality.min_samples``
+            pose periods after their last move.
+    """
+    step = float(np.median(np.diff(window.t))) if len(window) > 1 else 0.0
+    rest = last_ring_down(
+        rest_stretches(joints.t, joints.angles, config.rest_tolerance_rad),
+        config.min_samples * step,
+    )
+    swing = along_swing(window, rest.start_s, rest.end_s)
+    result, fit = identify_from(swing, beam, config, strict=True, release=ring_down_release(rest))
+    return result, fit, rest, swing
+
+
 def _analyze_ring_down(
     bag: Path, window: PoseWindow, beam: BeamParameters, config: IdentifierConfig, joints: int
 ) -> BagAnalysis:
@@ -200,16 +233,8 @@ def _analyze_ring_down(
             f'{bag}: {JOINT_STATES} has {series.angles.shape[1]} joint(s) '
             f'({", ".join(series.names)}), the arm {joints}'
         )
-    step = float(np.median(np.diff(window.t))) if len(window) > 1 else 0.0
     try:
-        rest = last_ring_down(
-            rest_stretches(series.t, series.angles, config.rest_tolerance_rad),
-            config.min_samples * step,
-        )
-        swing = along_swing(window, rest.start_s, rest.end_s)
-        result, fit = identify_from(
-            swing, beam, config, strict=True, release=ring_down_release(rest)
-        )
+        result, fit, rest, swing = identify_ring_down(window, series, beam, config)
     except LumpbeamError as exc:
         raise LumpbeamError(f'{bag}: {exc}') from None
     notes = tuple(note for note in (window.counts.note(),) if note)

@@ -113,25 +113,44 @@ class RestTracker:
 def rest_stretches(t: np.ndarray, angles: np.ndarray, tolerance_rad: float) -> list[JointRest]:
     """Every stretch at rest of a record of joint angles, oldest first.
 
+    The rule of :class:`RestTracker` on a whole record: each stretch runs from its first
+    sample to the last before one that strays more than ``tolerance_rad`` from it; the
+    search for that sample goes by numpy blocks, so a long rest costs few Python steps.
+
     Args:
         t: Stamps, s, increasing.
-        angles: Joint angles, rad, shape (len(t), n_joints).
+        angles: Joint angles, rad, shape (len(t), n_joints), finite.
         tolerance_rad: As :class:`RestTracker`.
 
     Returns:
         The stretches (a moving sample opens a new one).
     """
-    tracker = RestTracker(tolerance_rad)
+    t = np.asarray(t, dtype=float)
+    q = np.asarray(angles, dtype=float).reshape(t.size, -1)
     stretches: list[JointRest] = []
-    rows = np.asarray(angles, dtype=float)
-    for stamp, row in zip(np.asarray(t, dtype=float), rows, strict=True):
-        tracker.push(float(stamp), row)
-        if tracker.previous is not None and (
-            not stretches or stretches[-1] is not tracker.previous
-        ):
-            stretches.append(tracker.previous)
-    if tracker.current is not None:
-        stretches.append(tracker.current)
+    n = t.size
+    i = 0
+    while i < n:
+        stop = n
+        j, block = i + 1, 16
+        while j < n:
+            off = np.flatnonzero(np.any(np.abs(q[j : j + block] - q[i]) > tolerance_rad, axis=1))
+            if off.size:
+                stop = j + int(off[0])
+                break
+            j += block
+            block *= 2
+        last = stop - 1
+        stretches.append(
+            JointRest(
+                float(t[i]),
+                float(t[last]),
+                tuple(q[last].tolist()),
+                after_move=i > 0,
+                moved_again=stop < n,
+            )
+        )
+        i = stop
     return stretches
 
 

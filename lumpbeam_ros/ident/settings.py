@@ -177,9 +177,10 @@ class IdentifierConfig:
     )
     rest_tolerance_rad: float = setting(
         'ring_down.rest_tolerance_rad',
-        1e-3,
+        1e-5,
         'an arm (with /joint_states) is at rest while every joint stays within this of its '
-        'angle when it stopped; the free vibration is fitted from that stop',
+        'angle when it stopped; the free vibration is fitted from that stop (for encoder '
+        'readings, a few counts)',
         'rad',
         _POSITIVE,
     )
