@@ -149,7 +149,9 @@ class IdentifierNode(SchemaNode):
         snapshot = self.window.snapshot()
         release = None
         if self.joints.current is not None:
-            rest = self.joints.ring_down()
+            # The rest must hold for as many poses as an identification needs.
+            step = float(np.median(np.diff(snapshot.t))) if len(snapshot) > 1 else math.inf
+            rest = self.joints.ring_down(self.config.min_samples * step)
             if rest is None:
                 self._state = None
                 message = 'no ring-down yet: the joints have not stopped after a move'
