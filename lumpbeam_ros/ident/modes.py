@@ -49,8 +49,9 @@ _RESOLUTION_CELLS = 2.0
 _HARMONICS = (2, 3)
 _HARMONIC_FREQUENCY_TOL = 0.01
 _HARMONIC_DECAY_TOL = 0.3
-#: Grid points the residual's pencil sees at most (its cost is linear in them).
-_PENCIL_MAX_POINTS = 4096
+#: Samples of what the fit leaves that the pencil sees at most (its cost is linear in them):
+#: 5.7 s at 180 Hz, long enough to start a lightly damped mode, which the fit then refines.
+_PENCIL_MAX_POINTS = 1024
 #: A candidate whose fixed-pole statistic is below this fraction of the threshold is refused
 #: without a refit: the refit frees its pole, which raises the statistic, but not twofold.
 _SCREEN_FRACTION = 0.5
@@ -64,9 +65,12 @@ def harmonic_of(params: DampedSinusoidParams, index: int) -> int | None:
     with the n-th power of its amplitude). The fit keeps them, so that they leave nothing
     behind for the next mode's search, but they are not modes of the structure.
     """
-    mode = params.mode(index)
-    for m in range(params.n_modes):
-        base = params.mode(m)
+    return _harmonic_of([params.mode(m) for m in range(params.n_modes)], index)
+
+
+def _harmonic_of(modes: list[ModeEstimate], index: int) -> int | None:
+    mode = modes[index]
+    for m, base in enumerate(modes):
         if m == index or not base.amplitude > mode.amplitude:
             continue
         for n in _HARMONICS:
@@ -80,7 +84,8 @@ def harmonic_of(params: DampedSinusoidParams, index: int) -> int | None:
 
 def structural_modes(params: DampedSinusoidParams) -> list[int]:
     """The indices of the fitted modes that are not harmonics of another."""
-    return [m for m in range(params.n_modes) if harmonic_of(params, m) is None]
+    modes = [params.mode(m) for m in range(params.n_modes)]
+    return [m for m in range(len(modes)) if _harmonic_of(modes, m) is None]
 
 
 @dataclass(frozen=True)
@@ -178,7 +183,8 @@ def choose_modes(
 
 
 def _fitted_frequencies(params: DampedSinusoidParams) -> list[float]:
-    return [params.mode(m).damped_frequency_hz for m in range(params.n_modes)]
+    """Damped frequencies of the fitted modes, Hz (from the parameters alone)."""
+    return [float(params.x[params.mode_slice(m)][3]) / TWO_PI for m in range(params.n_modes)]
 
 
 def _next_mode(
