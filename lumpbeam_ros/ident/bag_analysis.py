@@ -182,7 +182,10 @@ def analyze_bag(
     if arm_joints is not None:
         return _analyze_ring_down(Path(bag), window, beam, config, arm_joints)
     window, split = keep_release_segment(window, config)
-    notes = tuple(note for note in (window.counts.note(), split) if note)
+    arm_hint = ''
+    if JOINT_STATES in BagReader(bag).topics:
+        arm_hint = f'taken as a drop test, but the bag has {JOINT_STATES}: an arm? (--arm FILE)'
+    notes = tuple(note for note in (window.counts.note(), split, arm_hint) if note)
     try:
         result, fit = identify_from(window, beam, config, strict=True)
     except LumpbeamError as exc:

@@ -301,3 +301,10 @@ def test_an_arm_bag_with_other_joints_or_no_move_is_one_line(arm_bag, tmp_path, 
     assert 'the joints never move' in _error_line(capsys)
     assert main(['analyze', str(_bag(tmp_path / 'b', poses=[(0.0, 0.0)])), '--arm', rotary]) == 2
     assert 'no topic /joint_states (topics: /tip_pose)' in _error_line(capsys)
+
+
+def test_an_arm_bag_without_arm_says_so(arm_bag, capsys):
+    main(['analyze', str(arm_bag)])
+    assert 'taken as a drop test, but the bag has /joint_states: an arm? (--arm FILE)' in (
+        capsys.readouterr().err
+    )
