@@ -93,7 +93,8 @@ class ReleaseFigures:
             response in the tip poses, with its std from the onset fit (``release_time_s``).
         static_deflection_m: delta_vE, the rise of the static tip level at the release.
         confidence: 0..1 (``release_confidence``).
-        source: ``tip_load``, ``data`` or ``none`` (``release_source``).
+        source: ``tip_load``, ``data``, ``none``, or ``joint_states`` for an arm's ring-down
+            (``release_source``).
         released_load_kg: F / g used in B.12.
         level_before_m: Static tip z before the release.
         level_after_m: The level the decay converges to.
