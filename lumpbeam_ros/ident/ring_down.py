@@ -167,7 +167,7 @@ def last_ring_down(stretches: list[JointRest], min_duration_s: float) -> JointRe
     if not long_enough:
         raise LumpbeamError(
             f'the joints rest at most {max(s.duration_s for s in after):.3g} s after a move, '
-            f'need {min_duration_s:.3g} s'
+            f'need {min_duration_s:.3g} s (at rest: within ring_down.rest_tolerance_rad)'
         )
     return long_enough[-1]
 

@@ -154,7 +154,10 @@ class IdentifierNode(SchemaNode):
             rest = self.joints.ring_down(self.config.min_samples * step)
             if rest is None:
                 self._state = None
-                message = 'no ring-down yet: the joints have not stopped after a move'
+                message = (
+                    'no ring-down yet: the joints have not stopped after a move (at rest: '
+                    f'within ring_down.rest_tolerance_rad = {self.config.rest_tolerance_rad:g} rad)'
+                )
                 self._output.publish(self.diagnostics(Identification(Status.ERROR, message)))
                 return
             snapshot = along_swing(snapshot, rest.start_s, rest.end_s)
