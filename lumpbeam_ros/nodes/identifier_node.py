@@ -154,9 +154,10 @@ class IdentifierNode(SchemaNode):
             rest = self.joints.ring_down(self.config.min_samples * step)
             if rest is None:
                 self._state = None
+                tolerance = self.config.rest_tolerance_rad
                 message = (
                     'no ring-down yet: the joints have not stopped after a move (at rest: '
-                    f'within ring_down.rest_tolerance_rad = {self.config.rest_tolerance_rad:g} rad)'
+                    f'within ring_down.rest_tolerance_rad = {tolerance:g} rad)'
                 )
                 self._output.publish(self.diagnostics(Identification(Status.ERROR, message)))
                 return
