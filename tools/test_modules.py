@@ -33,7 +33,7 @@ CORE_PACKAGES = (
 
 
 #: The lab's ROS-free packages (beside its top-level modules): held like the core.
-LAB_PACKAGES = ('camera',)
+LAB_PACKAGES = ('camera', 'ident')
 
 PRODUCT = 'lumpbeam_ros'
 LAB = 'lumpbeam_lab'

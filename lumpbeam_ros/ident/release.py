@@ -46,7 +46,8 @@ class Release:
         confidence: 0..1; 1 for a clear onset in the data (announced by ``/tip_load`` when
             there are readings), lower when the two disagree or the step is small.
         source: ``'tip_load'`` (announced by ``/tip_load``, timed from the data), ``'data'``
-            (found in the data alone) or ``'none'``.
+            (found in the data alone), ``'none'``, or ``'joint_states'`` (where an arm's joints
+            stopped, :mod:`~lumpbeam_ros.ident.ring_down`).
         load_kg: The mass released, kg (NaN when only the data saw it).
         load_after_kg: The mass still hanging after the release, kg (NaN when unknown).
         level_before_m: Mean tip z over the quiet stretch before the release.
