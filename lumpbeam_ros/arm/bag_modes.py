@@ -37,6 +37,9 @@ MIN_RINGDOWN_S = 1.0
 #: A mode is kept when its amplitude, frequency and damping ratio are each at least this
 #: many standard deviations from zero.
 MIN_SIGNIFICANCE = 5.0
+#: A mode within this fraction of an integer multiple of a stronger mode's frequency is
+#: taken for its overtone.
+HARMONIC_TOLERANCE = 2e-3
 #: Damping ratios above this are not a ringing mode (a slow drift the fit soaked up).
 MAX_DAMPING_RATIO = 0.5
 
@@ -127,7 +130,9 @@ def ringdown_modes(
     guesses = [
         (m.damped_frequency_hz, m.damping_ratio)
         for m in poles
-        if 0.0 < m.damping_ratio < MAX_DAMPING_RATIO and m.damped_frequency_hz < 0.4 * rate
+        if 0.0 < m.damping_ratio < MAX_DAMPING_RATIO
+        and m.damped_frequency_hz < 0.4 * rate
+        and not _harmonic(m, poles)
     ][:max_modes]
     while guesses:
         try:
@@ -136,7 +141,7 @@ def ringdown_modes(
             guesses = guesses[:-1]
             continue
         modes = [params.mode(k) for k in range(len(guesses))]
-        kept = [m for m in modes if _stands_out(m)]
+        kept = [m for m in modes if _stands_out(m) and not _harmonic(m, modes)]
         if len(kept) == len(modes):
             return tuple(
                 MeasuredMode(
@@ -171,6 +176,21 @@ def _stands_out(mode: ModeEstimate) -> bool:
         and mode.damping_ratio > MIN_SIGNIFICANCE * mode.damping_ratio_std
         and mode.natural_frequency_hz > MIN_SIGNIFICANCE * mode.natural_frequency_hz_std
     )
+
+
+def _harmonic(mode: ModeEstimate, modes: Sequence[ModeEstimate]) -> bool:
+    """Whether ``mode`` is an overtone of a stronger, slower one (a large ring-down's
+    geometric nonlinearity), not a mode of its own."""
+    for other in modes:
+        ratio = mode.damped_frequency_hz / other.damped_frequency_hz
+        order = round(ratio)
+        if (
+            other.amplitude > mode.amplitude
+            and order >= 2
+            and abs(ratio - order) < HARMONIC_TOLERANCE * order
+        ):
+            return True
+    return False
 
 
 def _principal_displacement(x: np.ndarray, z: np.ndarray) -> np.ndarray:
