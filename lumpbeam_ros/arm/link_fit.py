@@ -51,6 +51,8 @@ _STEP = 1e-5
 #: A parameter whose direction in the weighted Jacobian is this small (relative to the
 #: largest singular value) is not determined by the data.
 _RANK_TOLERANCE = 1e-6
+#: The weighted residual of a mode the model no longer has.
+_FAR = 1e6
 #: Rounds of fit-then-rematch before the matching must have settled.
 _MAX_ROUNDS = 4
 
@@ -238,6 +240,33 @@ def match_modes(measured_hz: np.ndarray, model_hz: np.ndarray) -> tuple[int, ...
     return tuple(reversed(picks))
 
 
+@dataclass(frozen=True)
+class _Data:
+    """The observations as the fit uses them.
+
+    Attributes:
+        qs: Each observation's final joint angles.
+        measured: Each observation's modes by increasing frequency.
+        labels: Each observation's label, for messages.
+        beta0: The damping each link's log factor is taken relative to.
+    """
+
+    qs: tuple[np.ndarray, ...]
+    measured: tuple[tuple[MeasuredMode, ...], ...]
+    labels: tuple[str, ...]
+    beta0: np.ndarray
+
+    @property
+    def frequencies(self) -> list[np.ndarray]:
+        """Each observation's measured frequencies, increasing."""
+        return [np.array([m.natural_frequency_hz for m in ms]) for ms in self.measured]
+
+    @property
+    def n_values(self) -> int:
+        """Measured values: a frequency and a damping ratio per mode."""
+        return 2 * sum(len(ms) for ms in self.measured)
+
+
 class LinkParameterFit:
     """Fits each link's k_tE and ``damping_beta`` to modes measured in several configurations.
 
@@ -251,32 +280,6 @@ class LinkParameterFit:
         self.n_links = arm.n_joints
         self._evaluations = 0
         self.result_: LinkFit | None = None
-
-    def _beta_start(self, observations: Sequence[ModeObservation]) -> np.ndarray:
-        """The nominal betas; a link without damping starts at ``2 zeta / omega`` of the data.
-
-        For stiffness-proportional damping every mode has ``zeta = beta omega / 2``.
-        """
-        betas = np.array([link.damping_beta for link in self.arm.links])
-        guesses = [
-            2.0 * m.damping_ratio / (2.0 * math.pi * m.natural_frequency_hz)
-            for obs in observations
-            for m in obs.modes
-        ]
-        data = float(np.median(guesses))
-        fallback = data if data > 0.0 else 1e-4
-        return np.where(betas > 0.0, betas, fallback)
-
-    def _modes(self, arm: ArmConfig, q: np.ndarray) -> Modes:
-        self._evaluations += 1
-        return arm_modes(ArmModel.from_config(arm), q)
-
-    def _all_modes(
-        self, theta: np.ndarray, beta0: np.ndarray, qs: list[np.ndarray]
-    ) -> list[Modes]:
-        n = self.n_links
-        arm = scaled_arm(self.arm, np.exp(theta[:n]), beta0 * np.exp(theta[n:]))
-        return [self._modes(arm, q) for q in qs]
 
     def fit(self, observations: Sequence[ModeObservation]) -> LinkFit:
         """Fits the links.
@@ -294,17 +297,19 @@ class LinkParameterFit:
                 stiffness or damping undetermined (configurations too alike).
         """
         obs = self._checked(observations)
-        qs = [o.joint_angles_rad for o in obs]
-        measured = [o.sorted_modes() for o in obs]
-        f_meas = [np.array([m.natural_frequency_hz for m in ms]) for ms in measured]
-        beta0 = self._beta_start(obs)
+        data = _Data(
+            qs=tuple(o.joint_angles_rad for o in obs),
+            measured=tuple(o.sorted_modes() for o in obs),
+            labels=tuple(o.label or f'observation {k + 1}' for k, o in enumerate(obs)),
+            beta0=self._beta_start(obs),
+        )
         n = self.n_links
         theta = np.zeros(2 * n)
-        theta[:n] = self._common_start(qs, f_meas, beta0, obs)
-        matches = self._match(theta, beta0, qs, f_meas, obs)
+        theta[:n] = self._common_start(data)
+        matches = self._match(theta, data)
         for _ in range(_MAX_ROUNDS):
-            theta = self._solve(theta, beta0, qs, measured, matches)
-            rematched = self._match(theta, beta0, qs, f_meas, obs)
+            theta = self._solve(theta, data, matches)
+            rematched = self._match(theta, data)
             if rematched == matches:
                 break
             matches = rematched
@@ -313,15 +318,15 @@ class LinkParameterFit:
                 'link fit: the measured modes match different model modes at every solution; '
                 'check that the bags come from this arm'
             )
-        residual = self._residuals(theta, beta0, qs, measured, matches)
-        jac = self._jacobian(theta, beta0, qs, measured, matches)
-        self._check_rank(jac, obs)
+        residual = self._residuals(theta, data, matches)
+        jac = self._jacobian(theta, data, matches)
+        self._check_rank(jac, len(obs))
         chi2 = float(residual @ residual)
         dof = residual.size - theta.size
         scale = math.sqrt(max(1.0, chi2 / dof)) if dof > 0 else 1.0
         covariance = np.linalg.inv(jac.T @ jac) * scale**2
         std = np.sqrt(np.diag(covariance))
-        arm = scaled_arm(self.arm, np.exp(theta[:n]), beta0 * np.exp(theta[n:]))
+        arm = self._arm(theta, data)
         links = []
         for i, link in enumerate(arm.links):
             k = link_stiffness_total(link)
@@ -378,25 +383,45 @@ class LinkParameterFit:
             )
         return obs
 
-    def _common_start(
-        self,
-        qs: list[np.ndarray],
-        f_meas: list[np.ndarray],
-        beta0: np.ndarray,
-        obs: list[ModeObservation],
-    ) -> float:
+    def _beta_start(self, observations: Sequence[ModeObservation]) -> np.ndarray:
+        """The nominal betas; a link without damping starts at ``2 zeta / omega`` of the data.
+
+        For stiffness-proportional damping every mode has ``zeta = beta omega / 2``.
+        """
+        betas = np.array([link.damping_beta for link in self.arm.links])
+        guesses = [
+            2.0 * m.damping_ratio / (2.0 * math.pi * m.natural_frequency_hz)
+            for obs in observations
+            for m in obs.modes
+        ]
+        data = float(np.median(guesses))
+        fallback = data if data > 0.0 else 1e-4
+        return np.where(betas > 0.0, betas, fallback)
+
+    def _arm(self, theta: np.ndarray, data: _Data) -> ArmConfig:
+        """The arm at log factors ``theta`` (stiffness factors, then damping factors)."""
+        n = self.n_links
+        return scaled_arm(self.arm, np.exp(theta[:n]), data.beta0 * np.exp(theta[n:]))
+
+    def _all_modes(self, theta: np.ndarray, data: _Data) -> list[Modes]:
+        model = ArmModel.from_config(self._arm(theta, data))
+        self._evaluations += len(data.qs)
+        return [arm_modes(model, q) for q in data.qs]
+
+    def _common_start(self, data: _Data) -> float:
         """The common log stiffness factor whose matched frequencies fit best."""
         best, best_cost = 0.0, math.inf
         n = self.n_links
+        frequencies = data.frequencies
         for factor in START_FACTORS:
             theta = np.zeros(2 * n)
             theta[:n] = math.log(factor)
             try:
-                modes = self._all_modes(theta, beta0, qs)
+                modes = self._all_modes(theta, data)
             except LumpbeamError:
                 continue  # too soft to stand at some q
             cost = 0.0
-            for f, m in zip(f_meas, modes, strict=True):
+            for f, m in zip(frequencies, modes, strict=True):
                 g = m.natural_frequency_hz
                 match = match_modes(f, g)
                 if match is None:
@@ -406,81 +431,62 @@ class LinkParameterFit:
             if cost < best_cost:
                 best, best_cost = math.log(factor), cost
         if not math.isfinite(best_cost):
-            worst = max(range(len(obs)), key=lambda i: f_meas[i].size)
-            raise LumpbeamError(
-                f'{obs[worst].label or "a bag"}: {f_meas[worst].size} modes measured, more than '
-                'the arm model has (check --arm)'
-            )
+            self._match(np.zeros(2 * n), data)  # names the bag with too many modes
+            raise LumpbeamError("link fit: the arm cannot stand at the bags' joint angles")
         return best
 
-    def _match(
-        self,
-        theta: np.ndarray,
-        beta0: np.ndarray,
-        qs: list[np.ndarray],
-        f_meas: list[np.ndarray],
-        obs: list[ModeObservation],
-    ) -> list[tuple[int, ...]]:
+    def _match(self, theta: np.ndarray, data: _Data) -> list[tuple[int, ...]]:
         matches = []
-        for f, m, o in zip(f_meas, self._all_modes(theta, beta0, qs), obs, strict=True):
+        modes = self._all_modes(theta, data)
+        for f, m, label in zip(data.frequencies, modes, data.labels, strict=True):
             match = match_modes(f, m.natural_frequency_hz)
             if match is None:
                 raise LumpbeamError(
-                    f'{o.label or "a bag"}: {f.size} modes measured, more than the arm model '
-                    f'has ({m.natural_frequency_hz.size})'
+                    f'{label}: {f.size} modes measured, more than the arm model has '
+                    f'({m.natural_frequency_hz.size})'
                 )
             matches.append(match)
         return matches
 
     def _residuals(
-        self,
-        theta: np.ndarray,
-        beta0: np.ndarray,
-        qs: list[np.ndarray],
-        measured: list[tuple[MeasuredMode, ...]],
-        matches: list[tuple[int, ...]],
+        self, theta: np.ndarray, data: _Data, matches: list[tuple[int, ...]]
     ) -> np.ndarray:
+        """Each matched mode's frequency and damping-ratio misfit over its std."""
         parts = []
-        for modes, ms, match in zip(
-            self._all_modes(theta, beta0, qs), measured, matches, strict=True
-        ):
+        all_modes = self._all_modes(theta, data)
+        for modes, ms, match in zip(all_modes, data.measured, matches, strict=True):
             for mode, j in zip(ms, match, strict=True):
                 if j >= modes.natural_frequency_hz.size:
                     # The mode turned overdamped or vanished: as far off as it can be.
-                    parts += [1e6, 1e6]
+                    parts += [_FAR, _FAR]
                     continue
-                parts.append(
-                    (modes.natural_frequency_hz[j] - mode.natural_frequency_hz)
-                    / mode.natural_frequency_hz_std
-                )
-                parts.append(
-                    (modes.damping_ratio[j] - mode.damping_ratio) / mode.damping_ratio_std
-                )
+                df = modes.natural_frequency_hz[j] - mode.natural_frequency_hz
+                dz = modes.damping_ratio[j] - mode.damping_ratio
+                parts += [df / mode.natural_frequency_hz_std, dz / mode.damping_ratio_std]
         return np.asarray(parts, dtype=float)
 
-    def _solve(
-        self,
-        theta: np.ndarray,
-        beta0: np.ndarray,
-        qs: list[np.ndarray],
-        measured: list[tuple[MeasuredMode, ...]],
-        matches: list[tuple[int, ...]],
-    ) -> np.ndarray:
+    def _solve(self, theta: np.ndarray, data: _Data, matches: list[tuple[int, ...]]) -> np.ndarray:
+        """Least squares in the log factors from ``theta``, the matching held."""
         bound = math.log(MAX_FACTOR)
 
         def residuals(x: np.ndarray) -> np.ndarray:
             try:
-                return self._residuals(x, beta0, qs, measured, matches)
+                return self._residuals(x, data, matches)
+            except LumpbeamError:  # no equilibrium: the solver steps back
+                return np.full(data.n_values, _FAR)
+
+        def jacobian(x: np.ndarray) -> np.ndarray:
+            try:
+                return self._jacobian(x, data, matches)
             except LumpbeamError:
-                return np.full(2 * sum(len(m) for m in matches), 1e6)
+                return np.zeros((data.n_values, x.size))
 
         solution = least_squares(
             residuals,
             np.clip(theta, -bound, bound),
-            jac=lambda x: self._jacobian(x, beta0, qs, measured, matches),
+            jac=jacobian,
             bounds=(-bound, bound),
             method='trf',
-            x_scale=1.0,
             xtol=1e-10,
             ftol=1e-12,
             gtol=1e-10,
@@ -489,24 +495,19 @@ class LinkParameterFit:
         return np.asarray(solution.x)
 
     def _jacobian(
-        self,
-        theta: np.ndarray,
-        beta0: np.ndarray,
-        qs: list[np.ndarray],
-        measured: list[tuple[MeasuredMode, ...]],
-        matches: list[tuple[int, ...]],
+        self, theta: np.ndarray, data: _Data, matches: list[tuple[int, ...]]
     ) -> np.ndarray:
         """Central differences of the weighted residuals in the log factors."""
         columns = []
         for i in range(theta.size):
             step = np.zeros_like(theta)
             step[i] = _STEP
-            up = self._residuals(theta + step, beta0, qs, measured, matches)
-            down = self._residuals(theta - step, beta0, qs, measured, matches)
+            up = self._residuals(theta + step, data, matches)
+            down = self._residuals(theta - step, data, matches)
             columns.append((up - down) / (2 * _STEP))
         return np.column_stack(columns)
 
-    def _check_rank(self, jac: np.ndarray, obs: list[ModeObservation]) -> None:
+    def _check_rank(self, jac: np.ndarray, n_bags: int) -> None:
         """Refuses data that leave a direction of the unknowns undetermined."""
         _, singular, vt = np.linalg.svd(jac, full_matrices=False)
         if singular[-1] > _RANK_TOLERANCE * singular[0]:
@@ -515,6 +516,6 @@ class LinkParameterFit:
         n = self.n_links
         what = 'stiffness' if worst < n else 'damping'
         raise LumpbeamError(
-            f"link fit: the modes of {len(obs)} bag(s) do not determine link {worst % n + 1}'s "
+            f"link fit: the modes of {n_bags} bag(s) do not determine link {worst % n + 1}'s "
             f'{what}: add bags whose moves end in other configurations'
         )
