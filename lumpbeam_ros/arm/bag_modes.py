@@ -61,8 +61,23 @@ class FinalJoints:
     end_s: float
 
 
-def read_final_joints(bag: str | Path) -> FinalJoints:
-    """Reads ``/joint_states`` and finds when the joints came to rest for good.
+@dataclass(frozen=True)
+class JointSeries:
+    """A bag's ``/joint_states``, sorted by stamp.
+
+    Attributes:
+        names: The joint names, in message order.
+        t: Stamps, s.
+        q: Angles, rad, shape (len(t), len(names)).
+    """
+
+    names: tuple[str, ...]
+    t: np.ndarray
+    q: np.ndarray
+
+
+def read_joint_states(bag: str | Path) -> JointSeries:
+    """Reads ``/joint_states`` whole.
 
     Raises:
         BagError: No ``/joint_states`` (not an arm's bag), no message, messages whose joint
@@ -92,13 +107,24 @@ def read_final_joints(bag: str | Path) -> FinalJoints:
     if names is None:
         raise BagError(f'{bag}: {JOINT_STATES} holds no messages')
     order = np.argsort(np.asarray(stamps), kind='stable')
-    t = np.asarray(stamps, dtype=float)[order] / convert.NS_PER_S
     q = np.vstack(rows)[order]
     if not np.all(np.isfinite(q)):
         raise BagError(f'{bag}: {JOINT_STATES} holds angles that are not finite')
+    t = np.asarray(stamps, dtype=float)[order] / convert.NS_PER_S
+    return JointSeries(tuple(names), t, q)
+
+
+def read_final_joints(bag: str | Path) -> FinalJoints:
+    """Reads ``/joint_states`` and finds when the joints came to rest for good.
+
+    Raises:
+        BagError: As :func:`read_joint_states`.
+    """
+    joints = read_joint_states(bag)
+    q, t = joints.q, joints.t
     moving = np.flatnonzero(np.any(np.abs(q - q[-1]) > REST_TOLERANCE_RAD, axis=1))
     rest = int(moving[-1]) + 1 if moving.size else 0
-    return FinalJoints(tuple(names), q[-1].copy(), float(t[rest]), float(t[-1]))
+    return FinalJoints(joints.names, q[-1].copy(), float(t[rest]), float(t[-1]))
 
 
 def ringdown_modes(
@@ -179,8 +205,10 @@ def _stands_out(mode: ModeEstimate) -> bool:
 
 
 def _harmonic(mode: ModeEstimate, modes: Sequence[ModeEstimate]) -> bool:
-    """Whether ``mode`` is an overtone of a stronger, slower one (a large ring-down's
-    geometric nonlinearity), not a mode of its own."""
+    """Whether ``mode`` is an overtone of a stronger, slower one, not a mode of its own.
+
+    A large ring-down's geometric nonlinearity puts overtones at integer multiples.
+    """
     for other in modes:
         ratio = mode.damped_frequency_hz / other.damped_frequency_hz
         order = round(ratio)
