@@ -23,6 +23,7 @@ import numpy as np
 
 from lumpbeam_ros.arm.config import ArmConfig
 from lumpbeam_ros.arm.link_fit import MeasuredMode, ModeObservation
+from lumpbeam_ros.arm.moves import find_moves
 from lumpbeam_ros.bagio import convert, open_bag, read_tip_poses
 from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.ident.mode_estimate import ModeEstimate
@@ -30,8 +31,6 @@ from lumpbeam_ros.ident.pencil import MatrixPencil
 from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit
 from lumpbeam_ros.interface import JOINT_STATE_TYPE, JOINT_STATES, TIP_POSE
 
-#: Joints closer than this to their final angles count as at rest, rad.
-REST_TOLERANCE_RAD = 1e-9
 #: Shortest ring-down worth fitting, s.
 MIN_RINGDOWN_S = 1.0
 #: A mode is kept when its amplitude, frequency and damping ratio are each at least this
@@ -111,7 +110,9 @@ def read_joint_states(bag: str | Path) -> JointSeries:
     if not np.all(np.isfinite(q)):
         raise BagError(f'{bag}: {JOINT_STATES} holds angles that are not finite')
     t = np.asarray(stamps, dtype=float)[order] / convert.NS_PER_S
-    return JointSeries(tuple(names), t, q)
+    # A repeated stamp (a message recorded twice) keeps its first message.
+    t, first = np.unique(t, return_index=True)
+    return JointSeries(tuple(names), t, q[first])
 
 
 def read_final_joints(bag: str | Path) -> FinalJoints:
@@ -121,10 +122,10 @@ def read_final_joints(bag: str | Path) -> FinalJoints:
         BagError: As :func:`read_joint_states`.
     """
     joints = read_joint_states(bag)
-    q, t = joints.q, joints.t
-    moving = np.flatnonzero(np.any(np.abs(q - q[-1]) > REST_TOLERANCE_RAD, axis=1))
-    rest = int(moving[-1]) + 1 if moving.size else 0
-    return FinalJoints(joints.names, q[-1].copy(), float(t[rest]), float(t[-1]))
+    t = joints.t
+    moves = find_moves(t, joints.q)
+    rest = moves[-1].end_s if moves else float(t[0])
+    return FinalJoints(joints.names, joints.q[-1].copy(), rest, float(t[-1]))
 
 
 def ringdown_modes(
