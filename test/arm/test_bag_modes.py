@@ -8,6 +8,7 @@ from lumpbeam_ros.arm.bag_modes import (
     bag_observation,
     bag_observations,
     read_final_joints,
+    read_joint_states,
     ringdown_modes,
 )
 from lumpbeam_ros.arm.model import ArmModel
@@ -80,3 +81,12 @@ def test_joint_states_that_change_names_are_refused(tmp_path):
         writer.write_joint_state('/joint_states', 0.1, ['joint_2'], np.zeros(1))
     with pytest.raises(BagError, match='names change'):
         read_final_joints(tmp_path / 'mixed')
+
+
+def test_a_joint_state_recorded_twice_counts_once(tmp_path):
+    with BagWriter(tmp_path / 'twice') as writer:
+        for stamp, angle in ((0.0, 0.0), (0.1, 0.2), (0.1, 0.2), (0.2, 0.2)):
+            writer.write_joint_state('/joint_states', stamp, ['joint_1'], np.array([angle]))
+    joints = read_joint_states(tmp_path / 'twice')
+    assert joints.t == pytest.approx([0.0, 0.1, 0.2])
+    assert read_final_joints(tmp_path / 'twice').rest_from_s == pytest.approx(0.1)
