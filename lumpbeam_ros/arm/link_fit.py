@@ -51,6 +51,8 @@ _STEP = 1e-5
 #: A parameter whose direction in the weighted Jacobian is this small (relative to the
 #: largest singular value) is not determined by the data.
 _RANK_TOLERANCE = 1e-6
+#: A stiffness whose relative std exceeds this is reported as uncertain.
+UNCERTAIN_ABOVE = 0.05
 #: The weighted residual of a mode the model no longer has.
 _FAR = 1e6
 #: Rounds of fit-then-rematch before the matching must have settled.
@@ -166,6 +168,21 @@ class LinkFit:
     def predict(self, q: np.ndarray) -> Modes:
         """The fitted arm's modes at rest at joint angles ``q``."""
         return arm_modes(ArmModel.from_config(self.arm), q)
+
+    def warnings(self) -> list[str]:
+        """One line per link whose stiffness is uncertain by more than :data:`UNCERTAIN_ABOVE`.
+
+        The fit is kept: its standard deviation says how uncertain it is.
+        """
+        lines = []
+        for i, link in enumerate(self.links, start=1):
+            relative = link.k_total_nm_per_rad_std / link.k_total_nm_per_rad
+            if relative > UNCERTAIN_ABOVE:
+                lines.append(
+                    f"link {i}'s stiffness is uncertain by {100 * relative:.0f} %: add bags "
+                    'that show more modes, or whose moves end in other configurations'
+                )
+        return lines
 
     def as_json(self) -> dict[str, Any]:
         """``links`` as the contract lists them, then the fit's figures."""

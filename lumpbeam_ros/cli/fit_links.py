@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 from lumpbeam_ros.arm.bag_modes import bag_observations
 from lumpbeam_ros.arm.config import load_arm_config
@@ -45,6 +46,8 @@ def run_fit_links(args: argparse.Namespace) -> int:
             f'{link_stiffness_total(nominal):.6g}), damping_beta {link.damping_beta:.4g} +- '
             f'{link.damping_beta_std:.2g} s (nominal {nominal.damping_beta:.4g})'
         )
+    for line in fit.warnings():
+        print(f'lumpbeam analyze: warning: {line}', file=sys.stderr)
     if args.json:
         data = fit.as_json()
         data['bags'] = [

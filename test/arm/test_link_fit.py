@@ -149,6 +149,14 @@ def test_modes_from_mujoco_give_the_truth_back():
     assert fitted_values(fit) == pytest.approx(truth_values(truth), rel=1e-5)
 
 
+def test_a_link_the_data_hardly_see_is_reported_uncertain():
+    # The first mode alone at three configurations: the wrist's stiffness barely shows.
+    fit = LinkParameterFit(nominal_of(TRUTH)).fit(observe(TRUTH, FINALS, 1))
+    warnings = fit.warnings()
+    assert any(line.startswith("link 3's stiffness is uncertain by") for line in warnings)
+    assert LinkParameterFit(nominal_of(TRUTH)).fit(observe(TRUTH, FINALS[:3], 3)).warnings() == []
+
+
 def test_too_few_modes_for_the_links_is_refused_in_one_line():
     with pytest.raises(LumpbeamError, match=r'1 bag\(s\) give 2 mode\(s\).*at least 3') as err:
         LinkParameterFit(nominal_of(TRUTH)).fit(observe(TRUTH, FINALS[:1], 2))
