@@ -39,6 +39,9 @@ MIN_SIGNIFICANCE = 5.0
 #: A mode within this fraction of an integer multiple of a stronger mode's frequency is
 #: taken for its overtone.
 HARMONIC_TOLERANCE = 2e-3
+#: A mode within this fraction of a stronger mode's frequency is taken for the stronger
+#: mode's drift with amplitude (an arm's modes lie much further apart).
+SHADOW_TOLERANCE = 0.02
 #: Damping ratios above this are not a ringing mode (a slow drift the fit soaked up).
 MAX_DAMPING_RATIO = 0.5
 
@@ -206,18 +209,20 @@ def _stands_out(mode: ModeEstimate) -> bool:
 
 
 def _harmonic(mode: ModeEstimate, modes: Sequence[ModeEstimate]) -> bool:
-    """Whether ``mode`` is an overtone of a stronger, slower one, not a mode of its own.
+    """Whether ``mode`` is an artefact of a stronger one, not a mode of its own.
 
-    A large ring-down's geometric nonlinearity puts overtones at integer multiples.
+    A large ring-down's geometric nonlinearity puts overtones at integer multiples of a
+    mode's frequency, and its frequency drifting with the amplitude shows as a weaker mode
+    beside it.
     """
     for other in modes:
+        if not other.amplitude > mode.amplitude:
+            continue
         ratio = mode.damped_frequency_hz / other.damped_frequency_hz
         order = round(ratio)
-        if (
-            other.amplitude > mode.amplitude
-            and order >= 2
-            and abs(ratio - order) < HARMONIC_TOLERANCE * order
-        ):
+        if order >= 2 and abs(ratio - order) < HARMONIC_TOLERANCE * order:
+            return True
+        if abs(ratio - 1.0) < SHADOW_TOLERANCE:
             return True
     return False
 
