@@ -15,7 +15,7 @@ amplitude, frequency and damping stand out of their standard deviations.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,6 +44,11 @@ HARMONIC_TOLERANCE = 2e-3
 SHADOW_TOLERANCE = 0.02
 #: Damping ratios above this are not a ringing mode (a slow drift the fit soaked up).
 MAX_DAMPING_RATIO = 0.5
+
+
+#: What identifies the modes of a ring-down: ``(t, x, z, max_modes)`` of the tip (s, m, m)
+#: from the moment the joints stop, to the modes that stand out of the noise.
+RingdownIdentifier = Callable[[np.ndarray, np.ndarray, np.ndarray, int], Sequence[MeasuredMode]]
 
 
 @dataclass(frozen=True)
@@ -235,17 +240,23 @@ def _principal_displacement(x: np.ndarray, z: np.ndarray) -> np.ndarray:
 
 
 def bag_observation(
-    bag: str | Path, joints: FinalJoints | None = None, max_modes: int = 3
+    bag: str | Path,
+    joints: FinalJoints | None = None,
+    max_modes: int = 3,
+    identify: RingdownIdentifier = ringdown_modes,
 ) -> ModeObservation:
     """A bag's final joint angles and the modes of its ring-down after the last move.
 
     This is the seam between the bags and the link fit: the observation it returns is all
-    :class:`~lumpbeam_ros.arm.link_fit.LinkParameterFit` needs.
+    :class:`~lumpbeam_ros.arm.link_fit.LinkParameterFit` needs, and ``identify`` is the one
+    call that finds the modes.
 
     Args:
         bag: An arm's bag: ``/joint_states`` and ``/tip_pose``.
         joints: Its :func:`read_final_joints`, when already read.
         max_modes: At most this many modes.
+        identify: ``(t, x, z, max_modes) -> modes`` of the tip's free vibration from the
+            moment the joints stop (:func:`ringdown_modes` by default).
 
     Returns:
         The observation.
@@ -263,7 +274,7 @@ def bag_observation(
             f'{bag}: no ring-down after the last move: {span:.2f} s of {TIP_POSE} after the '
             f'joints stop at {joints.rest_from_s:.3f} s (at least {MIN_RINGDOWN_S:g} s needed)'
         )
-    modes = ringdown_modes(after.t, after.x, after.z, max_modes)
+    modes = tuple(identify(after.t, after.x, after.z, max_modes))
     if not modes:
         raise BagError(
             f'{bag}: no ring-down after the last move: no mode stands out of the noise in '
@@ -273,9 +284,12 @@ def bag_observation(
 
 
 def bag_observations(
-    bags: Sequence[str | Path], arm: ArmConfig, max_modes: int = 3
+    bags: Sequence[str | Path],
+    arm: ArmConfig,
+    max_modes: int = 3,
+    identify: RingdownIdentifier = ringdown_modes,
 ) -> list[ModeObservation]:
-    """Every bag's observation, once all are checked to come from one arm: this one.
+    """Every bag's :func:`bag_observation`, once all are checked to come from this arm.
 
     Raises:
         BagError: As :func:`read_final_joints` and :func:`bag_observation`.
@@ -295,5 +309,6 @@ def bag_observations(
                 f'{list(finals[0].names)}: bags from different arms'
             )
     return [
-        bag_observation(bag, joints, max_modes) for bag, joints in zip(bags, finals, strict=True)
+        bag_observation(bag, joints, max_modes, identify)
+        for bag, joints in zip(bags, finals, strict=True)
     ]

@@ -29,8 +29,8 @@ Example::
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
@@ -74,6 +74,22 @@ class MeasuredMode:
     natural_frequency_hz_std: float
     damping_ratio: float
     damping_ratio_std: float
+
+    @classmethod
+    def from_json(cls, entry: Mapping[str, Any], where: str) -> MeasuredMode:
+        """A mode from an entry of ``lumpbeam analyze``'s ``modes`` list (extra keys ignored).
+
+        Raises:
+            LumpbeamError: A key missing, or a value that is not a number (null: no
+                estimate).
+        """
+        values = []
+        for key in (f.name for f in fields(cls)):
+            value = entry.get(key)
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise LumpbeamError(f'{where}: {key} is {value!r}, not a number')
+            values.append(float(value))
+        return cls(*values)
 
     def check(self, where: str) -> None:
         """Refuses a mode that cannot be fitted.
