@@ -4,9 +4,10 @@ An arm's modes change with its configuration: in a vertical arm gravity stiffens
 each spring by ``g G sin(phi)``, and in any arm of two links or more the mass matrix turns
 with the relative joint angles. Modes measured at rest in several configurations therefore
 pin down each link's total stiffness k_tE (B.12, B.13) and its damping ``beta = c / k``
-(B.23), which one configuration alone rarely can: the model's modes (statics, then B.16
-linearized about the rest at the final joint angles q) are fitted to the measured ones by
-weighted nonlinear least squares, each residual over the measurement's standard deviation.
+(B.23), which one configuration can only when it shows at least one mode per link: the
+model's modes (statics, then B.16 linearized about the rest at the final joint angles q) are
+fitted to the measured ones by weighted nonlinear least squares, each residual over the
+measurement's standard deviation.
 
 The unknowns are log factors on the nominal arm's values, one for each link's stiffness and
 one for its damping, so both stay positive and the solver sees relative changes. A link given
