@@ -179,6 +179,7 @@ def run_bags(case: ArmCase, folder: Path, move_s: float = 2.0, record_s: float =
     """
     from lumpbeam_lab.shaping_loop import minimum_jerk
     from lumpbeam_ros.arm.bag_modes import bag_observations
+    from lumpbeam_ros.ident.settings import IdentifierConfig
     from lumpbeam_ros.synthetic.arm_bag import ArmSynthOptions, write_arm_bag
 
     truth = load_arm_config(case.config)
@@ -190,7 +191,7 @@ def run_bags(case: ArmCase, folder: Path, move_s: float = 2.0, record_s: float =
         move = minimum_jerk(start, np.asarray(q, dtype=float), move_s)
         write_arm_bag(path, truth, move, ArmSynthOptions(record_s))
         bags.append(path)
-    obs = bag_observations(bags, truth)
+    obs = bag_observations(bags, truth, IdentifierConfig())
     nominal = nominal_arm(truth, np.random.default_rng(1))
     fit = LinkParameterFit(nominal).fit(obs)
     values, stds = fit_table(fit)

@@ -29,6 +29,7 @@ import numpy as np
 from lumpbeam_ros.arm.bag_modes import bag_observation
 from lumpbeam_ros.arm.config import ArmConfig, load_arm_config
 from lumpbeam_ros.arm.link_fit import MeasuredMode
+from lumpbeam_ros.ident.settings import IdentifierConfig
 from lumpbeam_ros.interface import TIP_POSE_TRUTH
 from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
 from lumpbeam_ros.params.shaper_params import SHAPER_SCHEMA
@@ -109,7 +110,7 @@ def run_loop(case: LoopCase, folder: Path, noise_m: float = 20e-6) -> tuple[str,
     first = folder / f'{case.name}_unshaped'
     options = ArmSynthOptions(out.duration_s + RECORD_AFTER_S, noise_m=noise_m)
     write_arm_bag(first, arm, out, options)
-    observation = bag_observation(first)
+    observation = bag_observation(first, arm, IdentifierConfig())
     kind, impulses = shaper_for(observation.sorted_modes())
     back = shape_trajectory(minimum_jerk(far, near, case.move_s), impulses)
     second = folder / f'{case.name}_shaped'

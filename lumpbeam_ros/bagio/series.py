@@ -247,6 +247,8 @@ class JointSeries(NamedTuple):
 def read_joint_states(bag: Bag, topic: str = JOINT_STATES) -> JointSeries:
     """Reads a ``sensor_msgs/JointState`` topic's positions, sorted by stamp.
 
+    A stamp recorded twice keeps its first message, so the stamps increase strictly.
+
     Raises:
         BagError: Missing topic, another type, no message, or messages that name other
             joints than the first one (a message that does not decode is skipped and
@@ -272,4 +274,7 @@ def read_joint_states(bag: Bag, topic: str = JOINT_STATES) -> JointSeries:
         raise BagError(f'{reader.path}: topic {topic} has no message')
     t = np.asarray(stamps)
     order = np.argsort(t, kind='stable')
-    return JointSeries(t[order], np.asarray(rows, dtype=float)[order], names)
+    # A message recorded twice (two recorders, a replayed bag) keeps its first copy: the
+    # stamps of a joint series increase strictly.
+    t, first = np.unique(t[order], return_index=True)
+    return JointSeries(t, np.asarray(rows, dtype=float)[order][first], names)

@@ -29,7 +29,7 @@ __all__ = ['CONTRACT_KEYS', 'Progress', 'read_window', 'result_json', 'run']
 
 def run(args: argparse.Namespace) -> int:
     """Reads the bag, identifies the whole record, prints a summary, writes JSON and plots."""
-    if args.fit_links or args.arm:
+    if args.fit_links:
         from lumpbeam_ros.cli.fit_links import run_fit_links
 
         return run_fit_links(args)

@@ -289,15 +289,15 @@ def add_analyze(parser: argparse.ArgumentParser) -> None:
         help='report at most N modes, each only when it stands out of the noise '
         "(default: the identifier config's fit.max_modes, 3)",
     )
-    parser.add_argument(
+    add_report(parser)
+    arm = parser.add_argument_group("an arm's bags (doc/arm.md)")
+    arm.add_argument(
         '--arm',
         metavar='FILE',
-        help="an arm's bag (with /joint_states): the free vibration after the last move, "
-        'beside the modes of this arm file at the final joint angles',
+        help="the arm's configuration file: the free vibration after the last move on "
+        "/joint_states, beside the arm's modes at the final joint angles; with --fit-links, "
+        'the nominal link values',
     )
-    add_report(parser)
-    arm = parser.add_argument_group("an arm's links from its ring-downs (doc/arm.md)")
-    arm.add_argument('--arm', metavar='FILE', help='arm configuration file (nominal values)')
     arm.add_argument(
         '--fit-links',
         action='store_true',

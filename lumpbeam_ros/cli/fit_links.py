@@ -10,22 +10,24 @@ from lumpbeam_ros.arm.config import load_arm_config
 from lumpbeam_ros.arm.link_fit import LinkParameterFit, link_stiffness_total
 from lumpbeam_ros.cli.output import write_json
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ident.settings import load_identifier_config, with_max_modes
 
 
 def run_fit_links(args: argparse.Namespace) -> int:
     """Reads each bag's final joints and ring-down modes, fits the links, prints and writes them.
 
     Raises:
-        LumpbeamError: ``--fit-links`` without ``--arm`` (or the reverse), and everything
+        LumpbeamError: ``--fit-links`` without ``--arm``, and everything
             :func:`~lumpbeam_ros.arm.bag_modes.bag_observations` and
             :meth:`~lumpbeam_ros.arm.link_fit.LinkParameterFit.fit` refuse.
     """
     if not args.arm:
         raise LumpbeamError('--fit-links needs --arm FILE (the arm the bags were recorded on)')
-    if not args.fit_links:
-        raise LumpbeamError('--arm takes the links from the bags with --fit-links')
     arm = load_arm_config(args.arm)
-    observations = bag_observations(args.bag, arm)
+    config = load_identifier_config(args.identifier_config)
+    if args.max_modes is not None:
+        config = with_max_modes(config, args.max_modes)
+    observations = bag_observations(args.bag, arm, config)
     for obs in observations:
         angles = ', '.join(f'{v:.4g}' for v in obs.joint_angles_rad)
         modes = ', '.join(

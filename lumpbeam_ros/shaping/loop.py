@@ -14,12 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
-from lumpbeam_ros.arm.bag_modes import read_joint_states
 from lumpbeam_ros.arm.config import ArmConfig
 from lumpbeam_ros.arm.model import ArmModel
 from lumpbeam_ros.arm.moves import Move, find_moves
 from lumpbeam_ros.arm.residual import WINDOW_S, residual_rms, rest_tip
 from lumpbeam_ros.bagio import read_tip_poses
+from lumpbeam_ros.bagio.series import read_joint_states
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.interface import TIP_POSE
 
@@ -108,7 +108,7 @@ def bag_move_residuals(
     """
     joints = read_joint_states(bag)
     poses = read_tip_poses(bag, topic)
-    return move_residuals(arm, joints.t, joints.q, poses.t, poses.x, poses.z, window_s)
+    return move_residuals(arm, joints.t, joints.angles, poses.t, poses.x, poses.z, window_s)
 
 
 @dataclass(frozen=True)

@@ -100,3 +100,15 @@ def test_joint_states_round_trip_and_other_joints_are_an_error(tmp_path):
         read_joint_states(tmp_path / 'mixed')
     with pytest.raises(BagError, match='no topic /joint_states'):
         read_joint_states(tmp_path / 'arm', '/joint_states_other')
+
+
+def test_a_joint_state_recorded_twice_counts_once(tmp_path):
+    from lumpbeam_ros.bagio import BagWriter
+    from lumpbeam_ros.bagio.series import read_joint_states
+
+    with BagWriter(tmp_path / 'twice') as bag:
+        for stamp, angle in ((0.0, 0.0), (0.1, 0.2), (0.1, 0.3), (0.2, 0.2)):
+            bag.write_joint_state('/joint_states', stamp, ['joint_1'], np.array([angle]))
+    series = read_joint_states(tmp_path / 'twice')
+    assert series.t == pytest.approx([0.0, 0.1, 0.2])
+    assert series.angles[:, 0].tolist() == [0.0, 0.2, 0.2]  # the first copy of 0.1 s
