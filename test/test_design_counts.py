@@ -113,3 +113,30 @@ def test_a_lab_import_by_the_product_is_found_and_the_cli_may_run_the_lab(tmp_pa
         'lumpbeam_ros/nodes/node.py:2: lumpbeam_lab.doctor',
         'lumpbeam_ros/vision/scores.py:1: lumpbeam_lab.camera.accuracy',
     ]
+
+
+def test_bags_are_read_by_the_one_reader_alone(tool):
+    assert tool.bag_readers(ROOT) == []
+
+
+def test_a_reader_of_its_own_is_found(tool, tmp_path):
+    repo = _package(
+        tmp_path,
+        {
+            'vision/offline.py': 'from mcap.reader import SeekingReader\n',
+            'bagio/reader.py': (
+                'from mcap.stream_reader import StreamReader\n'
+                "(length,) = struct.unpack_from('<Q', data, 1)\n"
+            ),
+            'bagio/fastscan.py': "(n,) = struct.unpack_from('<I', first, 12)\n",
+        },
+    )
+    assert tool.bag_readers(repo) == [
+        "lumpbeam_ros/bagio/fastscan.py:1: (n,) = struct.unpack_from('<I', first, 12)",
+        "lumpbeam_ros/bagio/reader.py:2: (length,) = struct.unpack_from('<Q', data, 1)",
+        'lumpbeam_ros/vision/offline.py:1: import mcap.reader',
+    ]
+    # The fast path with its agreement test is the one kept beside the reader.
+    (repo / 'test' / 'bagio').mkdir(parents=True)
+    (repo / 'test' / 'bagio' / 'test_fastscan.py').write_text('')
+    assert len(tool.bag_readers(repo)) == 2
