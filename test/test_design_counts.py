@@ -140,3 +140,28 @@ def test_a_reader_of_its_own_is_found(tool, tmp_path):
     (repo / 'test' / 'bagio').mkdir(parents=True)
     (repo / 'test' / 'bagio' / 'test_fastscan.py').write_text('')
     assert len(tool.bag_readers(repo)) == 2
+
+
+def test_configuration_types_follow_the_naming_rule(tool):
+    assert tool.config_type_names(ROOT) == []
+
+
+def test_a_configuration_type_against_the_rule_is_found(tool, tmp_path):
+    repo = _package(
+        tmp_path,
+        {
+            'a.py': (
+                'class FitParams:\n    a: float = 1.0\n'
+                "class LiveSettings:\n    x: float = setting('trigger', 1.0, 'x')\n"
+                "class SensorSettings:\n    f: float = setting('sensor.f', 1.0, 'f')\n"
+                "class RunOptions:\n    n: int = setting('run.n', 1, 'n')\n"
+                "class Window:\n    s: float = setting('window.s', 1.0, 's')\n"
+            ),
+        },
+    )
+    assert [line.split(': ')[1] for line in tool.config_type_names(repo)] == [
+        'FitParams',
+        'LiveSettings',
+        'RunOptions',
+        'Window',
+    ]

@@ -558,6 +558,62 @@ def bag_readers(repo: Path) -> list[str]:
     return found
 
 
+# --- Names of configuration types --------------------------------------------------------------
+
+
+def _declared_keys(node: ast.ClassDef) -> list[str]:
+    """The parameter keys a class's fields declare with ``setting('key', ...)``."""
+    keys = []
+    for item in node.body:
+        if (
+            isinstance(item, ast.AnnAssign)
+            and isinstance(item.value, ast.Call)
+            and isinstance(item.value.func, ast.Name)
+            and item.value.func.id == 'setting'
+            and item.value.args
+            and isinstance(item.value.args[0], ast.Constant)
+        ):
+            keys.append(str(item.value.args[0].value))
+    return keys
+
+
+def config_type_names(repo: Path) -> list[str]:
+    """Configuration types named against the rule of doc/architecture.md, "Names".
+
+    - no type ends in ``Params`` (``Parameters``, spelled out, is a model's quantities);
+    - a ``Settings`` type is one section of a configuration: its fields declare parameters,
+      all under one key prefix (``sensor.*``);
+    - an ``Options`` type declares no parameter (it is never read from a parameter file);
+    - a type that declares parameters ends in ``Config``, ``Settings`` or ``Parameters``.
+
+    Returns:
+        ``file:line: name: what is wrong`` for each.
+    """
+    found = []
+    for package in ('lumpbeam_ros', LAB):
+        for path in sorted((repo / package).rglob('*.py')):
+            rel = path.relative_to(repo).as_posix()
+            for node in ast.walk(ast.parse(path.read_text())):
+                if not isinstance(node, ast.ClassDef):
+                    continue
+                keys = _declared_keys(node)
+                prefixes = {key.partition('.')[0] for key in keys if '.' in key}
+                why = ''
+                if node.name.endswith('Params'):
+                    why = "Params: a model's quantities are Parameters; a configuration, Config"
+                elif node.name.endswith('Settings') and (
+                    not keys or len(prefixes) != 1 or not all('.' in key for key in keys)
+                ):
+                    why = 'Settings are one section of parameters, under one key prefix'
+                elif node.name.endswith('Options') and keys:
+                    why = 'Options are not read from a parameter file'
+                elif keys and not node.name.endswith(('Config', 'Settings', 'Parameters')):
+                    why = 'it declares parameters: a Config, Settings or Parameters'
+                if why:
+                    found.append(f'{rel}:{node.lineno}: {node.name}: {why}')
+    return found
+
+
 def main(argv: list[str]) -> int:
     """Prints the counts, each with the places that make it up."""
     repo = Path(argv[1]) if len(argv) > 1 else Path(__file__).resolve().parents[1]
@@ -577,6 +633,9 @@ def main(argv: list[str]) -> int:
         'places to change to add an effect (besides its physics)': effect_places(repo),
         'lab modules imported by the core': lab_imports(repo),
         'readers of bags besides bagio/reader.py and its tested fast path': bag_readers(repo),
+        'configuration types named against the rule (Config, Settings, Options, Parameters)': (
+            config_type_names(repo)
+        ),
     }
     for title, hits in rows.items():
         print(f'{title}: {len(hits)}')
