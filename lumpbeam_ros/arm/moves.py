@@ -1,8 +1,10 @@
 """The moves in a record of joint angles: when the joints leave rest and where they stop.
 
 A move starts at the last sample before the joints leave their angles and ends at the first
-sample at the angles they then keep; a rest shorter than ``min_rest_s`` inside a move (the
-flat stretches of a short move convolved with a shaper's impulses) does not end it.
+sample at the angles they then keep, by the rule of rest that finds an arm's ring-down
+(:func:`~lumpbeam_ros.ident.ring_down.rest_stretches`); a rest shorter than ``min_rest_s``
+inside a move (the flat stretches of a short move convolved with a shaper's impulses) does
+not end it.
 """
 
 from __future__ import annotations
@@ -12,8 +14,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ident.ring_down import rest_stretches
 
-#: Joints whose angles change by less than this between samples are at rest, rad.
+#: Joints that stay within this of the angles they stopped at are at rest, rad.
 REST_TOLERANCE_RAD = 1e-9
 #: A rest at least this long ends a move, s.
 MIN_REST_S = 0.5
@@ -46,7 +49,7 @@ def find_moves(
         t: Increasing stamps, s.
         q: Angles, rad, shape (len(t), n_joints) (or (len(t),) for one joint).
         min_rest_s: The shortest rest that separates two moves, s.
-        tolerance_rad: Smaller changes between samples are rest.
+        tolerance_rad: Joints within this of the angles they stopped at are at rest, rad.
 
     Returns:
         The moves in time order (none when the joints never move).
@@ -61,16 +64,15 @@ def find_moves(
         raise LumpbeamError(f'moves: {t.size} stamps for {q.shape[0]} joint samples')
     if np.any(np.diff(t) <= 0.0):
         raise LumpbeamError('moves: the stamps must increase')
-    steps = np.flatnonzero(np.any(np.abs(np.diff(q, axis=0)) > tolerance_rad, axis=1))
-    if steps.size == 0:
-        return ()
-    # Interval i runs from sample i to i + 1; a gap of rest between moving intervals splits.
-    groups = [[int(steps[0]), int(steps[0])]]
-    for i in steps[1:]:
-        if t[i] - t[groups[-1][1] + 1] >= min_rest_s:
-            groups.append([int(i), int(i)])
-        else:
-            groups[-1][1] = int(i)
+    stretches = rest_stretches(t, q, tolerance_rad)
+    # Moves run between the stretches at rest that separate them: the record's first and
+    # last, and every rest that lasts min_rest_s (a shorter one is a pause inside a move).
+    bounds = [
+        rest
+        for k, rest in enumerate(stretches)
+        if k in (0, len(stretches) - 1) or rest.duration_s >= min_rest_s
+    ]
     return tuple(
-        Move(float(t[first]), float(t[last + 1]), q[last + 1].copy()) for first, last in groups
+        Move(before.end_s, after.start_s, np.asarray(after.angles_rad))
+        for before, after in zip(bounds, bounds[1:], strict=False)
     )
