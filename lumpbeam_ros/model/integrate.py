@@ -72,6 +72,21 @@ class ChainSolution:
         return ChainState(self.phi[-1].copy(), self.phi_dot[-1].copy())
 
 
+def hold_weights(lam: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``e^{lam h}`` and the first-order-hold weights ``h phi1(lam h)``, ``h phi2(lam h)``.
+
+    The exact response of ``z' = lam z + u`` to a ``u`` linear over a step of ``h`` is
+    ``z_{k+1} = e^{lam h} z_k + h (phi1 - phi2) u_k + h phi2 u_{k+1}``.
+    """
+    lam_h = lam * h
+    e = np.exp(lam_h)
+    small = np.abs(lam_h) < 1e-4
+    safe = np.where(small, 1.0, lam_h)
+    phi1 = np.where(small, 1.0 + lam_h / 2.0, np.expm1(lam_h) / safe)
+    phi2 = np.where(small, 0.5 + lam_h / 6.0, (e - 1.0 - lam_h) / safe**2)
+    return e, h * phi1, h * phi2
+
+
 class ModalSolver:
     """The exact first-order-hold propagator of one linearised chain.
 
@@ -122,13 +137,7 @@ class ModalSolver:
 
     def _coefficients(self, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``e^{lam h}`` and the first-order-hold weights ``h phi1``, ``h phi2``."""
-        lam_h = self._lam * h
-        e = np.exp(lam_h)
-        small = np.abs(lam_h) < 1e-4
-        safe = np.where(small, 1.0, lam_h)
-        phi1 = np.where(small, 1.0 + lam_h / 2.0, np.expm1(lam_h) / safe)
-        phi2 = np.where(small, 0.5 + lam_h / 6.0, (e - 1.0 - lam_h) / safe**2)
-        return e, h * phi1, h * phi2
+        return hold_weights(self._lam, h)
 
     def _propagate(self, z0: np.ndarray, forcing: np.ndarray, h: float) -> np.ndarray:
         """Runs every modal recurrence over a grid of spacing ``h``.
