@@ -17,8 +17,8 @@ applied as joint forces ``k q + c q'`` on the clamp hinges with their springs' r
 
 from __future__ import annotations
 
-from collections.abc import Callable
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
@@ -231,8 +231,8 @@ class MujocoArm:
             sample_every: Sampling interval, s (a multiple of the step).
 
         Returns:
-            ``t``, ``x``, ``z``, ``pitch`` at the samples (time 0 included), and ``wall_s``:
-            the seconds spent in MuJoCo's loop alone.
+            ``t``, ``x``, ``z``, ``pitch`` at the samples (time 0 included), and ``wall_s``
+            and ``cpu_s``: the seconds spent in MuJoCo's loop alone.
         """
         h = self.timestep
         per_sample = round(sample_every / h)
@@ -245,18 +245,19 @@ class MujocoArm:
         mujoco.mj_getState(self.model, self.data, state, spec)
         control = mujoco.mjtState.mjSTATE_QFRC_APPLIED
         qpos = [self.data.qpos.copy()]
-        wall = 0.0
+        wall = cpu = 0.0
         done = 0
         while done < total:
             steps = min(ROLLOUT_CHUNK, total - done)
             q, q_dot = drives((done + np.arange(steps) + 0.5) * h)
             forces = np.zeros((1, steps, self.model.nv))
             forces[0][:, self.clamps] = self.clamp_stiffness * q + self.clamp_damping * q_dot
-            start = time.perf_counter()
+            start, start_cpu = time.perf_counter(), time.process_time()
             states, _ = mujoco.rollout.rollout(
                 self.model, self.data, state, forces, control_spec=control
             )
             wall += time.perf_counter() - start
+            cpu += time.process_time() - start_cpu
             state = states[0, -1]
             first = (-done - 1) % per_sample
             qpos.extend(states[0, first::per_sample, 1 : 1 + self.model.nq])
@@ -273,4 +274,5 @@ class MujocoArm:
             'z': table[:, 2],
             'pitch': table[:, 3],
             'wall_s': np.array(wall),
+            'cpu_s': np.array(cpu),
         }

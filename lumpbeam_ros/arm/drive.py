@@ -192,7 +192,7 @@ class SmoothMotion:
         if self.acceleration_function is not None:
             return np.asarray(self.acceleration_function(t), dtype=float)
         step = _DIFFERENCE_STEP_S
-        return (self.rates(t + step) - self.rates(t - step)) / (2.0 * step)
+        return np.asarray((self.rates(t + step) - self.rates(t - step)) / (2.0 * step))
 
     def sample(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Angles, rates and accelerations at many times, each (len(times), n_joints)."""

@@ -1,4 +1,4 @@
-"""The arm in motion as small deflections about its rigid motion, integrated modally.
+"""The arm in motion as small deflections about its rigid motion, integrated modally (B.16).
 
 The joints prescribe the rigid angles ``r(t)`` (every segment of link i turned by
 ``q_1 + ... + q_i``), and the springs see only the deflection ``d = phi - r``: ``K r`` and
@@ -14,8 +14,11 @@ its complex modal coordinates with a first-order hold on ``u`` (as
 springs cost nothing; ``u`` is smooth and small, and is found by waveform relaxation window by
 window: propagate with the last ``u``, evaluate ``u`` on the whole window at once, repeat until
 the deflections stop changing. A window's relaxation converges as fast as ``M(phi)`` stays near
-``M0``: when the relative joint angles have drifted by more than :data:`RELINEARIZE_RAD` from the
-reference, the next window takes a new one (an eigen-decomposition, the expensive step).
+``M0`` (its mass term feeds back instantly, whatever the window's length), so a window ends
+before the joints turn by half :data:`RELINEARIZE_RAD`, and once a joint has moved that far
+from the reference the next window takes a new linearization (an eigen-decomposition of the
+``2n`` state matrix, the expensive step). While the joints are held, one linearization serves
+the whole ring-down.
 
 The modal recurrences ``z_k = e^{lambda h} z_{k-1} + g_k`` of a window are summed by doubling
 (``log2`` of the window's length in array operations), not by a Python loop.
@@ -32,8 +35,15 @@ from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.integrate import hold_weights
 from lumpbeam_ros.model.modes import LinearModel
 
-#: A new linearization when a relative joint angle has moved this far from the reference's.
-RELINEARIZE_RAD = 0.1
+#: A new linearization when a joint angle has moved this far from the reference's, rad: 0.1
+#: takes more eigen-decompositions than it saves sweeps on the bench's arm, 0.4 more sweeps.
+RELINEARIZE_RAD = 0.2
+
+#: A mode's ``e^{lambda t}`` below this is gone for the scan (double rounding).
+_NEGLIGIBLE = 1e-17
+
+#: How far the first guess of a window carries the deflections' starting rate, s.
+GUESS_HORIZON_S = 0.02
 
 #: Relaxation sweeps a window may take before the solver gives up on it.
 MAX_SWEEPS = 40
@@ -73,11 +83,16 @@ class _Frame:
         eigenvalues, vectors = np.linalg.eig(linear.state_matrix())
         v_inv = np.linalg.inv(vectors)
         # One of each conjugate pair (and the real modes); the state is rebuilt as 2 Re(.).
-        keep = eigenvalues.imag >= 0.0
+        keep = np.flatnonzero(eigenvalues.imag >= 0.0)
+        # Slowest decay first: the scan drops the modes that have died out (a prefix).
+        keep = keep[np.argsort(-eigenvalues[keep].real, kind='stable')]
         lam = eigenvalues[keep]
-        self.v_t = (vectors[:, keep] * np.where(lam.imag > 0.0, 2.0, 1.0)).T
+        v_t = (vectors[:, keep] * np.where(lam.imag > 0.0, 2.0, 1.0)).T
         self.v_inv = v_inv[keep]
-        self.b_t = (self.v_inv[:, n:] @ m0_inv).T
+        b_t = (self.v_inv[:, n:] @ m0_inv).T
+        # Real products (a real input, a real state): half the work of complex ones.
+        self.b_re, self.b_im = np.ascontiguousarray(b_t.real), np.ascontiguousarray(b_t.imag)
+        self.v_re, self.v_im = np.ascontiguousarray(v_t.real), np.ascontiguousarray(-v_t.imag)
         self.e, h_phi1, h_phi2 = hold_weights(lam, h)
         self.w0 = h_phi1 - h_phi2
         self.w1 = h_phi2
@@ -85,12 +100,19 @@ class _Frame:
 
 
 def _scan(g: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """``z_k = e z_{k-1} + g_k`` (``z_0 = g_0``) for every column, by doubling."""
+    """``z_k = e z_{k-1} + g_k`` (``z_0 = g_0``) for every column, by doubling.
+
+    The columns are ordered by decreasing ``|e|``; a pass leaves out those whose ``e^step``
+    has fallen below the rounding of what it adds to (a mode that has died out).
+    """
     z = g.copy()
     power = e.copy()
     step = 1
     while step < z.shape[0]:
-        z[step:] += power * z[:-step]
+        alive = int(np.count_nonzero(np.abs(power) > _NEGLIGIBLE))
+        if alive == 0:
+            break
+        z[step:, :alive] += power[:alive] * z[:-step, :alive]
         power = power * power
         step *= 2
     return z
@@ -101,9 +123,9 @@ class DeflectionSolver:
 
     Args:
         chain: The arm's chain.
-        joint_angles: ``phi ->`` the angles ``M(phi)`` and gravity depend on (the joints':
-            the first segment's and each link's against the one before), to decide when
-            to re-linearize.
+        joint_angles: ``phi (..., n) ->`` the angles ``M(phi)`` and gravity depend on (the
+            joints': the first segment's and each link's against the one before), to decide
+            where windows end and when to re-linearize.
         tol: Convergence threshold on the change of the deflections between sweeps, rad.
     """
 
@@ -111,7 +133,7 @@ class DeflectionSolver:
         self,
         chain: LumpedChain,
         joint_angles: Callable[[np.ndarray], np.ndarray],
-        tol: float = 1e-10,
+        tol: float = 1e-9,
     ):
         self.chain = chain
         self.joint_angles = joint_angles
@@ -181,9 +203,13 @@ class DeflectionSolver:
         d = np.empty((total, n))
         d_dot = np.empty((total, n))
         d[0], d_dot[0] = d0, d0_dot
+        # A window ends before the joints turn by half the re-linearization angle in it.
+        joints = self.joint_angles(rigid.r)
         start = 0
         while start < total - 1:
-            stop = min(total, start + window + 1)
+            drift = np.max(np.abs(joints[start + 1 : start + window + 1] - joints[start]), axis=1)
+            beyond = np.flatnonzero(drift > 0.5 * RELINEARIZE_RAD)
+            stop = start + 1 + max(1, int(beyond[0]) if beyond.size else drift.size)
             frame = self._frame_for(rigid.r[start] + d[start], h)
             part = RigidMotion(
                 rigid.r[start:stop], rigid.r_dot[start:stop], rigid.r_ddot[start:stop]
@@ -201,20 +227,22 @@ class DeflectionSolver:
         """The relaxation of one window from ``(d0, d0_dot)``."""
         n = d0.size
         z0 = frame.v_inv @ np.concatenate([d0, d0_dot])
-        # First guess: the deflections held where they start.
-        held = np.broadcast_to(d0, part.r.shape)
-        zero = np.zeros_like(part.r)
-        u = self._forcing(frame, part, held, zero, zero)
-        previous = held
+        # First guess: the deflections go on at their starting rate for a short while
+        # (over a long window of free vibration, held where they start).
+        elapsed = np.minimum(frame.h * np.arange(part.r.shape[0]), GUESS_HORIZON_S)
+        guess = d0 + elapsed[:, None] * d0_dot
+        u = self._forcing(frame, part, guess, np.broadcast_to(d0_dot, guess.shape), 0.0 * guess)
+        previous = guess
         g = np.empty((part.r.shape[0], z0.size), dtype=complex)
         for _ in range(MAX_SWEEPS):
             self.sweeps += 1
-            modal_u = u @ frame.b_t
+            modal_u = (u @ frame.b_re) + 1j * (u @ frame.b_im)
             g[0] = z0
             g[1:] = frame.w0 * modal_u[:-1] + frame.w1 * modal_u[1:]
-            # A diverging window overflows on its way to the check below, which handles it.
+            # A diverging window overflows on its way to this check, which refuses it.
             with np.errstate(over='ignore', invalid='ignore'):
-                x = (_scan(g, frame.e) @ frame.v_t).real
+                z = _scan(g, frame.e)
+                x = z.real @ frame.v_re + z.imag @ frame.v_im
                 change = np.max(np.abs(x[:, :n] - previous))
             if not np.isfinite(change):
                 return None
@@ -222,6 +250,7 @@ class DeflectionSolver:
             if change < self.tol:
                 return d, d_dot
             previous = d
-            d_ddot = u @ frame.m0_inv_t - x @ frame.decay_t
-            u = self._forcing(frame, part, d, d_dot, d_ddot)
+            with np.errstate(over='ignore', invalid='ignore'):
+                d_ddot = u @ frame.m0_inv_t - x @ frame.decay_t
+                u = self._forcing(frame, part, d, d_dot, d_ddot)
         return None

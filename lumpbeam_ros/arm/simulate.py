@@ -76,6 +76,7 @@ class ArmMotion:
         tip_x: x of the last link's free end in beam_base, m.
         tip_z: z of it, m.
         tip_pitch: Its pitch (the last segment's angle), rad.
+        method: Which integrator produced it: ``'modal'`` or ``'lsoda'``.
     """
 
     t: np.ndarray
@@ -85,6 +86,7 @@ class ArmMotion:
     tip_x: np.ndarray
     tip_z: np.ndarray
     tip_pitch: np.ndarray
+    method: str = 'modal'
 
 
 class _MomentumForm:
@@ -153,8 +155,7 @@ class _MomentumForm:
         return np.concatenate([phi_dot, w_dot])
 
     def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
-        """Of :meth:`rhs`, leaving out the change of ``M`` with ``phi`` in ``phi'`` (NaN for a
-        non-finite state)."""
+        """Of :meth:`rhs`, leaving out the change of ``M`` with ``phi`` in ``phi'``; NaN too."""
         if not np.all(np.isfinite(y)):
             return np.full((y.size, y.size), np.nan)
         phi, w = y[: self.n], y[self.n :]
@@ -246,8 +247,12 @@ def _simulate_modal(
     t0, t1 = float(t_eval[0]), float(t_eval[-1])
     end = min(max(t0, drive.end_time), t1)
     bounds = np.unique(np.concatenate([[t0], knots[knots < end], [end, t1]]))
-    joints = np.concatenate([[0], model.link_starts[1:]])
-    solver = DeflectionSolver(model.chain, lambda phi: np.diff(phi, prepend=0.0)[joints])
+    starts = model.link_starts
+
+    def joint_angles(phi: np.ndarray) -> np.ndarray:
+        return np.asarray(np.diff(phi, axis=-1, prepend=0.0)[..., starts])
+
+    solver = DeflectionSolver(model.chain, joint_angles)
     q0 = drive.sample(np.array([t0]))[0][0]
     r0 = model.rigid_angles(q0)
     d = arm_equilibrium(model, q0) - r0
@@ -301,7 +306,7 @@ def _simulate_lsoda(
     moving_end = min(t1, ring_start)
     knots = knots[knots < moving_end]
     bounds = [t0, *(knots if knots.size <= MAX_RESTARTS else []), moving_end]
-    states = np.empty((t_eval.size, 2 * n))
+    states = np.full((t_eval.size, 2 * n), np.nan)
     states[0] = y
     for start, end in zip(bounds[:-1], bounds[1:], strict=True):
         if end <= start:
@@ -325,10 +330,12 @@ def _simulate_lsoda(
         states[inside] = result.y.T[: int(inside.sum())]
         y = result.y[:, -1]
     phi = states[:, :n]
-    phi_dot = np.array(
-        [form.rates(t, p, w)[0] for t, p, w in zip(t_eval, phi, states[:, n:], strict=True)]
-    )
     tail = t_eval > ring_start
+    phi_dot = np.full_like(phi, np.nan)
+    phi_dot[~tail] = [
+        form.rates(t, p, w)[0]
+        for t, p, w in zip(t_eval[~tail], phi[~tail], states[~tail, n:], strict=True)
+    ]
     if np.any(tail):
         start_state = ChainState(y[:n], form.rates(ring_start, y[:n], y[n:])[0])
         q_end = drive.angles(ring_start)
@@ -354,7 +361,7 @@ def _simulate_lsoda(
             rung = tail_phi, np.array(tail_rates)
         phi[tail], phi_dot[tail] = rung
     x, z, pitch = model.chain.tip_pose(phi)
-    return ArmMotion(t_eval, motion.sample(t_eval)[0], phi, phi_dot, x, z, pitch)
+    return ArmMotion(t_eval, motion.sample(t_eval)[0], phi, phi_dot, x, z, pitch, 'lsoda')
 
 
 def _ring_down(

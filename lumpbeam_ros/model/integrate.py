@@ -228,13 +228,16 @@ class ModalSolver:
             phi = d + phi_eq
             # r: everything B.16 has beyond its linearisation (see the module docstring).
             # The equilibrium's own forces cancel, leaving the linear model's -K_eff d - C d'.
-            inertial_excess = chain.inertial_forces(phi, d_ddot) - d_ddot @ self.linear.mass
-            linear_force = -d @ self.linear.stiffness - d_dot @ self.linear.damping
-            forcing = (
-                chain.generalized_forces(phi, d_dot, friction=False)
-                - linear_force
-                - inertial_excess
-            )
+            # A diverging sweep's large but finite angles may overflow here: the next
+            # sweep's check refuses them.
+            with np.errstate(over='ignore', invalid='ignore'):
+                inertial_excess = chain.inertial_forces(phi, d_ddot) - d_ddot @ self.linear.mass
+                linear_force = -d @ self.linear.stiffness - d_dot @ self.linear.damping
+                forcing = (
+                    chain.generalized_forces(phi, d_dot, friction=False)
+                    - linear_force
+                    - inertial_excess
+                )
         return None
 
 
