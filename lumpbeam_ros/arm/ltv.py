@@ -9,15 +9,17 @@ The joints prescribe the rigid angles ``r(t)`` (every segment of link i turned b
 
 with ``M0 = M(phi_0)`` and ``K0 = K + diag(g G sin phi_0)`` the linearization about a
 reference configuration ``phi_0`` near the current one. The left-hand side is solved exactly in
-its complex modal coordinates with a first-order hold on ``u`` (as
-:class:`~lumpbeam_ros.model.integrate.ModalSolver` does about an equilibrium), so the stiff
-springs cost nothing; ``u`` is smooth and small, and is found by waveform relaxation window by
-window: propagate with the last ``u``, evaluate ``u`` on the whole window at once, repeat until
-the deflections stop changing. A window's relaxation converges as fast as ``M(phi)`` stays near
-``M0`` (its mass term feeds back instantly, whatever the window's length), so a window ends
-before the joints turn by half :data:`RELINEARIZE_RAD`, and once a joint has moved that far
-from the reference the next window takes a new linearization (an eigen-decomposition of the
-``2n`` state matrix, the expensive step). While the joints are held, one linearization serves
+its complex modal coordinates, ``u`` held as the parabola through the grid points before, at
+and after each step (a first-order hold, as
+:class:`~lumpbeam_ros.model.integrate.ModalSolver` does about an equilibrium, on a piece's
+first step), so the stiff springs cost nothing; ``u`` is smooth and small, and is found by
+waveform relaxation window by window: propagate with the last ``u``, evaluate ``u`` on the
+whole window at once, repeat until the deflections stop changing. A window's relaxation
+converges as fast as ``M(phi)`` stays near ``M0`` (its mass term feeds back instantly,
+whatever the window's length), so a window ends before the joints turn by half
+:data:`RELINEARIZE_RAD`, and once a joint has moved that far from the reference the next
+window takes a new linearization (an eigen-decomposition of the ``2n`` state matrix, the
+expensive step). While the joints are held, one linearization serves
 the whole ring-down.
 
 The modal recurrences ``z_k = e^{lambda h} z_{k-1} + g_k`` of a window are summed by doubling
@@ -94,9 +96,24 @@ class _Frame:
         self.b_re, self.b_im = np.ascontiguousarray(b_t.real), np.ascontiguousarray(b_t.imag)
         self.v_re, self.v_im = np.ascontiguousarray(v_t.real), np.ascontiguousarray(-v_t.imag)
         self.e, h_phi1, h_phi2 = hold_weights(lam, h)
+        # The first step: a first-order hold; the others: the parabola through the samples
+        # before, at and after the step (O(h^3) globally instead of O(h^2)).
         self.w0 = h_phi1 - h_phi2
         self.w1 = h_phi2
+        h_phi3 = _h_phi3(lam, h)
+        self.q_before = h_phi3 - 0.5 * h_phi2
+        self.q_at = h_phi1 - 2.0 * h_phi3
+        self.q_after = h_phi3 + 0.5 * h_phi2
         self.h = h
+
+
+def _h_phi3(lam: np.ndarray, h: float) -> np.ndarray:
+    """``h phi3(lam h)``, ``phi3(z) = (e^z - 1 - z - z^2 / 2) / z^3`` (its series when small)."""
+    z = lam * h
+    small = np.abs(z) < 0.05
+    safe = np.where(small, 1.0, z)
+    series = 1.0 / 6.0 + z * (1.0 / 24.0 + z * (1.0 / 120.0 + z * (1.0 / 720.0 + z / 5040.0)))
+    return np.asarray(h * np.where(small, series, (np.expm1(z) - z - 0.5 * z * z) / safe**3))
 
 
 def _scan(g: np.ndarray, e: np.ndarray) -> np.ndarray:
@@ -206,6 +223,8 @@ class DeflectionSolver:
         # A window ends before the joints turn by half the re-linearization angle in it.
         joints = self.joint_angles(rigid.r)
         start = 0
+        # The last window's frame and forcing, for the point before the next one's start.
+        last: tuple[_Frame, np.ndarray] | None = None
         while start < total - 1:
             drift = np.max(np.abs(joints[start + 1 : start + window + 1] - joints[start]), axis=1)
             beyond = np.flatnonzero(drift > 0.5 * RELINEARIZE_RAD)
@@ -214,19 +233,41 @@ class DeflectionSolver:
             part = RigidMotion(
                 rigid.r[start:stop], rigid.r_dot[start:stop], rigid.r_ddot[start:stop]
             )
-            solved = self._window(frame, part, d[start], d_dot[start])
+            before = None
+            if last is not None:
+                before = _reframed(last[0], frame, last[1], d[start - 1], d_dot[start - 1])
+            solved = self._window(frame, part, d[start], d_dot[start], before)
             if solved is None:
                 return None
-            d[start:stop], d_dot[start:stop] = solved
+            d[start:stop], d_dot[start:stop], u = solved
+            last = (frame, u[-2])
             start = stop - 1
         return d, d_dot
 
     def _window(
-        self, frame: _Frame, part: RigidMotion, d0: np.ndarray, d0_dot: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray] | None:
-        """The relaxation of one window from ``(d0, d0_dot)``."""
+        self,
+        frame: _Frame,
+        part: RigidMotion,
+        d0: np.ndarray,
+        d0_dot: np.ndarray,
+        before: np.ndarray | None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The relaxation of one window from ``(d0, d0_dot)``.
+
+        Args:
+            frame: The linearization.
+            part: The rigid motion over the window.
+            d0: Deflections at its start.
+            d0_dot: Their rates.
+            before: The forcing one step before the start, in this frame (the last window's,
+                converged), for the first step's parabola; ``None``: a first-order hold.
+
+        Returns:
+            ``(d, d_dot, u)`` on the window, or ``None`` when it did not converge.
+        """
         n = d0.size
         z0 = frame.v_inv @ np.concatenate([d0, d0_dot])
+        modal_before = None if before is None else before @ frame.b_re + 1j * (before @ frame.b_im)
         # First guess: the deflections go on at their starting rate for a short while
         # (over a long window of free vibration, held where they start).
         elapsed = np.minimum(frame.h * np.arange(part.r.shape[0]), GUESS_HORIZON_S)
@@ -238,7 +279,19 @@ class DeflectionSolver:
             self.sweeps += 1
             modal_u = (u @ frame.b_re) + 1j * (u @ frame.b_im)
             g[0] = z0
-            g[1:] = frame.w0 * modal_u[:-1] + frame.w1 * modal_u[1:]
+            if modal_before is None:
+                g[1] = frame.w0 * modal_u[0] + frame.w1 * modal_u[1]
+            else:
+                g[1] = (
+                    frame.q_before * modal_before
+                    + frame.q_at * modal_u[0]
+                    + frame.q_after * modal_u[1]
+                )
+            g[2:] = (
+                frame.q_before * modal_u[:-2]
+                + frame.q_at * modal_u[1:-1]
+                + frame.q_after * modal_u[2:]
+            )
             # A diverging window overflows on its way to this check, which refuses it.
             with np.errstate(over='ignore', invalid='ignore'):
                 z = _scan(g, frame.e)
@@ -248,9 +301,25 @@ class DeflectionSolver:
                 return None
             d, d_dot = x[:, :n], x[:, n:]
             if change < self.tol:
-                return d, d_dot
+                return d, d_dot, u
             previous = d
             with np.errstate(over='ignore', invalid='ignore'):
                 d_ddot = u @ frame.m0_inv_t - x @ frame.decay_t
                 u = self._forcing(frame, part, d, d_dot, d_ddot)
         return None
+
+
+def _reframed(
+    old: _Frame, new: _Frame, u: np.ndarray, d: np.ndarray, d_dot: np.ndarray
+) -> np.ndarray:
+    """A converged forcing of ``old``'s linearization in ``new``'s.
+
+    ``u`` holds the linear model's own ``K0 d`` and ``M0 d''`` terms (module docstring), so
+    a new linearization moves it by the difference of those, with ``d''`` the converged one.
+    """
+    if new is old:
+        return u
+    d_ddot = u @ old.m0_inv_t - np.concatenate([d, d_dot]) @ old.decay_t
+    return np.asarray(
+        u + (new.gravity_stiffness - old.gravity_stiffness) * d + d_ddot @ (new.mass - old.mass)
+    )
