@@ -14,8 +14,8 @@ Tolerances, and why:
   the drive at its midpoint value over each step (second order): a few nanometres here. This
   is the model against MuJoCo's.
 - tip position, by the arm's default modal method: RMS below 1 um and the largest below
-  5 um. Its first-order hold on a 1 ms grid errs as h^2 (0.02 to 0.2 um on these quick moves);
-  this is the fast method against the same model. A wrong sign, lever or spring rule shows
+  5 um. Its hold on a 2 ms grid errs by 0.01 to 0.05 um on these quick moves; this is the
+  fast method against the same model. A wrong sign, lever or spring rule shows
   as millimetres in either.
 
 Run with ``-s`` to print the figures.
