@@ -24,9 +24,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from lumpbeam_lab.mujoco_arm import MujocoArm
 from scipy.interpolate import CubicSpline
 
+from lumpbeam_lab.mujoco_arm import MujocoArm
 from lumpbeam_ros.arm.config import ArmConfig, load_arm_config
 from lumpbeam_ros.arm.drive import SampledMotion
 from lumpbeam_ros.arm.model import ArmModel
