@@ -5,7 +5,7 @@ with ZV, ZVD or EI designed for the modes the arm's linearization gives at the m
 angles (:func:`~lumpbeam_ros.arm.statics.arm_modes`), at the exact frequency or 15 % off.
 Unshaped and shaped moves are simulated by the arm's model
 (:func:`~lumpbeam_ros.arm.simulate.simulate_arm`) and by the independent MuJoCo model of the
-arm's tests (test/arm/mujoco_arm.py: its own bodies, hinges, mass matrix and RK4), each
+arm's tests (lumpbeam_lab/mujoco_arm.py: its own bodies, hinges, mass matrix and RK4), each
 driven by the same spline of the samples. The residual vibration is the RMS of the tip's
 distance from its final rest (each model's own static equilibrium) over the 3 s after the
 move ends (the shaped move ends later, by the shaper's duration).
@@ -24,9 +24,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from arm.mujoco_arm import MujocoArm
 from scipy.interpolate import CubicSpline
 
+from lumpbeam_lab.mujoco_arm import MujocoArm
 from lumpbeam_ros.arm.config import ArmConfig, load_arm_config
 from lumpbeam_ros.arm.drive import SampledMotion
 from lumpbeam_ros.arm.model import ArmModel
@@ -49,7 +49,7 @@ STEP_S = 1e-3
 OUTPUT_S = 2e-3
 
 #: The arms' moves: (file, start angles, end angles, duration s, modes shaped). The rotary
-#: link (first mode 4.2 Hz, period 0.24 s) turns 1 rad in 0.3 s; the three-link arm (modes
+#: link (first mode 3.5 Hz, period 0.29 s) turns 1 rad in 0.3 s; the three-link arm (modes
 #: 1.2 and 6.8 Hz at the end) moves all joints in 1 s, lifting against gravity.
 ARMS = {
     'rotary': ('arm_rotary.yaml', [0.0], [1.0], 0.3, 1),
