@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from arm.arm_cases import small_arm
-from arm.mujoco_arm import MujocoArm
+from lumpbeam_lab.mujoco_arm import MujocoArm
 from lumpbeam_ros.arm.config import arm_from_mapping
 from lumpbeam_ros.arm.link_fit import (
     LinkParameterFit,
