@@ -113,3 +113,55 @@ def test_a_lab_import_by_the_product_is_found_and_the_cli_may_run_the_lab(tmp_pa
         'lumpbeam_ros/nodes/node.py:2: lumpbeam_lab.doctor',
         'lumpbeam_ros/vision/scores.py:1: lumpbeam_lab.camera.accuracy',
     ]
+
+
+def test_bags_are_read_by_the_one_reader_alone(tool):
+    assert tool.bag_readers(ROOT) == []
+
+
+def test_a_reader_of_its_own_is_found(tool, tmp_path):
+    repo = _package(
+        tmp_path,
+        {
+            'vision/offline.py': 'from mcap.reader import SeekingReader\n',
+            'bagio/reader.py': (
+                'from mcap.stream_reader import StreamReader\n'
+                "(length,) = struct.unpack_from('<Q', data, 1)\n"
+            ),
+            'bagio/fastscan.py': "(n,) = struct.unpack_from('<I', first, 12)\n",
+        },
+    )
+    assert tool.bag_readers(repo) == [
+        "lumpbeam_ros/bagio/fastscan.py:1: (n,) = struct.unpack_from('<I', first, 12)",
+        "lumpbeam_ros/bagio/reader.py:2: (length,) = struct.unpack_from('<Q', data, 1)",
+        'lumpbeam_ros/vision/offline.py:1: import mcap.reader',
+    ]
+    # The fast path with its agreement test is the one kept beside the reader.
+    (repo / 'test' / 'bagio').mkdir(parents=True)
+    (repo / 'test' / 'bagio' / 'test_fastscan.py').write_text('')
+    assert len(tool.bag_readers(repo)) == 2
+
+
+def test_configuration_types_follow_the_naming_rule(tool):
+    assert tool.config_type_names(ROOT) == []
+
+
+def test_a_configuration_type_against_the_rule_is_found(tool, tmp_path):
+    repo = _package(
+        tmp_path,
+        {
+            'a.py': (
+                'class FitParams:\n    a: float = 1.0\n'
+                "class LiveSettings:\n    x: float = setting('trigger', 1.0, 'x')\n"
+                "class SensorSettings:\n    f: float = setting('sensor.f', 1.0, 'f')\n"
+                "class RunOptions:\n    n: int = setting('run.n', 1, 'n')\n"
+                "class Window:\n    s: float = setting('window.s', 1.0, 's')\n"
+            ),
+        },
+    )
+    assert [line.split(': ')[1] for line in tool.config_type_names(repo)] == [
+        'FitParams',
+        'LiveSettings',
+        'RunOptions',
+        'Window',
+    ]

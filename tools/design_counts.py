@@ -16,7 +16,11 @@ Usage: ``python tools/design_counts.py [REPO]``. Prints, one line each:
 - node parameters declared but never read by what the node runs;
 - places that must change to add an effect, besides its physics;
 - lab modules (``lumpbeam_lab``: benchmarks, the validation renderer, scoring against
-  truth, the MCAP doctor) imported by the product outside the commands that run them.
+  truth, the MCAP doctor) imported by the product outside the commands that run them;
+- readers of bags: places that read MCAP records or CDR themselves (or through another
+  bag reader) outside the one reader (``bagio/reader.py``, on the ``mcap`` package) and the
+  fast path kept beside it with its agreement test (``bagio/fastscan.py``);
+- configuration types named against the naming rule (doc/architecture.md, "Names").
 
 mypy's count is its own command: ``mypy`` (the configuration is ``mypy.ini``).
 """
@@ -481,6 +485,135 @@ def lab_imports(repo: Path) -> list[str]:
     return found
 
 
+# --- One reader of bags ------------------------------------------------------------------------
+
+#: The one reader of bags: it may import mcap's record-level readers, and parses no bytes itself.
+THE_READER = 'lumpbeam_ros/bagio/reader.py'
+#: The type system: rosbags' CDR deserializer is called here, and only here.
+_TYPE_SYSTEM = 'lumpbeam_ros/bagio/typestore.py'
+#: The fast path kept beside the reader, and the test that it agrees with the library
+#: message for message (without the test, the fast path counts).
+FAST_PATH = ('lumpbeam_ros/bagio/fastscan.py', 'test/bagio/test_fastscan.py')
+
+#: The lab's check of the record layout our writer makes (the checks of ``mcap doctor``): it
+#: looks at records to judge them, and reads no message for anyone.
+_LAYOUT_CHECKER = 'lumpbeam_lab/doctor.py'
+
+#: Modules that parse MCAP records, or read bags, on their own: mcap's record-level readers
+#: and rosbags' bag readers and deserializers.
+_READING_MODULES = (
+    'mcap.reader',
+    'mcap.stream_reader',
+    'mcap.data_stream',
+    'mcap.opcode',
+    'rosbags.rosbag2.reader',
+    'rosbags.highlevel',
+    'rosbags.serde',
+)
+
+#: Calls that take bytes apart by hand (CDR offsets, MCAP fields).
+_BYTE_PARSING = re.compile(
+    r'\bstruct\.(unpack|unpack_from|iter_unpack|Struct)\(|\.unpack_from\(|int\.from_bytes\('
+    r'|deserialize_cdr\(|\bReader\(|AnyReader\(|\\x89MCAP'
+)
+
+
+def bag_readers(repo: Path) -> list[str]:
+    """Places that parse MCAP records or CDR outside the one reader and its fast path.
+
+    A place is an import of a record-level reader (:data:`_READING_MODULES`, or rosbags'
+    ``Reader``) outside :data:`THE_READER`, or a line that takes bytes apart by hand
+    (``struct`` unpacking, ``int.from_bytes``, a ``deserialize_cdr`` call, the MCAP magic)
+    anywhere, the one reader included, in either package. The fast path counts too once its
+    agreement test is gone.
+
+    Returns:
+        ``file:line: what`` for each place.
+    """
+    found = []
+    for package in ('lumpbeam_ros', LAB):
+        for path in sorted((repo / package).rglob('*.py')):
+            rel = path.relative_to(repo).as_posix()
+            tested = rel == FAST_PATH[0] and (repo / FAST_PATH[1]).exists()
+            if rel in (_LAYOUT_CHECKER, _TYPE_SYSTEM) or tested:
+                continue
+            text = path.read_text()
+            tree = ast.parse(text)
+            for node in ast.walk(tree):
+                if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                    names = [node.module, *(f'{node.module}.{a.name}' for a in node.names)]
+                elif isinstance(node, ast.Import):
+                    names = [a.name for a in node.names]
+                else:
+                    continue
+                hits = [
+                    n for n in names if n.startswith(_READING_MODULES) or n.endswith('.Reader')
+                ]
+                if hits and rel != THE_READER:
+                    found.append(f'{rel}:{node.lineno}: import {hits[0]}')
+            skip = _docstring_lines(tree)
+            for number, line in enumerate(text.splitlines(), 1):
+                if number not in skip and _BYTE_PARSING.search(line.split('#')[0]):
+                    found.append(f'{rel}:{number}: {line.strip()}')
+    return found
+
+
+# --- Names of configuration types --------------------------------------------------------------
+
+
+def _declared_keys(node: ast.ClassDef) -> list[str]:
+    """The parameter keys a class's fields declare with ``setting('key', ...)``."""
+    keys = []
+    for item in node.body:
+        if (
+            isinstance(item, ast.AnnAssign)
+            and isinstance(item.value, ast.Call)
+            and isinstance(item.value.func, ast.Name)
+            and item.value.func.id == 'setting'
+            and item.value.args
+            and isinstance(item.value.args[0], ast.Constant)
+        ):
+            keys.append(str(item.value.args[0].value))
+    return keys
+
+
+def config_type_names(repo: Path) -> list[str]:
+    """Configuration types named against the rule of doc/architecture.md, "Names".
+
+    - no type ends in ``Params`` (``Parameters``, spelled out, is a model's quantities);
+    - a ``Settings`` type is one section of a configuration: its fields declare parameters,
+      all under one key prefix (``sensor.*``);
+    - an ``Options`` type declares no parameter (it is never read from a parameter file);
+    - a type that declares parameters ends in ``Config``, ``Settings`` or ``Parameters``.
+
+    Returns:
+        ``file:line: name: what is wrong`` for each.
+    """
+    found = []
+    for package in ('lumpbeam_ros', LAB):
+        for path in sorted((repo / package).rglob('*.py')):
+            rel = path.relative_to(repo).as_posix()
+            for node in ast.walk(ast.parse(path.read_text())):
+                if not isinstance(node, ast.ClassDef):
+                    continue
+                keys = _declared_keys(node)
+                prefixes = {key.partition('.')[0] for key in keys if '.' in key}
+                why = ''
+                if node.name.endswith('Params'):
+                    why = "Params: a model's quantities are Parameters; a configuration, Config"
+                elif node.name.endswith('Settings') and (
+                    not keys or len(prefixes) != 1 or not all('.' in key for key in keys)
+                ):
+                    why = 'Settings are one section of parameters, under one key prefix'
+                elif node.name.endswith('Options') and keys:
+                    why = 'Options are not read from a parameter file'
+                elif keys and not node.name.endswith(('Config', 'Settings', 'Parameters')):
+                    why = 'it declares parameters: a Config, Settings or Parameters'
+                if why:
+                    found.append(f'{rel}:{node.lineno}: {node.name}: {why}')
+    return found
+
+
 def main(argv: list[str]) -> int:
     """Prints the counts, each with the places that make it up."""
     repo = Path(argv[1]) if len(argv) > 1 else Path(__file__).resolve().parents[1]
@@ -499,6 +632,10 @@ def main(argv: list[str]) -> int:
         'node parameters declared but never read': unread_parameters(repo),
         'places to change to add an effect (besides its physics)': effect_places(repo),
         'lab modules imported by the core': lab_imports(repo),
+        'readers of bags besides bagio/reader.py and its tested fast path': bag_readers(repo),
+        'configuration types named against the rule (Config, Settings, Options, Parameters)': (
+            config_type_names(repo)
+        ),
     }
     for title, hits in rows.items():
         print(f'{title}: {len(hits)}')

@@ -20,7 +20,7 @@ from pathlib import Path
 from lumpbeam_lab.bench.bench_result import BenchResult
 from lumpbeam_ros.campaign.engine import run_campaign, run_serial
 from lumpbeam_ros.campaign.store import ResultsStore
-from lumpbeam_ros.campaign.task import CampaignSettings, warm_up
+from lumpbeam_ros.campaign.task import CampaignOptions, warm_up
 from lumpbeam_ros.ident.settings import load_identifier_config
 from lumpbeam_ros.model.parameters import DropTestConfig, load_beam_config
 from lumpbeam_ros.synthetic.campaign_bags import write_campaign
@@ -39,7 +39,7 @@ def run(quick: bool = False) -> list[BenchResult]:
         One result per worker count, against the plain loop.
     """
     beam, _ = load_beam_config()
-    settings = CampaignSettings(beam, load_identifier_config())
+    settings = CampaignOptions(beam, load_identifier_config())
     duration = 4.0 if quick else 8.0
     loads, seeds = (LOADS[:2], 1) if quick else (LOADS, 2)
     with tempfile.TemporaryDirectory(prefix='lumpbeam-bench-') as tmp:

@@ -1,16 +1,19 @@
 """Reading rosbag2 bags with MCAP storage: whole, cut short, or damaged.
 
-The MCAP file is walked record by record from its start, with the ``mcap`` package's record
-layout (:mod:`mcap.records`), and every chunk is checked before anything in it is believed:
-its declared sizes against the file, its CRC-32 (when its writer stored one, as
-:class:`~lumpbeam_ros.bagio.writer.BagWriter` does) against its records. So
+The ``mcap`` package reads the records: :class:`mcap.stream_reader.StreamReader` parses
+each one, :func:`mcap.stream_reader.breakup_chunk` decompresses a chunk, checks its CRC-32
+(when its writer stored one, as :class:`~lumpbeam_ros.bagio.writer.BagWriter` does) and
+parses what it holds, and :class:`mcap.reader.SeekingReader` reads the closing summary. What
+this module adds is the policy for damage, which the package's own ``iter_messages`` does not
+have (it stops the whole read at the first bad chunk):
 
-- a file whose writer was killed (no closing summary) is read up to its first incomplete
-  record, with a warning: everything that reached the disk is read;
-- a damaged chunk (overwritten, inserted or missing bytes) is skipped whole and the walk
-  goes on after it; where the damage broke the record framing, the walk resumes at the next
-  chunk the file's (CRC-checked) summary lists, or else at the next place that holds an
-  intact chunk;
+- a complete file is read chunk by chunk through its summary's chunk indexes (the summary
+  first checked against its CRC); a chunk that does not read, does not match its index or
+  fails its CRC is skipped whole, and the next chunk is read as if nothing happened;
+- a file without a usable summary (a recording whose writer was killed, or a damaged
+  summary) is read as a stream of records, up to its first incomplete record (with a
+  warning: everything that reached the disk is read); where a record does not parse, the
+  stream resumes at the next place that holds an intact chunk;
 - what was lost is counted per topic against ``metadata.yaml`` (the bag's own record of
   what it holds) and reported as one warning line naming the bag, the topic and the count
   (:meth:`BagReader.report_loss`); a message that does not decode is skipped and counted the
@@ -20,6 +23,7 @@ its declared sizes against the file, its CRC-32 (when its writer stored one, as
 
 from __future__ import annotations
 
+import io
 import logging
 import mmap
 import struct
@@ -28,13 +32,17 @@ from collections import Counter
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import IO, Any, cast
 
 import zstandard
-from mcap.exceptions import McapError
-from mcap.reader import SeekingReader
-from mcap.records import Channel, Message, Schema
+from mcap.data_stream import ReadDataStream
+from mcap.exceptions import McapError, RecordLengthLimitExceeded
+from mcap.opcode import Opcode
+from mcap.reader import FOOTER_SIZE, SeekingReader
+from mcap.records import Channel, Chunk, ChunkIndex, DataEnd, Footer, McapRecord, Message, Schema
+from mcap.stream_reader import StreamReader, breakup_chunk, read_magic
 from mcap.summary import Summary
+from mcap.writer import MCAP0_MAGIC
 
 from lumpbeam_ros.bagio import metadata
 from lumpbeam_ros.bagio.typestore import deserialize
@@ -42,18 +50,17 @@ from lumpbeam_ros.errors import BagError
 
 _log = logging.getLogger(__name__)
 
-MAGIC = b'\x89MCAP0\r\n'
-_OP_FOOTER, _OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK = 0x02, 0x03, 0x04, 0x05, 0x06
-_OP_DATA_END = 0x0F
-#: The opcodes of MCAP version 0; anything else where a record should start is damage.
-_KNOWN_OPCODES = frozenset(range(0x01, 0x10))
-_RECORD = struct.Struct('<BQ')
-_CHUNK_HEAD = struct.Struct('<QQQI')  # message start and end time, uncompressed size and CRC
-_MESSAGE_HEAD = struct.Struct('<HIQQ')  # channel, sequence, log time, publish time
-_FOOTER = struct.Struct('<BQQQI')  # opcode, length, summary start, summary offset start, CRC
-_U16, _U32, _U64 = struct.Struct('<H'), struct.Struct('<I'), struct.Struct('<Q')
+#: The bytes an MCAP file starts and ends with.
+MAGIC = MCAP0_MAGIC
 #: Largest chunk decompressed (a damaged size field must not become a huge allocation).
 MAX_CHUNK_BYTES = 1 << 30
+#: A record's opcode and length, before its content.
+_RECORD_PREFIX = 1 + 8
+#: A chunk's fields besides its compression's name and its data: start and end times, the
+#: uncompressed size and CRC, the lengths of the name and of the data.
+_CHUNK_FIELDS = 8 + 8 + 8 + 4 + 4 + 8
+#: The compressions of MCAP chunks ('': none).
+_COMPRESSIONS = ('', 'zstd', 'lz4')
 
 # What the mcap package and the decompressors raise on malformed bytes.
 _READ_ERRORS = (
@@ -142,6 +149,21 @@ class BagReader:
         if msgtype is not None and entry.msgtype != msgtype:
             raise BagError(f'{self.path}: topic {topic} has type {entry.msgtype}, not {msgtype}')
         return entry
+
+    def schemas(self) -> dict[str, Schema]:
+        """The schema of each topic's channel, as the data files' summaries declare them.
+
+        A file without a usable summary (cut, damaged) adds none: it is read without them.
+        """
+        found: dict[str, Schema] = {}
+        for summary in self._summaries.values():
+            if summary is None:
+                continue
+            for channel in summary.channels.values():
+                schema = summary.schemas.get(channel.schema_id)
+                if schema is not None:
+                    found[channel.topic] = schema
+        return found
 
     def iter_raw(
         self, topics: Iterable[str] | None = None, *, report: bool = True
@@ -298,58 +320,119 @@ def probe(file: Path, bag: Path) -> Summary | None:
         BagError: The file is empty, unreadable or not an MCAP file.
     """
     try:
-        size = file.stat().st_size
         with file.open('rb') as stream:
-            if size == 0:
+            if file.stat().st_size == 0:
                 raise BagError(f'{bag}: data file {file.name} is empty')
-            if stream.read(len(MAGIC)) != MAGIC:
-                raise BagError(f'{bag}: {file.name} is not an MCAP file')
-            if not _summary_crc_ok(stream, size):
-                return None
-            stream.seek(0)
-            try:
-                return SeekingReader(stream).get_summary()
-            except (*_READ_ERRORS, OSError):  # OSError: a seek before the start
-                return None
+            with mmap.mmap(stream.fileno(), 0, access=mmap.ACCESS_READ) as buffer:
+                return _summary(buffer, f'{bag}: {file.name}')
     except OSError as exc:
         raise BagError(f'{bag}: cannot read {file.name}: {exc.strerror}') from None
 
 
-def _summary_crc_ok(stream: Any, size: int) -> bool:
-    """Tells whether the file ends in a footer whose summary CRC (if any) matches."""
-    if size < len(MAGIC) * 2 + _FOOTER.size:
+def _summary(buffer: mmap.mmap, name: str) -> Summary | None:
+    stream = _as_stream(buffer)
+    try:
+        read_magic(ReadDataStream(stream))
+    except (McapError, struct.error):
+        raise BagError(f'{name} is not an MCAP file') from None
+    try:
+        if not _summary_crc_ok(buffer):
+            return None
+        buffer.seek(0)
+        return SeekingReader(stream, record_size_limit=len(buffer)).get_summary()
+    except (*_READ_ERRORS, OSError):  # OSError: a seek before the start
+        return None
+
+
+def _summary_crc_ok(buffer: mmap.mmap) -> bool:
+    """Tells whether the file ends in a footer whose summary CRC (if it has one) matches.
+
+    mcap's reader takes a summary as it finds it; a damaged one must not direct the walk.
+    """
+    size = len(buffer)
+    footer_at = size - len(MAGIC) - FOOTER_SIZE
+    if footer_at < len(MAGIC):
         return False
-    stream.seek(size - len(MAGIC) - _FOOTER.size)
-    tail = stream.read(_FOOTER.size + len(MAGIC))
-    if tail[-len(MAGIC) :] != MAGIC:
+    buffer.seek(footer_at)
+    # The reader stops after the footer and the closing magic, which it checks.
+    reader = StreamReader(_as_stream(buffer), skip_magic=True, record_size_limit=FOOTER_SIZE)
+    records = list(reader.records)
+    if len(records) != 1 or not isinstance(records[0], Footer) or buffer.tell() != size:
         return False
-    opcode, length, summary_start, _, crc = _FOOTER.unpack_from(tail)
-    if opcode != _OP_FOOTER or length != _FOOTER.size - _RECORD.size:
+    footer = records[0]
+    if footer.summary_crc == 0:
+        return bool(footer.summary_start <= footer_at)
+    if not len(MAGIC) <= footer.summary_start <= footer_at:
         return False
-    footer_at = size - len(MAGIC) - _FOOTER.size
-    if crc == 0:
-        return bool(summary_start <= footer_at)
-    if not len(MAGIC) <= summary_start <= footer_at:
-        return False
-    stream.seek(summary_start)
-    covered = stream.read(footer_at + _FOOTER.size - 4 - summary_start)
-    return bool(zlib.crc32(covered) == crc)
+    # The CRC covers the summary and the footer up to the CRC field itself.
+    covered = buffer[footer.summary_start : footer_at + FOOTER_SIZE - 4]
+    return bool(zlib.crc32(covered) == footer.summary_crc)
+
+
+def _as_stream(buffer: mmap.mmap) -> IO[bytes]:
+    """The file's map as the stream mcap reads from.
+
+    A map's ``read(n)`` returns what is there: a damaged length field asks for gigabytes,
+    which a file object would allocate before reading.
+    """
+    return cast(IO[bytes], buffer)
+
+
+def _read_record(buffer: mmap.mmap, at: int) -> tuple[McapRecord, int] | None:
+    """The record at ``at`` as mcap parses it, and where it ends (``None``: it does not parse).
+
+    A chunk comes whole (:class:`~mcap.records.Chunk`, not yet decompressed).
+    """
+    buffer.seek(at)
+    reader = StreamReader(
+        _as_stream(buffer), skip_magic=True, emit_chunks=True, record_size_limit=len(buffer)
+    )
+    try:
+        record = next(iter(reader.records))
+    except (*_READ_ERRORS, StopIteration):
+        return None
+    return record, buffer.tell()
+
+
+def _chunk_end(at: int, chunk: Chunk) -> int:
+    """Where a chunk record that starts at ``at`` ends, by the fields mcap read from it.
+
+    mcap skips to the end its length field declares; one that disagrees with the content
+    would make a stream skip (or reread) the records after it.
+    """
+    content = _CHUNK_FIELDS + len(chunk.compression.encode()) + len(chunk.data)
+    return at + _RECORD_PREFIX + content
+
+
+def _chunk_records(chunk: Chunk) -> list[McapRecord] | None:
+    """A chunk's records, decompressed, CRC-checked and parsed by mcap (``None``: damaged)."""
+    if chunk.compression not in _COMPRESSIONS or chunk.uncompressed_size > MAX_CHUNK_BYTES:
+        return None  # mcap takes an unknown compression for none
+    try:
+        if chunk.compression == 'zstd':
+            # The decompressor allocates the size the frame states, not the record's.
+            if zstandard.frame_content_size(chunk.data) != chunk.uncompressed_size:
+                return None
+        return breakup_chunk(chunk, validate_crc=True)
+    except _READ_ERRORS:
+        return None
 
 
 class FileWalk:
-    """One pass over an MCAP file's data section that skips what is damaged.
+    """One pass over an MCAP file's messages that skips what is damaged.
 
     Iterating yields ``(schema, channel, message)`` for every message of the wanted topics
-    found in an intact chunk (or outside chunks), in file order; with a summary, each chunk's
-    messages in log-time order (chunks themselves stay in file order, which is log-time
-    order for every writer that closes a chunk before it starts the next).
+    found in an intact chunk (or outside chunks), in file order. With a summary, the chunks
+    its indexes list are read one by one, each chunk's messages in log-time order (chunks
+    themselves stay in file order, which is log-time order for every writer that closes a
+    chunk before it starts the next). Without one, the records are read as a stream.
 
     Args:
         file: The ``.mcap`` file.
         bag: Its bag folder, to name in warnings.
         summary: The file's CRC-checked summary (``None``: cut or damaged): its schemas and
-            channels define topics whose own records were lost, its chunk indexes are where
-            the walk resumes after damage.
+            channels define topics whose own records were lost, its chunk indexes are the
+            chunks to read.
         wanted: Topics to yield; all when ``None``.
         declared: Filled, when given, with the schema and channel of every topic the file
             declares (in its summary or its records), whether or not a message follows.
@@ -357,8 +440,7 @@ class FileWalk:
     Attributes:
         damaged: One line per damaged stretch skipped.
         cut: Whether the file ends in an incomplete record (a cut recording).
-        sort_chunks: Whether each chunk's messages are sorted by log time (a summary was
-            given: the file is complete).
+        messages: Messages yielded so far.
     """
 
     def __init__(
@@ -375,17 +457,16 @@ class FileWalk:
         self.declared = declared
         self.schemas: dict[int, Schema] = {}
         self.channels: dict[int, Channel] = {}
-        self.chunk_starts: list[int] = []
+        self.chunk_indexes: list[ChunkIndex] = []
         self.damaged: list[str] = []
         self.cut = False
         self.messages = 0
-        self.sort_chunks = summary is not None
         if summary is not None:
             for schema in summary.schemas.values():
                 self.schemas[schema.id] = schema
             for channel in summary.channels.values():
                 self._define_channel(channel)
-            self.chunk_starts = sorted(i.chunk_start_offset for i in summary.chunk_indexes)
+            self.chunk_indexes = sorted(summary.chunk_indexes, key=lambda i: i.chunk_start_offset)
 
     def __iter__(self) -> Iterator[tuple[Schema | None, Channel, Message]]:
         try:
@@ -394,7 +475,10 @@ class FileWalk:
                     self._note_cut(len(MAGIC))
                     return
                 with mmap.mmap(stream.fileno(), 0, access=mmap.ACCESS_READ) as buffer:
-                    yield from self._walk(buffer)
+                    if self.chunk_indexes:
+                        yield from self._indexed(buffer)
+                    else:
+                        yield from self._streamed(buffer)
         except OSError as exc:
             raise BagError(f'{self.bag}: cannot read {self.file.name}: {exc.strerror}') from None
         if self.damaged:
@@ -403,57 +487,83 @@ class FileWalk:
             more = f' and {len(self.damaged) - 3} more' if len(self.damaged) > 3 else ''
             _log.info('%s: %s is damaged: skipped %s%s', self.bag, self.file.name, shown, more)
 
-    # -- the walk ---------------------------------------------------------------------------
+    # -- a complete file: chunk by chunk, through the summary -------------------------------
 
-    def _walk(self, buffer: mmap.mmap) -> Iterator[tuple[Schema | None, Channel, Message]]:
-        size = len(buffer)
-        offset = len(MAGIC)
-        chunked = bool(self.chunk_starts)
-        while offset < size:
-            if size - offset < _RECORD.size:
-                self._note_cut(offset)
-                return
-            opcode, length = _RECORD.unpack_from(buffer, offset)
-            body = offset + _RECORD.size
-            end = body + length
-            framed = opcode in _KNOWN_OPCODES and end <= size
-            records = None
-            if framed and opcode == _OP_CHUNK:
-                chunked = True
-                records = self._chunk_records(buffer, offset, body, end)
-                framed = records is not None
-            if not framed:
-                resume = self._next_chunk(buffer, offset + 1)
-                if resume is None and end > size and not self.damaged:
-                    self._note_cut(offset)  # a record cut by the end of the file
-                    return
-                what = 'a damaged chunk' if opcode == _OP_CHUNK else 'unreadable records'
-                offset = self._skip(offset, resume, size, what)
+    def _indexed(self, buffer: mmap.mmap) -> Iterator[tuple[Schema | None, Channel, Message]]:
+        for index in self.chunk_indexes:
+            records = self._indexed_chunk(buffer, index)
+            if records is None:
+                start = index.chunk_start_offset
+                self.damaged.append(
+                    f'a damaged chunk at bytes {start}-{start + index.chunk_length}'
+                )
                 continue
-            if records is not None:
-                chunk = self._records(records, offset)
-                if self.sort_chunks:
-                    # As mcap's own reader does with a summary: a chunk's messages in log
-                    # time, so that a file written out of order (rosbags' writer keeps the
-                    # order it is given) replays with a clock that never turns back.
-                    chunk = iter(sorted(chunk, key=lambda record: record[2].log_time))
-                yield from chunk
-            elif opcode in (_OP_DATA_END, _OP_FOOTER):
-                return
-            elif not chunked and not self.damaged:
-                # Records outside chunks are only believed in an unchunked file read without
-                # damage so far: after damage, garbage may look like one.
-                if opcode == _OP_MESSAGE:
-                    yield from self._message(buffer, body, end)
-                elif opcode in (_OP_SCHEMA, _OP_CHANNEL):
-                    self._definition(opcode, buffer, body, end)
-            offset = end
+            # As mcap's own reader does with a summary: a chunk's messages in log time, so
+            # that a file written out of order (rosbags' writer keeps the order it is given)
+            # replays with a clock that never turns back.
+            chunk = list(self._records(records))
+            chunk.sort(key=lambda record: record[2].log_time)
+            yield from chunk
 
-    def _skip(self, offset: int, resume: int | None, size: int, what: str) -> int:
-        """Notes a damaged stretch from ``offset`` to where the walk resumes."""
-        stop = size if resume is None else resume
-        self.damaged.append(f'{what} at bytes {offset}-{stop}')
-        return stop
+    @staticmethod
+    def _indexed_chunk(buffer: mmap.mmap, index: ChunkIndex) -> list[McapRecord] | None:
+        """The records of the chunk an index points at, if it is the chunk the index lists."""
+        start = index.chunk_start_offset
+        read = _read_record(buffer, start) if len(MAGIC) <= start < len(buffer) else None
+        if read is None:
+            return None
+        chunk, end = read
+        if (
+            not isinstance(chunk, Chunk)
+            or end != start + index.chunk_length
+            or chunk.compression != index.compression
+            or len(chunk.data) != index.compressed_size
+            or chunk.uncompressed_size != index.uncompressed_size
+        ):
+            return None
+        return _chunk_records(chunk)
+
+    # -- a cut or damaged file: record by record --------------------------------------------
+
+    def _streamed(self, buffer: mmap.mmap) -> Iterator[tuple[Schema | None, Channel, Message]]:
+        size = len(buffer)
+        at = len(MAGIC)
+        chunked = False
+        while at < size:
+            buffer.seek(at)
+            reader = StreamReader(
+                _as_stream(buffer), skip_magic=True, emit_chunks=True, record_size_limit=size
+            )
+            ran_out = False
+            try:
+                for record in reader.records:
+                    end = buffer.tell()
+                    if isinstance(record, Chunk):
+                        chunked = True
+                        intact = end == _chunk_end(at, record)
+                        records = _chunk_records(record) if intact else None
+                        if records is None:
+                            break  # resume at the next intact chunk
+                        yield from self._records(records)
+                    elif isinstance(record, DataEnd | Footer):
+                        return
+                    elif not chunked and not self.damaged:
+                        # Records outside chunks are only believed in an unchunked file read
+                        # without damage so far: after damage, garbage may look like one.
+                        yield from self._records([record])
+                    at = end
+                else:
+                    return
+            except _READ_ERRORS as exc:
+                # A record that runs past the end of the file: cut, unless data follows.
+                ran_out = isinstance(exc, RecordLengthLimitExceeded) or buffer.tell() >= size
+            resume = self._next_chunk(buffer, at + 1)
+            if resume is None and ran_out and not self.damaged:
+                self._note_cut(at)
+                return
+            stop = size if resume is None else resume
+            self.damaged.append(f'unreadable records at bytes {at}-{stop}')
+            at = stop
 
     def _note_cut(self, offset: int) -> None:
         self.cut = True
@@ -465,144 +575,40 @@ class FileWalk:
             self.messages,
         )
 
-    def _next_chunk(self, buffer: mmap.mmap, start: int) -> int | None:
+    @staticmethod
+    def _next_chunk(buffer: mmap.mmap, start: int) -> int | None:
         """Where the next intact chunk after ``start`` begins (``None``: there is none).
 
-        The summary's chunk indexes say it when the file has a trustworthy summary; else the
-        bytes are searched for a chunk record whose sizes fit and whose CRC matches.
+        The bytes are searched for a chunk's opcode where mcap reads a chunk whose length
+        fits its content and whose CRC matches.
         """
-        if self.chunk_starts:
-            return next((at for at in self.chunk_starts if at >= start), None)
-        at = buffer.find(bytes([_OP_CHUNK]), start)
+        opcode = bytes([Opcode.CHUNK])
+        at = buffer.find(opcode, start)
         while at != -1:
-            if self._plausible_chunk(buffer, at):
+            if _intact_chunk_at(buffer, at):
                 return at
-            at = buffer.find(bytes([_OP_CHUNK]), at + 1)
+            at = buffer.find(opcode, at + 1)
         return None
-
-    def _plausible_chunk(self, buffer: mmap.mmap, at: int) -> bool:
-        try:
-            _, length = _RECORD.unpack_from(buffer, at)
-            body = at + _RECORD.size
-            end = body + length
-            if end > len(buffer) or length < _CHUNK_HEAD.size + 12:
-                return False
-            return self._chunk_data(buffer, body, end, quiet=True) is not None
-        except _READ_ERRORS:
-            return False
-
-    # -- chunks -----------------------------------------------------------------------------
-
-    def _chunk_records(self, buffer: mmap.mmap, offset: int, body: int, end: int) -> Any:
-        """The records of an intact chunk; ``None`` for a damaged one."""
-        try:
-            records = self._chunk_data(buffer, body, end)
-        except _READ_ERRORS as exc:
-            records = f'{type(exc).__name__}'
-        return None if isinstance(records, str) else records
-
-    def _chunk_data(self, buffer: mmap.mmap, body: int, end: int, quiet: bool = False) -> Any:
-        """Decompresses and checks a chunk; a string says what is wrong with it."""
-        _, _, size, crc = _CHUNK_HEAD.unpack_from(buffer, body)
-        at = body + _CHUNK_HEAD.size
-        (name_length,) = _U32.unpack_from(buffer, at)
-        if name_length > 8:
-            return None if quiet else f'compression name of {name_length} bytes'
-        compression = bytes(buffer[at + 4 : at + 4 + name_length]).decode('ascii')
-        at += 4 + name_length
-        (length,) = _U64.unpack_from(buffer, at)
-        at += 8
-        if at + length != end or size > MAX_CHUNK_BYTES:
-            return None if quiet else 'sizes do not fit the record'
-        data = memoryview(buffer)[at:end]
-        try:
-            if compression == '':
-                records: bytes | memoryview = data
-            elif compression == 'zstd':
-                if zstandard.frame_content_size(data) != size:
-                    return None if quiet else 'compressed size does not match'
-                records = zstandard.ZstdDecompressor().decompress(data, max_output_size=size)
-            elif compression == 'lz4':
-                import lz4.frame
-
-                records = lz4.frame.decompress(bytes(data))
-            else:
-                return None if quiet else f'unknown compression {compression!r}'
-            if len(records) != size:
-                return None if quiet else 'uncompressed size does not match'
-            if crc and zlib.crc32(records) != crc:
-                return None if quiet else 'CRC mismatch'
-            return bytes(records)
-        finally:
-            data.release()
-
-    def _records(
-        self, records: bytes, offset: int
-    ) -> Iterator[tuple[Schema | None, Channel, Message]]:
-        """The messages of a chunk's records (a record that does not parse ends the chunk)."""
-        at, size = 0, len(records)
-        while at < size:
-            try:
-                opcode, length = _RECORD.unpack_from(records, at)
-            except struct.error:
-                opcode, length = 0, size
-            body = at + _RECORD.size
-            end = body + length
-            if end > size:
-                self.damaged.append(f'the rest of the chunk at byte {offset} (a cut record)')
-                return
-            if opcode == _OP_MESSAGE:
-                yield from self._message(records, body, end)
-            elif opcode in (_OP_SCHEMA, _OP_CHANNEL):
-                self._definition(opcode, records, body, end)
-            at = end
 
     # -- records ----------------------------------------------------------------------------
 
-    def _message(
-        self, buffer: Any, body: int, end: int
+    def _records(
+        self, records: Iterable[McapRecord]
     ) -> Iterator[tuple[Schema | None, Channel, Message]]:
-        if end - body < _MESSAGE_HEAD.size:
-            self.damaged.append('a message record too short for its header')
-            return
-        channel_id, sequence, log_time, publish_time = _MESSAGE_HEAD.unpack_from(buffer, body)
-        channel = self.channels.get(channel_id)
-        if channel is None or (self.wanted is not None and channel.topic not in self.wanted):
-            return  # a message of a channel whose definition was lost is counted as lost
-        data = bytes(buffer[body + _MESSAGE_HEAD.size : end])
-        self.messages += 1
-        yield (
-            self.schemas.get(channel.schema_id),
-            channel,
-            Message(
-                channel_id=channel_id,
-                log_time=log_time,
-                data=data,
-                publish_time=publish_time,
-                sequence=sequence,
-            ),
-        )
-
-    def _definition(self, opcode: int, buffer: Any, body: int, end: int) -> None:
-        try:
-            content = _Cursor(bytes(buffer[body:end]))
-            if opcode == _OP_SCHEMA:
-                schema_id, name, encoding = content.u16(), content.string(), content.string()
-                schema = Schema(id=schema_id, data=content.bytes(), encoding=encoding, name=name)
-                self.schemas.setdefault(schema.id, schema)
-            else:
-                channel_id, schema_id = content.u16(), content.u16()
-                topic, encoding = content.string(), content.string()
-                channel = Channel(
-                    id=channel_id,
-                    topic=topic,
-                    message_encoding=encoding,
-                    metadata=content.string_map(),
-                    schema_id=schema_id,
-                )
-                self._define_channel(channel)
-        except _READ_ERRORS:
-            self.damaged.append('a schema or channel record that does not parse')
+        """The wanted messages among records; the schemas and channels among them defined."""
+        for record in records:
+            if isinstance(record, Message):
+                channel = self.channels.get(record.channel_id)
+                if channel is None or (
+                    self.wanted is not None and channel.topic not in self.wanted
+                ):
+                    continue  # a message of a channel whose definition was lost is lost
+                self.messages += 1
+                yield self.schemas.get(channel.schema_id), channel, record
+            elif isinstance(record, Schema):
+                self.schemas.setdefault(record.id, record)
+            elif isinstance(record, Channel):
+                self._define_channel(record)
 
     def _define_channel(self, channel: Channel) -> None:
         self.channels.setdefault(channel.id, channel)
@@ -612,38 +618,21 @@ class FileWalk:
             )
 
 
-class _Cursor:
-    """Reads MCAP's little-endian fields from a record's content, failing on a short read."""
-
-    def __init__(self, data: bytes):
-        self.data = data
-        self.at = 0
-
-    def _take(self, n: int) -> bytes:
-        if n > len(self.data) - self.at:
-            raise ValueError('field runs past its record')
-        chunk = self.data[self.at : self.at + n]
-        self.at += n
-        return chunk
-
-    def u16(self) -> int:
-        return int(_U16.unpack(self._take(2))[0])
-
-    def bytes(self) -> bytes:
-        return self._take(int(_U32.unpack(self._take(4))[0]))
-
-    def string(self) -> str:
-        return self.bytes().decode()
-
-    def string_map(self) -> dict[str, str]:
-        end = int(_U32.unpack(self._take(4))[0]) + self.at
-        if end > len(self.data):
-            raise ValueError('map runs past its record')
-        pairs = {}
-        while self.at < end:
-            key = self.string()
-            pairs[key] = self.string()
-        return pairs
+def _intact_chunk_at(buffer: mmap.mmap, at: int) -> bool:
+    """Whether an intact chunk record starts at ``at``."""
+    prefix = ReadDataStream(io.BytesIO(buffer[at : at + _RECORD_PREFIX]))
+    try:
+        prefix.read1()
+        length = prefix.read8()
+    except _READ_ERRORS:
+        return False
+    # Most places that hold the opcode by chance declare a length the file cannot hold.
+    if length < _CHUNK_FIELDS or at + _RECORD_PREFIX + length > len(buffer):
+        return False
+    read = _read_record(buffer, at)
+    if read is None or not isinstance(read[0], Chunk) or read[1] != _chunk_end(at, read[0]):
+        return False
+    return _chunk_records(read[0]) is not None
 
 
 def _raw(schema: Schema | None, channel: Channel, message: Message) -> RawMessage:

@@ -17,7 +17,7 @@ from typing import TextIO
 from lumpbeam_ros.campaign.bags import fingerprint
 from lumpbeam_ros.campaign.store import ResultsStore
 from lumpbeam_ros.campaign.task import (
-    CampaignSettings,
+    CampaignOptions,
     Row,
     error_line,
     process_bag,
@@ -53,7 +53,7 @@ class CampaignRun:
 
 
 def pending_bags(
-    bags: Sequence[Path], store: ResultsStore, settings: CampaignSettings
+    bags: Sequence[Path], store: ResultsStore, settings: CampaignOptions
 ) -> list[str]:
     """The bags that have no finished row with their current key.
 
@@ -121,7 +121,7 @@ def start_client(
 def run_campaign(
     bags: Sequence[Path],
     store: ResultsStore,
-    settings: CampaignSettings,
+    settings: CampaignOptions,
     *,
     scheduler: str | None = None,
     workers: int = 2,
@@ -192,7 +192,7 @@ def _collect(
     return failed
 
 
-def run_serial(bags: Sequence[Path], settings: CampaignSettings) -> list[Row]:
+def run_serial(bags: Sequence[Path], settings: CampaignOptions) -> list[Row]:
     """The same rows by a plain loop in this process (the baseline of ``lumpbeam bench``).
 
     Args:

@@ -48,7 +48,7 @@ Row = dict[str, Any]
 
 
 @dataclass(frozen=True)
-class CampaignSettings:
+class CampaignOptions:
     """What every bag of a campaign is analysed with.
 
     Attributes:
@@ -121,7 +121,7 @@ def error_line(exc: BaseException) -> str:
     return f'{type(exc).__name__}: {text}{where}'
 
 
-def process_bag(bag: str, settings: CampaignSettings) -> Row:
+def process_bag(bag: str, settings: CampaignOptions) -> Row:
     """Analyses (and diagnoses) one bag into its row; never raises for a bad bag.
 
     Args:

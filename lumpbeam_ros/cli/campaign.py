@@ -12,15 +12,13 @@ def run(args: argparse.Namespace) -> int:
     from lumpbeam_ros.campaign.engine import run_campaign
     from lumpbeam_ros.campaign.store import ResultsStore
     from lumpbeam_ros.campaign.summary import summarize, write_campaign_report
-    from lumpbeam_ros.campaign.task import CampaignSettings
+    from lumpbeam_ros.campaign.task import CampaignOptions
     from lumpbeam_ros.ident.settings import load_identifier_config
     from lumpbeam_ros.model.parameters import load_beam_config
 
     bags = expand_bags(args.bags)
     beam, _ = load_beam_config(args.config)
-    settings = CampaignSettings(
-        beam, load_identifier_config(args.identifier_config), args.diagnose
-    )
+    settings = CampaignOptions(beam, load_identifier_config(args.identifier_config), args.diagnose)
     store = ResultsStore(args.out)
     result = run_campaign(
         bags,

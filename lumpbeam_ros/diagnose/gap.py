@@ -9,7 +9,7 @@ import numpy as np
 from lumpbeam_ros.diagnose.measurement import Record
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.mode_estimate import ModeEstimate
-from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParams
+from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParameters
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
 #: Time after a load event before the decay fit starts: the higher modes (20 Hz and up,
@@ -39,7 +39,7 @@ class Gap:
         return asdict(self)
 
 
-def decay_fit(t: np.ndarray, z: np.ndarray, start_s: float) -> DampedSinusoidParams:
+def decay_fit(t: np.ndarray, z: np.ndarray, start_s: float) -> DampedSinusoidParameters:
     """A one-mode damped-sinusoid fit of the free decay after ``start_s``.
 
     Args:

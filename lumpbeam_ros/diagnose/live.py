@@ -43,7 +43,7 @@ AMPLITUDE_SPAN_S = 0.5
 
 
 @dataclass(frozen=True)
-class LiveSettings:
+class LiveDiagnosisConfig:
     """When the live diagnosis runs (the diagnosis node's parameters).
 
     Attributes:
@@ -263,7 +263,7 @@ class LiveBuffer:
         settings: When a stretch is complete.
     """
 
-    def __init__(self, settings: LiveSettings):
+    def __init__(self, settings: LiveDiagnosisConfig):
         self.settings = settings
         self.measured = self._buffer()
         self.predicted = self._buffer()

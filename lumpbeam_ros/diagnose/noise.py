@@ -20,7 +20,7 @@ from dataclasses import replace
 import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParams
+from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParameters
 
 #: Order of the differences. The k-th difference damps a sinusoid by ``(2 sin(pi f / fs))^k``:
 #: for the beam's 3 Hz at 180 Hz, 1e-4 at k = 4, so even a 20 mm swing leaves 2 um, while
@@ -88,7 +88,7 @@ def decay_error_std(t: np.ndarray, y: np.ndarray, start_s: float, t0: float) -> 
     return float(np.sqrt(residual @ residual / (n - design.shape[1])))
 
 
-def _modulated_design(fit: DampedSinusoidParams, t: np.ndarray) -> np.ndarray:
+def _modulated_design(fit: DampedSinusoidParameters, t: np.ndarray) -> np.ndarray:
     """The free-form decay's columns: offset, level shift, carrier times hat functions.
 
     The carrier's two quadratures (the fitted decay, frequency and its amplitude-dependent

@@ -35,7 +35,7 @@ from lumpbeam_ros.ident.pencil import MatrixPencil
 from lumpbeam_ros.ident.release import Release, detect_release
 from lumpbeam_ros.ident.samples import PoseWindow
 from lumpbeam_ros.ident.settings import IdentifierConfig
-from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParams, ModeGuess
+from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParameters, ModeGuess
 from lumpbeam_ros.model import rules
 from lumpbeam_ros.model.parameters import BeamParameters
 
@@ -72,7 +72,7 @@ class FitState:
     """
 
     release_time_s: float
-    params: DampedSinusoidParams
+    params: DampedSinusoidParameters
     checks: CrossChecks
     checked_at_s: float
 
@@ -285,7 +285,7 @@ def _initial_modes(
 
 def _fit_decay(
     t: np.ndarray, z: np.ndarray, guesses: list[ModeGuess], start: float, config: IdentifierConfig
-) -> DampedSinusoidParams:
+) -> DampedSinusoidParameters:
     """The least-squares decay, with the modes and nonlinear terms the data support.
 
     The nonlinear terms are fitted when :func:`_wants_nonlinear`; a second mode that does
@@ -326,7 +326,7 @@ def _wants_nonlinear(first: ModeGuess, span_s: float, config: IdentifierConfig) 
 
 
 def _reject_mode(
-    mode: ModeEstimate, params: DampedSinusoidParams, config: IdentifierConfig
+    mode: ModeEstimate, params: DampedSinusoidParameters, config: IdentifierConfig
 ) -> str:
     """Why the fitted first mode is not an oscillation of the beam, or ``''``."""
     snr = mode.amplitude / max(params.residual_rms, 1e-15)
@@ -342,7 +342,7 @@ def _reject_mode(
     return ''
 
 
-def _damping_total(params: DampedSinusoidParams, mode: ModeEstimate) -> tuple[float, float]:
+def _damping_total(params: DampedSinusoidParameters, mode: ModeEstimate) -> tuple[float, float]:
     """c_tE = 2 zeta omega_d (B.22) and its std from the (sigma, omega_d) covariance."""
     s, w = params.x[params.mode_slice(0)][2:]
     wn = math.hypot(s, w)
@@ -405,7 +405,7 @@ def _derive(
     config: IdentifierConfig,
     release: Release,
     t: np.ndarray,
-    params: DampedSinusoidParams,
+    params: DampedSinusoidParameters,
     mode: ModeEstimate,
 ) -> _Figures:
     """The physics: damping (B.22) and stiffness (B.12, and from the frequency)."""
@@ -484,7 +484,7 @@ def _grade(
     return warnings
 
 
-def _method(params: DampedSinusoidParams) -> str:
+def _method(params: DampedSinusoidParameters) -> str:
     """The estimator's name: the fit, its modes and whether it was nonlinear."""
     method = METHOD if params.n_modes == 1 else f'{METHOD}_{params.n_modes}modes'
     return method + '_nonlinear' if params.nonlinear else method
@@ -575,7 +575,7 @@ def _pencil_first(guesses: list[ModeGuess]) -> tuple[float, float]:
 
 
 def _log_decrement(
-    t: np.ndarray, z: np.ndarray, params: DampedSinusoidParams
+    t: np.ndarray, z: np.ndarray, params: DampedSinusoidParameters
 ) -> LogDecrementResult | None:
     """The paper's B.20/B.21 on the same stretch, about the fitted level; None if it fails."""
     try:
@@ -587,7 +587,7 @@ def _log_decrement(
 def _pitch_stiffness(
     window: PoseWindow,
     release: Release,
-    params: DampedSinusoidParams,
+    params: DampedSinusoidParameters,
     end: float,
     load: float,
     beam: BeamParameters,

@@ -37,7 +37,7 @@ ModeGuess = tuple[float, float]
 
 
 @dataclass(frozen=True)
-class DampedSinusoidParams:
+class DampedSinusoidParameters:
     """A fitted decay.
 
     Attributes:
@@ -82,7 +82,7 @@ class DampedSinusoidParams:
         """d, m/s (0 when not fitted)."""
         return float(self.x[1]) if self.drift else 0.0
 
-    def shifted(self, t0: float) -> DampedSinusoidParams:
+    def shifted(self, t0: float) -> DampedSinusoidParameters:
         """The same curve with its time origin moved to ``t0`` (the covariance is kept).
 
         Moving the origin by ``D`` scales each mode by ``e^{-sigma D}`` and turns its phase
@@ -399,7 +399,7 @@ class DampedSinusoidFit:
         self.nonlinear = nonlinear
         self.min_frequency_hz = min_frequency_hz
         self.max_frequency_hz = max_frequency_hz
-        self.params_: DampedSinusoidParams | None = None
+        self.params_: DampedSinusoidParameters | None = None
 
     @property
     def n_params(self) -> int:
@@ -412,8 +412,8 @@ class DampedSinusoidFit:
         y: np.ndarray,
         initial: Sequence[ModeGuess] | None = None,
         t0: float | None = None,
-        start: DampedSinusoidParams | None = None,
-    ) -> DampedSinusoidParams:
+        start: DampedSinusoidParameters | None = None,
+    ) -> DampedSinusoidParameters:
         """Fits the model to samples.
 
         Args:
@@ -479,7 +479,7 @@ class DampedSinusoidFit:
                     x[-1] = -x[-1]
         residuals = decay.value(x) - y
         cov = sandwich_covariance(decay.jacobian(x), residuals)
-        self.params_ = DampedSinusoidParams(
+        self.params_ = DampedSinusoidParameters(
             origin,
             x,
             cov,

@@ -6,21 +6,21 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, get_args
 
 import numpy as np
 import yaml
 
-from lumpbeam_ros.errors import ConfigError
 from lumpbeam_ros.model import rules
-from lumpbeam_ros.paramfile import (
-    check_known_keys,
-    get_choice,
-    get_float,
-    get_int,
-    read_parameter_file,
+from lumpbeam_ros.paramfile import check_known_keys, read_parameter_file
+from lumpbeam_ros.params.schema import (
+    Bounds,
+    ParameterSpec,
+    setting,
+    settings_from_parameters,
+    settings_specs,
+    settings_to_parameters,
 )
-from lumpbeam_ros.params.schema import Bounds
 from lumpbeam_ros.resources import config_path
 
 StiffnessSource = Literal['analytic', 'identified']
@@ -31,6 +31,9 @@ TipPlacement = Literal['free_end', 'segment_com']
 #: (:func:`~lumpbeam_ros.model.simulate.simulate_loads`, the stream) or the measured position
 #: (:func:`~lumpbeam_ros.model.sensor.measured_position`).
 EffectHook = Literal['chain', 'stamps', 'position']
+
+_POSITIVE = Bounds(0.0, low_open=True)
+_NON_NEGATIVE = Bounds(0.0)
 
 
 @dataclass(frozen=True)
@@ -90,6 +93,11 @@ class EffectRecord:
     compliance: bool = False
     signature: str = ''
 
+    @property
+    def key(self) -> str:
+        """Its parameter's dotted name in a beam file: ``effects.<name>.<parameter>``."""
+        return f'effects.{self.name}.{self.parameter}'
+
     def problem(self, value: float) -> str | None:
         """Why ``value`` is outside :attr:`limits` (``None``: inside).
 
@@ -102,8 +110,14 @@ class EffectRecord:
 
 
 def _effect(record: EffectRecord) -> Any:
-    """The :class:`Effects` field of an effect: off by default, its record attached."""
-    return field(default=record.off, metadata={'effect': record})
+    """The :class:`Effects` field of an effect: off by default, its record attached.
+
+    The field is also the effect's parameter in a beam file (:func:`beam_from_parameters`).
+    """
+    spec = ParameterSpec(
+        record.key, 'double', record.off, record.meaning, record.unit, record.limits
+    )
+    return field(default=record.off, metadata={'effect': record, 'parameter': spec})
 
 
 @dataclass(frozen=True)
@@ -330,19 +344,39 @@ class BeamParameters:
         effects: Effects beyond the paper's model.
     """
 
-    length_m: float = 2.3107
-    bending_stiffness_nm2: float = 5000.6
-    mass_kg: float = 1.90
-    n_segments: int = 10
-    stiffness_source: StiffnessSource = 'identified'
-    k_total_nm_per_rad: float = 3899.1
-    c_total: float = 0.08
-    beta_identified: float = 12.0
-    beta_analytic: float = 2.2e-4
-    gravity_mps2: float = 9.81
-    tip_mass_kg: float = 2.5
-    tip_inertia_kgm2: float = 0.0
-    tip_placement: TipPlacement = 'free_end'
+    length_m: float = setting('beam.length_m', 2.3107, 'L', 'm', _POSITIVE)
+    bending_stiffness_nm2: float = setting(
+        'beam.bending_stiffness_nm2', 5000.6, 'EI (the analytic rule, B.9)', 'N m^2', _POSITIVE
+    )
+    mass_kg: float = setting('beam.mass_kg', 1.90, 'm_b', 'kg', _POSITIVE)
+    n_segments: int = setting('beam.n_segments', 10, 'n_s', bounds=Bounds(1.0))
+    stiffness_source: StiffnessSource = setting(
+        'beam.stiffness_source',
+        'identified',
+        'joint 1 from k_tE (B.13, B.23) or from EI (B.9)',
+        choices=get_args(StiffnessSource),
+    )
+    k_total_nm_per_rad: float = setting(
+        'beam.k_total_nm_per_rad', 3899.1, 'k_tE (B.12)', 'N m/rad', _POSITIVE
+    )
+    c_total: float = setting('beam.c_total', 0.08, 'c_tE (B.22)', '1/s', _NON_NEGATIVE)
+    beta_identified: float = setting(
+        'beam.beta_identified', 12.0, 'beta of B.23', '', _NON_NEGATIVE
+    )
+    beta_analytic: float = setting(
+        'beam.beta_analytic', 2.2e-4, 'beta of c = beta k', 's', _NON_NEGATIVE
+    )
+    gravity_mps2: float = setting('beam.gravity_mps2', 9.81, 'g', 'm/s^2', _NON_NEGATIVE)
+    tip_mass_kg: float = setting('tip.mass_kg', 2.5, 'm_d', 'kg', _NON_NEGATIVE)
+    tip_inertia_kgm2: float = setting(
+        'tip.inertia_kgm2', 0.0, 'rotary inertia of the mounted body', 'kg m^2', _NON_NEGATIVE
+    )
+    tip_placement: TipPlacement = setting(
+        'tip.placement',
+        'free_end',
+        'where the tip masses sit on the last segment',
+        choices=get_args(TipPlacement),
+    )
     effects: Effects = field(default_factory=Effects)
 
     @property
@@ -389,38 +423,24 @@ class DropTestConfig:
         duration_s: Length of the record.
     """
 
-    load_kg: float = 4.5
-    release_time_s: float = 2.0
-    duration_s: float = 12.0
+    load_kg: float = setting('drop_test.load_kg', 4.5, 'm_l', 'kg', _NON_NEGATIVE)
+    release_time_s: float = setting(
+        'drop_test.release_time_s', 2.0, 'when the load is released', 's', _NON_NEGATIVE
+    )
+    duration_s: float = setting('drop_test.duration_s', 12.0, 'record length', 's', _POSITIVE)
 
 
+#: Every key of a beam file.
 _KEYS = frozenset(
-    {
-        'beam.length_m',
-        'beam.bending_stiffness_nm2',
-        'beam.mass_kg',
-        'beam.n_segments',
-        'beam.stiffness_source',
-        'beam.k_total_nm_per_rad',
-        'beam.c_total',
-        'beam.beta_identified',
-        'beam.beta_analytic',
-        'beam.gravity_mps2',
-        'tip.mass_kg',
-        'tip.inertia_kgm2',
-        'tip.placement',
-        'drop_test.load_kg',
-        'drop_test.release_time_s',
-        'drop_test.duration_s',
-    }
-    | {f'effects.{name}.{param}' for name, param in EFFECT_PARAMETERS.items()}
+    spec.name for cls in (BeamParameters, Effects, DropTestConfig) for spec in settings_specs(cls)
 )
 
 
 def beam_from_parameters(params: Mapping[str, Any], source: str | Path) -> BeamParameters:
     """Builds and validates beam parameters from flat (dotted) ROS parameters.
 
-    Missing keys take the defaults of doc/interfaces.md, 'Beam model'.
+    Missing keys take the defaults of doc/interfaces.md, 'Beam model'; the keys, defaults and
+    bounds are the fields' of :class:`BeamParameters` and :class:`Effects`.
 
     Args:
         params: Flat parameters, e.g. from :func:`~lumpbeam_ros.paramfile.read_parameter_file`.
@@ -430,61 +450,16 @@ def beam_from_parameters(params: Mapping[str, Any], source: str | Path) -> BeamP
         The beam.
 
     Raises:
-        ConfigError: An unknown key, a wrong type, or a non-positive length, mass, stiffness
-            or n_s.
+        ConfigError: An unknown key, a wrong type, or a value out of its bounds.
     """
     check_known_keys(params, _KEYS, source)
-    d = BeamParameters()
-    pos = {'positive': True}
-    nonneg = {'non_negative': True}
-    effects = Effects()
-    for name, param in EFFECT_PARAMETERS.items():
-        key = f'effects.{name}.{param}'
-        value = get_float(params, key, source, EFFECT_OFF[name])
-        problem = effect_value_problem(name, value)
-        if problem is not None:
-            raise ConfigError(source, key, problem)
-        effects = effects.with_effect(name, value)
-    return BeamParameters(
-        length_m=get_float(params, 'beam.length_m', source, d.length_m, **pos),
-        bending_stiffness_nm2=get_float(
-            params, 'beam.bending_stiffness_nm2', source, d.bending_stiffness_nm2, **pos
-        ),
-        mass_kg=get_float(params, 'beam.mass_kg', source, d.mass_kg, **pos),
-        n_segments=get_int(params, 'beam.n_segments', source, d.n_segments, minimum=1),
-        stiffness_source=get_choice(  # type: ignore[arg-type]
-            params, 'beam.stiffness_source', source, ('identified', 'analytic'), 'identified'
-        ),
-        k_total_nm_per_rad=get_float(
-            params, 'beam.k_total_nm_per_rad', source, d.k_total_nm_per_rad, **pos
-        ),
-        c_total=get_float(params, 'beam.c_total', source, d.c_total, **nonneg),
-        beta_identified=get_float(
-            params, 'beam.beta_identified', source, d.beta_identified, **nonneg
-        ),
-        beta_analytic=get_float(params, 'beam.beta_analytic', source, d.beta_analytic, **nonneg),
-        gravity_mps2=get_float(params, 'beam.gravity_mps2', source, d.gravity_mps2, **nonneg),
-        tip_mass_kg=get_float(params, 'tip.mass_kg', source, d.tip_mass_kg, **nonneg),
-        tip_inertia_kgm2=get_float(
-            params, 'tip.inertia_kgm2', source, d.tip_inertia_kgm2, **nonneg
-        ),
-        tip_placement=get_choice(  # type: ignore[arg-type]
-            params, 'tip.placement', source, ('free_end', 'segment_com'), 'free_end'
-        ),
-        effects=effects,
-    )
+    beam = settings_from_parameters(BeamParameters, params, source)
+    return replace(beam, effects=settings_from_parameters(Effects, params, source))
 
 
 def drop_test_from_parameters(params: Mapping[str, Any], source: str | Path) -> DropTestConfig:
     """Builds the drop-test scenario from flat parameters (defaults of doc/interfaces.md)."""
-    d = DropTestConfig()
-    return DropTestConfig(
-        load_kg=get_float(params, 'drop_test.load_kg', source, d.load_kg, non_negative=True),
-        release_time_s=get_float(
-            params, 'drop_test.release_time_s', source, d.release_time_s, non_negative=True
-        ),
-        duration_s=get_float(params, 'drop_test.duration_s', source, d.duration_s, positive=True),
-    )
+    return settings_from_parameters(DropTestConfig, params, source)
 
 
 def load_beam_config(path: str | Path | None = None) -> tuple[BeamParameters, DropTestConfig]:
@@ -506,34 +481,16 @@ def load_beam_config(path: str | Path | None = None) -> tuple[BeamParameters, Dr
 
 def beam_to_parameters(beam: BeamParameters, drop: DropTestConfig | None = None) -> dict[str, Any]:
     """Returns the nested ``ros__parameters`` mapping that reads back as ``beam``."""
-    tree: dict[str, Any] = {
-        'beam': {
-            'length_m': beam.length_m,
-            'bending_stiffness_nm2': beam.bending_stiffness_nm2,
-            'mass_kg': beam.mass_kg,
-            'n_segments': beam.n_segments,
-            'stiffness_source': beam.stiffness_source,
-            'k_total_nm_per_rad': beam.k_total_nm_per_rad,
-            'c_total': beam.c_total,
-            'beta_identified': beam.beta_identified,
-            'beta_analytic': beam.beta_analytic,
-            'gravity_mps2': beam.gravity_mps2,
-        },
-        'tip': {
-            'mass_kg': beam.tip_mass_kg,
-            'inertia_kgm2': beam.tip_inertia_kgm2,
-            'placement': beam.tip_placement,
-        },
-        'effects': {
-            name: {param: beam.effects.value(name)} for name, param in EFFECT_PARAMETERS.items()
-        },
-    }
+    flat = {**settings_to_parameters(beam), **settings_to_parameters(beam.effects)}
     if drop is not None:
-        tree['drop_test'] = {
-            'load_kg': drop.load_kg,
-            'release_time_s': drop.release_time_s,
-            'duration_s': drop.duration_s,
-        }
+        flat.update(settings_to_parameters(drop))
+    tree: dict[str, Any] = {}
+    for key, value in flat.items():
+        *sections, name = key.split('.')
+        node = tree
+        for section in sections:
+            node = node.setdefault(section, {})
+        node[name] = value
     return tree
 
 

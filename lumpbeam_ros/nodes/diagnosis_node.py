@@ -46,7 +46,7 @@ from lumpbeam_ros.diagnose.live import (
     STALE,
     LiveBuffer,
     LiveDiagnosis,
-    LiveSettings,
+    LiveDiagnosisConfig,
     Stretch,
     diagnose_live,
     status_values,
@@ -106,7 +106,7 @@ class DiagnosisNode(SchemaNode):
         self.hardware_id = str(values['hardware_id'])
         self.beam: BeamParameters = load_beam_config(values['beam_config'] or None)[0]
         self.buffer = LiveBuffer(
-            settings_from_parameters(LiveSettings, values, f'{self.get_name()} parameters')
+            settings_from_parameters(LiveDiagnosisConfig, values, f'{self.get_name()} parameters')
         )
         self.wrong_frame = 0
         self.non_finite = 0

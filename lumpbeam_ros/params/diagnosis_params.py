@@ -1,12 +1,12 @@
 """The diagnosis node's parameters (values in ``config/diagnosis.yaml``, documented there).
 
-When a diagnosis runs: :class:`~lumpbeam_ros.diagnose.live.LiveSettings`' fields, declared there
-once; the rest is the node's own.
+When a diagnosis runs: the fields of :class:`~lumpbeam_ros.diagnose.live.LiveDiagnosisConfig`,
+declared there once; the rest is the node's own.
 """
 
 from __future__ import annotations
 
-from lumpbeam_ros.diagnose.live import LiveSettings
+from lumpbeam_ros.diagnose.live import LiveDiagnosisConfig
 from lumpbeam_ros.interface import DIAGNOSIS_NODE, SIMULATOR_NODE
 from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec, settings_specs
 
@@ -21,7 +21,7 @@ DIAGNOSIS_SCHEMA = ParameterSchema(
     ),
     config_file='diagnosis.yaml',
     parameters=(
-        *settings_specs(LiveSettings),
+        *settings_specs(LiveDiagnosisConfig),
         ParameterSpec(
             'worker',
             'string',

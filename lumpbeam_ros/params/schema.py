@@ -275,18 +275,18 @@ class ParameterSchema:
         return None
 
 
-# --- Settings: a configuration object whose fields are declared parameters ---------------------
+# --- A configuration object whose fields are declared parameters ------------------------------
 
 _T = TypeVar('_T', bound=ParameterValue)
 
 
-class Settings(Protocol):
+class DeclaredFields(Protocol):
     """A dataclass whose fields are declared with :func:`setting` (others are no parameter)."""
 
     __dataclass_fields__: ClassVar[dict[str, Field[Any]]]
 
 
-_S = TypeVar('_S', bound=Settings)
+_S = TypeVar('_S', bound=DeclaredFields)
 
 
 def _kind(default: object) -> ParameterKind:
@@ -333,7 +333,7 @@ def setting(
     return field(default=default, metadata={'parameter': spec})
 
 
-def settings_specs(cls: type[Settings]) -> tuple[ParameterSpec, ...]:
+def settings_specs(cls: type[DeclaredFields]) -> tuple[ParameterSpec, ...]:
     """The parameters a settings class declares, in field order."""
     return tuple(f.metadata['parameter'] for f in fields(cls) if 'parameter' in f.metadata)
 
@@ -382,7 +382,7 @@ def settings_from_parameters(cls: type[_S], params: Mapping[str, Any], source: s
     return settings
 
 
-def settings_to_parameters(settings: Settings) -> dict[str, Any]:
+def settings_to_parameters(settings: DeclaredFields) -> dict[str, Any]:
     """The flat parameters that read back as ``settings``."""
     return {
         f.metadata['parameter'].name: getattr(settings, f.name)

@@ -9,7 +9,7 @@ from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec
 
 def effect_parameter_name(effect: str) -> str:
     """The simulator's parameter of an effect: ``effects.<effect>.<contract parameter>``."""
-    return f'effects.{effect}.{EFFECTS[effect].parameter}'
+    return EFFECTS[effect].key
 
 
 def _effect_spec(record: EffectRecord) -> ParameterSpec:

@@ -35,6 +35,7 @@ from lumpbeam_ros.model.parameters import (
 from lumpbeam_ros.model.simulate import DEFAULT_STEP_S, drop_test_events, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.synthetic.reference_sensor import (
+    ReferenceSamples,
     ReferenceSensorOptions,
     simulate_reference_sensor,
     write_reference_points,
@@ -43,6 +44,7 @@ from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.viz.marker_messages import write_scene
 from lumpbeam_ros.viz.markers import (
     BeamScene,
+    BoardPlacement,
     TipPoint,
     board_placement,
     lifetime_for_rate,
@@ -50,7 +52,7 @@ from lumpbeam_ros.viz.markers import (
 )
 
 if TYPE_CHECKING:
-    from lumpbeam_ros.synthetic.images import ImageOptions
+    from lumpbeam_ros.synthetic.images import ImageOptions, ImageStream
 
 #: Pitch noise per metre of position noise: the camera sees the board about 1 m away.
 PITCH_NOISE_PER_M = 1.0
@@ -182,6 +184,80 @@ def load_messages(drop: DropTestConfig, duration_s: float) -> list[tuple[float, 
     ]
 
 
+def _check_record(
+    drop: DropTestConfig, options: SynthOptions, tracker: ReferenceSensorOptions | None
+) -> None:
+    """Refuses a record that ends before the release or holds too many samples."""
+    if options.duration_s <= drop.release_time_s:
+        raise LumpbeamError(
+            f'duration {options.duration_s} s ends before the release at {drop.release_time_s} s'
+        )
+    rates = {'poses': options.rate_hz, 'simulation grid': 1.0 / DEFAULT_STEP_S}
+    if tracker is not None:
+        rates['tracker'] = tracker.rate_hz
+    check_sample_count(options.duration_s, rates)
+
+
+@dataclass
+class _Record:
+    """What a drop-test bag holds, simulated: the streams :func:`_write_record` writes.
+
+    Attributes:
+        beam: The nominal beam (its segments drawn on ``/beam_markers``).
+        measured: The measured tip, before pose noise.
+        truth: The true tip and joint angles.
+        noise: Pose noise added to ``measured``: x, z (m) and pitch (rad) rows.
+        points: The reference sensor's points (``None``: none).
+        camera: The camera filming the measured motion (``None``: no images).
+        drawn: Indices of the samples drawn on ``/beam_markers``.
+        board: The checkerboard drawn with them.
+        lifetime: Their lifetime, s.
+    """
+
+    beam: BeamParameters
+    measured: TipTrajectory
+    truth: TipTrajectory
+    noise: np.ndarray
+    points: ReferenceSamples | None
+    camera: ImageStream | None
+    drawn: set[int] = field(default_factory=set)
+    board: BoardPlacement | None = None
+    lifetime: float = 0.0
+
+
+def _write_record(bag: BagWriter, record: _Record, loads: list[tuple[float, float]]) -> None:
+    """Writes every stream of a simulated record, in log-time order."""
+    measured, truth, noise, points = record.measured, record.truth, record.noise, record.points
+    assert truth.q is not None  # the truth keeps its joint angles
+    written = 0
+    pending_loads = iter(loads)
+    pending = next(pending_loads, None)
+    for i, stamp in enumerate(measured.t):
+        # In log-time order: the reference points since the last pose come before a load
+        # change at this stamp (a flush between the two would put them after).
+        if points is not None:
+            written = write_reference_points(bag, points, written, stamp)
+        while pending is not None and pending[0] <= stamp:
+            bag.write_float(TIP_LOAD, pending[0], pending[1])
+            pending = next(pending_loads, None)
+        x, z = measured.x[i] + noise[0, i], measured.z[i] + noise[1, i]
+        bag.write_pose(TIP_POSE, stamp, x, z, measured.pitch[i] + noise[2, i])
+        bag.write_pose(TIP_POSE_TRUTH, stamp, truth.x[i], truth.z[i], truth.pitch[i])
+        if i in record.drawn:
+            scene = BeamScene(
+                record.beam.segment_length_m,
+                phi=truth.q[i],
+                measured=TipPoint(x, z),
+                load_kg=float(truth.load_kg[i]),
+                board=record.board,
+            )
+            write_scene(bag, stamp, scene, record.lifetime)
+        if record.camera is not None:
+            record.camera.write_next(bag)
+    if points is not None:
+        write_reference_points(bag, points, written, math.inf)
+
+
 def write_drop_test_bag(
     out: str | Path,
     beam: BeamParameters,
@@ -212,16 +288,8 @@ def write_drop_test_bag(
         LumpbeamError: The record ends before the release, or needs more than
             :data:`MAX_SAMPLES` samples in a stream.
     """
-    if options.duration_s <= drop.release_time_s:
-        raise LumpbeamError(
-            f'duration {options.duration_s} s ends before the release at {drop.release_time_s} s'
-        )
-    rates = {'poses': options.rate_hz, 'simulation grid': 1.0 / DEFAULT_STEP_S}
-    if tracker is not None:
-        rates['tracker'] = tracker.rate_hz
-    check_sample_count(options.duration_s, rates)
+    _check_record(drop, options, tracker)
     measured, truth = simulate_experiment(beam, drop, options)
-    assert truth.q is not None  # the truth keeps its joint angles
     rng = np.random.default_rng(options.seed)
     noise = options.noise_m * rng.standard_normal((3, len(measured)))
     noise[2] *= PITCH_NOISE_PER_M
@@ -229,56 +297,22 @@ def write_drop_test_bag(
     if tracker is not None:
         hidden = with_effects(beam, options.effects)
         points = simulate_reference_sensor(hidden, drop, options.duration_s, tracker)
-    written = 0
     camera = None
     if images is not None:
         # OpenCV only when filming: the pose-only bag needs none (`pip install lumpbeam_ros`).
         from lumpbeam_ros.synthetic.images import ImageStream
 
         camera = ImageStream(measured, images)
-    drawn = set()
+    record = _Record(beam, measured, truth, noise, points, camera)
     if options.markers_rate_hz > 0.0:
-        drawn = set(marker_sample_indices(truth.t, options.markers_rate_hz).tolist())
-        board = board_placement(
-            load_camera_config(None if images is None else images.camera_config)
-        )
-        lifetime = lifetime_for_rate(options.markers_rate_hz)
+        record.drawn = set(marker_sample_indices(truth.t, options.markers_rate_hz).tolist())
+        config = load_camera_config(None if images is None else images.camera_config)
+        record.board = board_placement(config)
+        record.lifetime = lifetime_for_rate(options.markers_rate_hz)
     created = not Path(out).exists()  # BagWriter refuses an existing OUT: never removed below
     try:
         with BagWriter(out) as bag:
-            loads = iter(load_messages(drop, options.duration_s))
-            pending = next(loads, None)
-            for i, stamp in enumerate(measured.t):
-                # In log-time order: the reference points since the last pose come before a
-                # load change at this stamp (a flush between the two would put them after).
-                if points is not None:
-                    written = write_reference_points(bag, points, written, stamp)
-                while pending is not None and pending[0] <= stamp:
-                    bag.write_float(TIP_LOAD, pending[0], pending[1])
-                    pending = next(loads, None)
-                bag.write_pose(
-                    TIP_POSE,
-                    stamp,
-                    measured.x[i] + noise[0, i],
-                    measured.z[i] + noise[1, i],
-                    measured.pitch[i] + noise[2, i],
-                )
-                bag.write_pose(TIP_POSE_TRUTH, stamp, truth.x[i], truth.z[i], truth.pitch[i])
-                if i in drawn:
-                    scene = BeamScene(
-                        beam.segment_length_m,
-                        phi=truth.q[i],
-                        measured=TipPoint(
-                            measured.x[i] + noise[0, i], measured.z[i] + noise[1, i]
-                        ),
-                        load_kg=float(truth.load_kg[i]),
-                        board=board,
-                    )
-                    write_scene(bag, stamp, scene, lifetime)
-                if camera is not None:
-                    camera.write_next(bag)
-            if points is not None:
-                write_reference_points(bag, points, written, math.inf)
+            _write_record(bag, record, load_messages(drop, options.duration_s))
     except BaseException:
         # Interrupted (Ctrl-C, SIGTERM) or failed: a bag cut short is not the record asked for.
         if created:

@@ -27,7 +27,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from mcap.reader import SeekingReader
 
 from lumpbeam_ros.bagio import BagReader, BagWriter, convert, read_camera_info, read_tip_poses
 from lumpbeam_ros.bagio.qos import from_dict
@@ -117,19 +116,10 @@ class TrackSummary:
 
 def _definitions(reader: BagReader) -> dict[str, tuple[str, str]]:
     """The ``(encoding, text)`` message definitions the MCAP files store, by topic."""
-    found: dict[str, tuple[str, str]] = {}
-    for file in reader.info.files:
-        if file in reader.truncated:
-            continue  # no summary to read them from; known types need none
-        with file.open('rb') as stream:
-            summary = SeekingReader(stream).get_summary()
-        if summary is None:
-            continue
-        for channel in summary.channels.values():
-            schema = summary.schemas.get(channel.schema_id)
-            if schema is not None:
-                found[channel.topic] = (schema.encoding, schema.data.decode(errors='replace'))
-    return found
+    return {
+        topic: (schema.encoding, schema.data.decode(errors='replace'))
+        for topic, schema in reader.schemas().items()
+    }
 
 
 def _declare_copies(reader: BagReader, out: BagWriter, summary: TrackSummary) -> set[str]:

@@ -139,3 +139,15 @@ def test_an_intact_bag_reads_without_a_loss_warning(drop, caplog):
         assert len(read_tip_poses(drop).t) == BagReader(drop).topics['/tip_pose'].count
         assert len(list(BagReader(drop).iter_raw())) == BagReader(drop).info.message_count
     assert 'lost' not in caplog.text
+
+
+def test_a_damaged_summary_is_not_trusted_and_every_message_is_still_read(drop, caplog):
+    full = read_tip_poses(drop)
+    data_file = drop / 'drop.mcap'
+    data = bytearray(data_file.read_bytes())
+    data[-(8 + 29) - 5] ^= 0xFF  # in the summary, just before the footer: its CRC fails
+    data_file.write_bytes(bytes(data))
+    with caplog.at_level(logging.WARNING):
+        poses = read_tip_poses(drop)
+    assert 'no closing index' in caplog.text and 'lost' not in caplog.text
+    np.testing.assert_array_equal(poses.z, full.z)

@@ -11,7 +11,7 @@ import pytest
 from campaign.conftest import LOADS, truncate_bag
 from lumpbeam_ros.campaign.engine import run_campaign, run_serial
 from lumpbeam_ros.campaign.store import ResultsStore
-from lumpbeam_ros.campaign.task import CampaignSettings
+from lumpbeam_ros.campaign.task import CampaignOptions
 from lumpbeam_ros.cli.main import main
 from lumpbeam_ros.ident.settings import load_identifier_config
 from lumpbeam_ros.model.parameters import load_beam_config
@@ -20,7 +20,7 @@ from lumpbeam_ros.model.parameters import load_beam_config
 @pytest.fixture(scope='module')
 def settings():
     beam, _ = load_beam_config()
-    return CampaignSettings(beam, load_identifier_config())
+    return CampaignOptions(beam, load_identifier_config())
 
 
 @pytest.fixture

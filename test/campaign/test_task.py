@@ -11,7 +11,7 @@ from lumpbeam_ros.campaign.bags import fingerprint
 from lumpbeam_ros.campaign.task import (
     ID_COLUMNS,
     SCHEMA_VERSION,
-    CampaignSettings,
+    CampaignOptions,
     error_line,
     flatten,
     process_bag,
@@ -39,7 +39,7 @@ def _strict_json(text):
 @pytest.fixture(scope='module')
 def settings():
     beam, _ = load_beam_config()
-    return CampaignSettings(beam, load_identifier_config())
+    return CampaignOptions(beam, load_identifier_config())
 
 
 # -- flatten ---------------------------------------------------------------------------------
@@ -95,7 +95,7 @@ def test_flatten_prefixes_every_column():
 def test_the_settings_digest_is_stable_and_names_every_setting(settings):
     digest = settings.digest()
     assert re.fullmatch('[0-9a-f]{16}', digest)
-    assert CampaignSettings(settings.beam, settings.identifier).digest() == digest
+    assert CampaignOptions(settings.beam, settings.identifier).digest() == digest
     changed = [
         replace(settings, diagnose=True),
         replace(settings, beam=replace(settings.beam, length_m=settings.beam.length_m * 1.01)),

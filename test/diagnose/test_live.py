@@ -14,7 +14,7 @@ from lumpbeam_ros.diagnose.live import (
     WARN,
     LiveBuffer,
     LiveDiagnosis,
-    LiveSettings,
+    LiveDiagnosisConfig,
     Stretch,
     diagnose_live,
     named_effects,
@@ -54,7 +54,7 @@ def _filled(settings, t, z, pitch, loads=((0.0, 4.5), (RELEASE_S, 0.0)), found=N
 
 def test_a_ring_down_is_complete_after_decay_s_and_handed_out_once():
     _, drop, t, z, pitch = _stream()
-    settings = LiveSettings(pre_release_s=1.0, decay_s=2.3)
+    settings = LiveDiagnosisConfig(pre_release_s=1.0, decay_s=2.3)
     early = t < RELEASE_S + 2.0
     buffer = _filled(settings, t[early], z[early], pitch[early])
     assert buffer.next_stretch() is None  # the decay has lasted 2 s only
@@ -73,16 +73,16 @@ def test_a_ring_down_ends_early_once_the_swing_is_small():
     _, _, t, z, pitch = _stream(duration_s=6.0)
     # Above the whole swing: complete as soon as enough poses follow the release.
     found = []
-    _filled(LiveSettings(decay_s=60.0, min_amplitude_m=0.5), t, z, pitch, found=found)
+    _filled(LiveDiagnosisConfig(decay_s=60.0, min_amplitude_m=0.5), t, z, pitch, found=found)
     assert len(found) == 1 and 2.0 <= found[0].end_s - RELEASE_S < 2.1
     never = []
-    _filled(LiveSettings(decay_s=60.0, min_amplitude_m=1e-6), t, z, pitch, found=never)
+    _filled(LiveDiagnosisConfig(decay_s=60.0, min_amplitude_m=1e-6), t, z, pitch, found=never)
     assert never == []
 
 
 def test_a_window_without_a_release_is_refused_with_a_reason():
     _, _, t, z, pitch = _stream()
-    buffer = _filled(LiveSettings(trigger='window', window_s=1.5), t, z, pitch)
+    buffer = _filled(LiveDiagnosisConfig(trigger='window', window_s=1.5), t, z, pitch)
     stretch = buffer.next_stretch()
     assert stretch.start_s == t[0] and math.isnan(stretch.release_s)
     with pytest.raises(LumpbeamError, match='no load change between'):
@@ -92,7 +92,7 @@ def test_a_window_without_a_release_is_refused_with_a_reason():
 
 
 def test_missing_input_names_what_is_missing():
-    buffer = LiveBuffer(LiveSettings())
+    buffer = LiveBuffer(LiveDiagnosisConfig())
     assert buffer.missing_input().startswith('/tip_pose: no measured pose received yet')
     buffer.push_predicted(1.0, 0.0, 0.0)
     assert 'only /tip_pose_predicted arrives' in buffer.missing_input()
@@ -103,7 +103,7 @@ def test_missing_input_names_what_is_missing():
 
 
 def test_prediction_gap_is_the_rms_of_measured_minus_predicted():
-    buffer = LiveBuffer(LiveSettings())
+    buffer = LiveBuffer(LiveDiagnosisConfig())
     t = np.arange(0.0, 3.0, 1 / 180)
     for ti in t:
         buffer.push_measured(ti, 1e-3 * math.sin(10 * ti), 0.0)
@@ -170,7 +170,7 @@ def test_named_effects_reads_a_list_or_the_single_effect():
 
 def test_diagnose_live_names_a_hidden_latency_on_a_short_ring_down():
     beam, _, t, z, pitch = _stream(effects={'sensor_latency': 0.015})
-    buffer = _filled(LiveSettings(decay_s=2.3), t, z, pitch)
+    buffer = _filled(LiveDiagnosisConfig(decay_s=2.3), t, z, pitch)
     stretch = buffer.next_stretch()
     result = diagnose_live(buffer.record(stretch), beam, stretch)
     assert result.missing_effect == 'sensor_latency'
@@ -190,7 +190,7 @@ def test_a_stretch_with_many_poses_dropped_is_never_ok(name, level):
 
 def test_late_and_repeated_poses_are_counted_in_the_stretch_record():
     _, _, t, z, pitch = _stream()
-    buffer = LiveBuffer(LiveSettings(pre_release_s=1.0, decay_s=2.3))
+    buffer = LiveBuffer(LiveDiagnosisConfig(pre_release_s=1.0, decay_s=2.3))
     buffer.push_load(0.0, 4.5)
     for ti, zi, pi in zip(t, z, pitch, strict=True):
         if ti >= RELEASE_S and buffer.loads[-1][1] != 0.0:

@@ -66,7 +66,7 @@ def test_roundtrip(tmp_path):
         ('beam:\n      length_m: .nan', 'beam.length_m', 'finite'),
         ('beam:\n      lenght_m: 2.0', 'beam.lenght_m', 'unknown key'),
         ('tip:\n      placement: middle', 'tip.placement', 'must be one of'),
-        ('tip:\n      mass_kg: -2.5', 'tip.mass_kg', 'must not be negative'),
+        ('tip:\n      mass_kg: -2.5', 'tip.mass_kg', 'must be non-negative'),
         (
             'effects:\n      sensor_scale:\n        scale: 0.0',
             'effects.sensor_scale.scale',

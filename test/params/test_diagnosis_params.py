@@ -3,11 +3,11 @@ import typing
 
 import pytest
 
-from lumpbeam_ros.diagnose.live import LiveSettings, Trigger
+from lumpbeam_ros.diagnose.live import LiveDiagnosisConfig, Trigger
 from lumpbeam_ros.interface import DIAGNOSIS_NODE, SIMULATOR_NODE
 from lumpbeam_ros.params.diagnosis_params import DIAGNOSIS_SCHEMA
 
-#: The node's parameter of each field of LiveSettings (nodes/diagnosis_node.py builds it so).
+#: The node's parameter of each LiveDiagnosisConfig field (nodes/diagnosis_node.py builds it so).
 LIVE_PARAMETERS = {
     'trigger': 'trigger',
     'pre_release_s': 'ring_down.pre_release_s',
@@ -20,10 +20,13 @@ LIVE_PARAMETERS = {
 
 def test_the_live_settings_defaults_are_the_schemas():
     # Every parameter is a field; max_rate_hz sizes the buffers and is not a parameter.
-    fields = {f.name for f in dataclasses.fields(LiveSettings)}
+    fields = {f.name for f in dataclasses.fields(LiveDiagnosisConfig)}
     assert fields - set(LIVE_PARAMETERS) == {'max_rate_hz'}
     defaults = DIAGNOSIS_SCHEMA.defaults()
-    assert LiveSettings(**{f: defaults[p] for f, p in LIVE_PARAMETERS.items()}) == LiveSettings()
+    assert (
+        LiveDiagnosisConfig(**{f: defaults[p] for f, p in LIVE_PARAMETERS.items()})
+        == LiveDiagnosisConfig()
+    )
 
 
 def test_the_triggers_are_the_live_buffers():
