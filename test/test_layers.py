@@ -82,6 +82,7 @@ REFUSED: dict[str, frozenset[str]] = {
 LAB_REFUSED: dict[str, frozenset[str]] = {
     'lumpbeam_lab.camera': frozenset({ROS, MATPLOTLIB}),
     'lumpbeam_lab.doctor': frozenset({ROS, OPENCV, MATPLOTLIB}),
+    'lumpbeam_lab.mujoco_arm': frozenset({ROS, OPENCV, MATPLOTLIB}),
 }
 
 

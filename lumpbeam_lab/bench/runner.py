@@ -21,6 +21,7 @@ SUITES = (
     'cli',
     'live_graph',
     'shaping',
+    'arm',
 )
 
 

@@ -4,18 +4,26 @@ The arm starts at rest in its static equilibrium at the motion's first angles an
 
     M(phi) phi'' + S(phi) phi'^2 + K phi + C phi' = g G cos phi + D^T (k o(q) + c o(q')),
 
-(:class:`~lumpbeam_ros.model.chain.LumpedChain`, :mod:`lumpbeam_ros.arm.model`), written in
-the angles and a momentum-like variable (:class:`_MomentumForm`) so that the joint rates, which
-jump at every sample of a trajectory file, drop out of the right-hand side. The springs between
-short segments make the chain stiff (its fastest modes are hundreds of times faster than the
-first), so it is integrated by ``scipy.integrate.solve_ivp(method='LSODA')``, which switches to
-BDF when the fast modes dominate, given the Jacobian of the forces (springs, gravity, dampers,
-the velocity terms; the change of ``M`` with ``phi`` in ``phi'`` left out, which only slows its
-Newton iterations). A trajectory of few samples (a few-row file's corners) is integrated
-sample to sample, so no step straddles a corner; a dense one (smooth motion sampled at 1 kHz)
-is followed through the cubic spline of its samples (:meth:`SampledMotion.spline`), whose
-rates are continuous: stepping onto a thousand rate jumps a second costs the integrator 20 to
-80 times more than the motion itself.
+(:class:`~lumpbeam_ros.model.chain.LumpedChain`, :mod:`lumpbeam_ros.arm.model`).
+
+Two integrators. The default (``method='modal'``) follows the small deflections about the
+rigid motion the joints prescribe (:mod:`lumpbeam_ros.arm.ltv`): the springs' linear part
+exactly in modal coordinates, linearized afresh as the joints turn, the rest by waveform
+relaxation on a 1 ms grid while the joints move and a 5 ms grid once they stop; it is about
+a hundred times faster than integrating B.16 step by step and agrees with a tight reference to
+a few hundredths of a micrometre (doc/arm.md, ``lumpbeam bench --only arm``). The other
+(``method='lsoda'``, the reference, and the fallback when the deflections are too large for
+the first) integrates B.16 in the angles and a momentum-like variable (:class:`_MomentumForm`)
+so that the joint rates, which jump at every sample of a trajectory file, drop out of the
+right-hand side, with ``scipy.integrate.solve_ivp(method='LSODA')`` and the Jacobian of the
+forces (springs, gravity, dampers, the velocity terms; the change of ``M`` with ``phi`` in
+``phi'`` left out, which only slows its Newton iterations).
+
+Either way, a trajectory of few samples (a few-row file's corners) is integrated sample to
+sample, so no step straddles a corner; a dense one (smooth motion sampled at 1 kHz) is
+followed through the cubic spline of its samples (:meth:`SampledMotion.spline`), whose rates
+are continuous: stepping onto a thousand rate jumps a second costs an integrator 20 to 80 times
+more than the motion itself.
 """
 
 from __future__ import annotations
@@ -27,8 +35,10 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicHermiteSpline
 
 from lumpbeam_ros.arm.drive import JointMotion, SampledMotion
+from lumpbeam_ros.arm.ltv import DeflectionSolver, RigidMotion
 from lumpbeam_ros.arm.model import ArmModel
 from lumpbeam_ros.arm.statics import arm_equilibrium
+from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.integrate import ChainState, ModalSolver
 from lumpbeam_ros.model.modes import LinearModel
@@ -37,7 +47,18 @@ from lumpbeam_ros.model.modes import LinearModel
 #: the span (a few-row trajectory's corners); denser ones are integrated straight through.
 MAX_RESTARTS = 200
 
-#: Grid of the modal ring-down, s. The solver samples the nonlinear remainder with a
+#: The modal method's grid while the joints move, s, and its relaxation window in steps. The
+#: first-order hold's error falls as the step squared: 2 ms gives 0.23 um on the bench's
+#: three-link arm, 1 ms 0.04 um, 0.5 ms 0.01 um.
+MOVE_STEP_S = 1e-3
+MOVE_WINDOW = 128
+
+#: The modal method's grid once the joints have stopped, s, and its window in steps: free
+#: vibration about one configuration, whose remainder is small (5 ms adds 0.01 um to 2 ms).
+HELD_STEP_S = 5e-3
+HELD_WINDOW = 1024
+
+#: Grid of the LSODA method's modal ring-down, s. The solver samples the nonlinear remainder with a
 #: first-order hold, so its error falls as the step squared: at 0.5 ms a three-link arm's
 #: ring-down agrees with integrating on to 0.1 um (1/180 s, the beam's grid, gives 8 um).
 RING_DOWN_STEP_S = 5e-4
@@ -55,6 +76,7 @@ class ArmMotion:
         tip_x: x of the last link's free end in beam_base, m.
         tip_z: z of it, m.
         tip_pitch: Its pitch (the last segment's angle), rad.
+        method: Which integrator produced it: ``'modal'`` or ``'lsoda'``.
     """
 
     t: np.ndarray
@@ -64,6 +86,7 @@ class ArmMotion:
     tip_x: np.ndarray
     tip_z: np.ndarray
     tip_pitch: np.ndarray
+    method: str = 'modal'
 
 
 class _MomentumForm:
@@ -118,7 +141,13 @@ class _MomentumForm:
         return np.concatenate([phi, mass @ phi_dot + self.c @ phi - damper])
 
     def rhs(self, t: float, y: np.ndarray) -> np.ndarray:
-        """``[phi', w']``."""
+        """``[phi', w']``; NaN for a non-finite state.
+
+        An adaptive integrator may try a step that overflows; the NaN it gets back makes it
+        retry smaller, where evaluating the forces of a NaN state would only warn.
+        """
+        if not np.all(np.isfinite(y)):
+            return np.full_like(y, np.nan)
         phi, w = y[: self.n], y[self.n :]
         phi_dot, _, sin, spring = self.rates(t, phi, w)
         d_t = -phi_dot * ((self.a * sin) @ phi_dot)
@@ -126,7 +155,9 @@ class _MomentumForm:
         return np.concatenate([phi_dot, w_dot])
 
     def jacobian(self, t: float, y: np.ndarray) -> np.ndarray:
-        """Of :meth:`rhs`, leaving out the change of ``M`` with ``phi`` in ``phi'``."""
+        """Of :meth:`rhs`, leaving out the change of ``M`` with ``phi`` in ``phi'``; NaN too."""
+        if not np.all(np.isfinite(y)):
+            return np.full((y.size, y.size), np.nan)
         phi, w = y[: self.n], y[self.n :]
         phi_dot, mass, sin, _ = self.rates(t, phi, w)
         m_inv = np.linalg.inv(mass)
@@ -150,6 +181,7 @@ def simulate_arm(
     rtol: float = 1e-8,
     atol: float = 1e-10,
     modal_ring_down: bool = True,
+    method: str = 'modal',
 ) -> ArmMotion:
     """Moves the arm along ``motion`` from rest, sampled at ``t_eval``.
 
@@ -158,20 +190,21 @@ def simulate_arm(
         motion: The joints' prescribed angles and rates.
         t_eval: Output times, increasing; the arm is at rest in its static equilibrium at
             ``motion.angles(t_eval[0])`` at the first.
-        rtol: Relative tolerance of the integrator.
-        atol: Absolute tolerance, rad and rad/s.
-        modal_ring_down: After the motion's end, propagate the free vibration about the
-            final equilibrium with the beam's modal solver
-            (:class:`~lumpbeam_ros.model.integrate.ModalSolver`, exact for the linear part,
-            waveform relaxation for the rest) instead of integrating on; it falls back to
-            integrating when the vibration is too large for it.
+        rtol: Relative tolerance of the LSODA method.
+        atol: Its absolute tolerance, rad and rad/s.
+        modal_ring_down: With the LSODA method, propagate the free vibration after the
+            motion's end with the beam's modal solver
+            (:class:`~lumpbeam_ros.model.integrate.ModalSolver`) instead of integrating on.
+        method: ``'modal'`` (the deflections about the rigid motion,
+            :mod:`lumpbeam_ros.arm.ltv`; falls back to LSODA when they are too large for it)
+            or ``'lsoda'`` (B.16 integrated step by step, the reference).
 
     Returns:
         The motion at ``t_eval``.
 
     Raises:
         LumpbeamError: The motion has the wrong number of joints, the times do not increase,
-            or the integrator failed.
+            an unknown method, or the integrator failed.
     """
     t_eval = np.asarray(t_eval, dtype=float)
     if t_eval.ndim != 1 or t_eval.size == 0 or np.any(np.diff(t_eval) <= 0.0):
@@ -180,13 +213,92 @@ def simulate_arm(
         raise LumpbeamError(
             f'arm simulation: the arm has {model.n_joints} joints, the motion {motion.n_joints}'
         )
-    n = model.chain.n
+    if method not in ('modal', 'lsoda'):
+        raise LumpbeamError(f'arm simulation: unknown method {method!r} (modal or lsoda)')
     t0, t1 = float(t_eval[0]), float(t_eval[-1])
     knots = motion.knots[(motion.knots > t0) & (motion.knots < t1)]
     drive = motion
     if knots.size > MAX_RESTARTS and isinstance(motion, SampledMotion):
         drive = motion.spline()
         knots = drive.knots[(drive.knots > t0) & (drive.knots < t1)]
+    if method == 'modal':
+        with single_threaded_blas():
+            modal = _simulate_modal(model, drive, knots, t_eval)
+        if modal is not None:
+            phi, phi_dot = modal
+            x, z, pitch = model.chain.tip_pose(phi)
+            q = motion.sample(t_eval)[0]
+            return ArmMotion(t_eval, q, phi, phi_dot, x, z, pitch)
+    return _simulate_lsoda(model, motion, drive, knots, t_eval, rtol, atol, modal_ring_down)
+
+
+def _simulate_modal(
+    model: ArmModel, drive: JointMotion, knots: np.ndarray, t_eval: np.ndarray
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """``(phi, phi_dot)`` at ``t_eval`` by :class:`~lumpbeam_ros.arm.ltv.DeflectionSolver`.
+
+    The span is cut at the knots (where the rigid rates jump, the deflection rates jump the
+    other way: ``phi'`` is continuous) and where the motion ends; each piece gets a uniform
+    grid, fine while the joints move, coarse once they are held.
+
+    Returns:
+        ``None`` when the deflections are too large for the solver.
+    """
+    t0, t1 = float(t_eval[0]), float(t_eval[-1])
+    end = min(max(t0, drive.end_time), t1)
+    bounds = np.unique(np.concatenate([[t0], knots[knots < end], [end, t1]]))
+    starts = model.link_starts
+
+    def joint_angles(phi: np.ndarray) -> np.ndarray:
+        return np.asarray(np.diff(phi, axis=-1, prepend=0.0)[..., starts])
+
+    solver = DeflectionSolver(model.chain, joint_angles)
+    q0 = drive.sample(np.array([t0]))[0][0]
+    r0 = model.rigid_angles(q0)
+    d = arm_equilibrium(model, q0) - r0
+    grid_t, grid_phi, grid_rate = [np.array([t0])], [d + r0], [np.zeros_like(d)]
+    for start, stop in zip(bounds[:-1], bounds[1:], strict=True):
+        moving = start < end
+        h_max, window = (MOVE_STEP_S, MOVE_WINDOW) if moving else (HELD_STEP_S, HELD_WINDOW)
+        steps = max(1, int(np.ceil((stop - start) / h_max - 1e-9)))
+        times = np.linspace(start, stop, steps + 1)
+        # Rates and accelerations of the piece itself at its ends, not of its neighbours.
+        inside = np.clip(times, start + 1e-9 * (stop - start), stop - 1e-9 * (stop - start))
+        q, _, _ = drive.sample(times)
+        _, q_dot, q_ddot = drive.sample(inside)
+        rigid = RigidMotion(
+            model.rigid_angles(q), model.rigid_angles(q_dot), model.rigid_angles(q_ddot)
+        )
+        # phi' carries over a knot (and is 0 at the start), so d' takes up the rigid rates'.
+        d_dot = grid_rate[-1][-1] - rigid.r_dot[0]
+        solved = solver.solve(d, d_dot, rigid, (stop - start) / steps, window)
+        if solved is None:
+            return None
+        deflection, deflection_rate = solved
+        grid_t.append(times[1:])
+        grid_phi.append((rigid.r + deflection)[1:])
+        grid_rate.append((rigid.r_dot + deflection_rate)[1:])
+        d, d_dot = deflection[-1], deflection_rate[-1]
+    t = np.concatenate(grid_t)
+    if t.size < 2:
+        return np.vstack(grid_phi), np.vstack(grid_rate)
+    spline = CubicHermiteSpline(t, np.vstack(grid_phi), np.vstack(grid_rate), axis=0)
+    return spline(t_eval), spline(t_eval, 1)
+
+
+def _simulate_lsoda(
+    model: ArmModel,
+    motion: JointMotion,
+    drive: JointMotion,
+    knots: np.ndarray,
+    t_eval: np.ndarray,
+    rtol: float,
+    atol: float,
+    modal_ring_down: bool,
+) -> ArmMotion:
+    """:func:`simulate_arm` by LSODA (and the modal ring-down when asked)."""
+    n = model.chain.n
+    t0, t1 = float(t_eval[0]), float(t_eval[-1])
     form = _MomentumForm(model, drive)
     y = form.state_from(t0, arm_equilibrium(model, drive.angles(t0)), np.zeros(n))
     # After the motion stops the arm rings down about one equilibrium: the modal solver's job.
@@ -194,7 +306,7 @@ def simulate_arm(
     moving_end = min(t1, ring_start)
     knots = knots[knots < moving_end]
     bounds = [t0, *(knots if knots.size <= MAX_RESTARTS else []), moving_end]
-    states = np.empty((t_eval.size, 2 * n))
+    states = np.full((t_eval.size, 2 * n), np.nan)
     states[0] = y
     for start, end in zip(bounds[:-1], bounds[1:], strict=True):
         if end <= start:
@@ -218,10 +330,12 @@ def simulate_arm(
         states[inside] = result.y.T[: int(inside.sum())]
         y = result.y[:, -1]
     phi = states[:, :n]
-    phi_dot = np.array(
-        [form.rates(t, p, w)[0] for t, p, w in zip(t_eval, phi, states[:, n:], strict=True)]
-    )
     tail = t_eval > ring_start
+    phi_dot = np.full_like(phi, np.nan)
+    phi_dot[~tail] = [
+        form.rates(t, p, w)[0]
+        for t, p, w in zip(t_eval[~tail], phi[~tail], states[~tail, n:], strict=True)
+    ]
     if np.any(tail):
         start_state = ChainState(y[:n], form.rates(ring_start, y[:n], y[n:])[0])
         q_end = drive.angles(ring_start)
@@ -247,8 +361,7 @@ def simulate_arm(
             rung = tail_phi, np.array(tail_rates)
         phi[tail], phi_dot[tail] = rung
     x, z, pitch = model.chain.tip_pose(phi)
-    q = np.array([motion.angles(t) for t in t_eval])
-    return ArmMotion(t_eval, q, phi, phi_dot, x, z, pitch)
+    return ArmMotion(t_eval, motion.sample(t_eval)[0], phi, phi_dot, x, z, pitch, 'lsoda')
 
 
 def _ring_down(

@@ -72,6 +72,21 @@ class ChainSolution:
         return ChainState(self.phi[-1].copy(), self.phi_dot[-1].copy())
 
 
+def hold_weights(lam: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``e^{lam h}`` and the first-order-hold weights ``h phi1(lam h)``, ``h phi2(lam h)``.
+
+    The exact response of ``z' = lam z + u`` to a ``u`` linear over a step of ``h`` is
+    ``z_{k+1} = e^{lam h} z_k + h (phi1 - phi2) u_k + h phi2 u_{k+1}``.
+    """
+    lam_h = lam * h
+    e = np.exp(lam_h)
+    small = np.abs(lam_h) < 1e-4
+    safe = np.where(small, 1.0, lam_h)
+    phi1 = np.where(small, 1.0 + lam_h / 2.0, np.expm1(lam_h) / safe)
+    phi2 = np.where(small, 0.5 + lam_h / 6.0, (e - 1.0 - lam_h) / safe**2)
+    return e, h * phi1, h * phi2
+
+
 class ModalSolver:
     """The exact first-order-hold propagator of one linearised chain.
 
@@ -122,13 +137,7 @@ class ModalSolver:
 
     def _coefficients(self, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``e^{lam h}`` and the first-order-hold weights ``h phi1``, ``h phi2``."""
-        lam_h = self._lam * h
-        e = np.exp(lam_h)
-        small = np.abs(lam_h) < 1e-4
-        safe = np.where(small, 1.0, lam_h)
-        phi1 = np.where(small, 1.0 + lam_h / 2.0, np.expm1(lam_h) / safe)
-        phi2 = np.where(small, 0.5 + lam_h / 6.0, (e - 1.0 - lam_h) / safe**2)
-        return e, h * phi1, h * phi2
+        return hold_weights(self._lam, h)
 
     def _propagate(self, z0: np.ndarray, forcing: np.ndarray, h: float) -> np.ndarray:
         """Runs every modal recurrence over a grid of spacing ``h``.
@@ -219,13 +228,16 @@ class ModalSolver:
             phi = d + phi_eq
             # r: everything B.16 has beyond its linearisation (see the module docstring).
             # The equilibrium's own forces cancel, leaving the linear model's -K_eff d - C d'.
-            inertial_excess = chain.inertial_forces(phi, d_ddot) - d_ddot @ self.linear.mass
-            linear_force = -d @ self.linear.stiffness - d_dot @ self.linear.damping
-            forcing = (
-                chain.generalized_forces(phi, d_dot, friction=False)
-                - linear_force
-                - inertial_excess
-            )
+            # A diverging sweep's large but finite angles may overflow here: the next
+            # sweep's check refuses them.
+            with np.errstate(over='ignore', invalid='ignore'):
+                inertial_excess = chain.inertial_forces(phi, d_ddot) - d_ddot @ self.linear.mass
+                linear_force = -d @ self.linear.stiffness - d_dot @ self.linear.damping
+                forcing = (
+                    chain.generalized_forces(phi, d_dot, friction=False)
+                    - linear_force
+                    - inertial_excess
+                )
         return None
 
 

@@ -1,6 +1,6 @@
 """The arm against MuJoCo: statics, modal frequencies and tip trajectories in motion.
 
-MuJoCo (test/arm/mujoco_arm.py) builds the same segments as bodies on hinges in relative
+MuJoCo (lumpbeam_lab/mujoco_arm.py) builds the same segments as bodies on hinges in relative
 coordinates and computes its own mass matrix, bias forces and gravity; it shares with the
 arm only the physical description (lengths, masses, springs, dampers, the ideal servo).
 
@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from arm.arm_cases import small_arm, smooth_move
-from arm.mujoco_arm import MujocoArm
+from lumpbeam_lab.mujoco_arm import MujocoArm
 from lumpbeam_ros.arm.model import ArmModel
 from lumpbeam_ros.arm.simulate import simulate_arm
 from lumpbeam_ros.arm.statics import arm_equilibrium, arm_modes

@@ -5,7 +5,7 @@ with ZV, ZVD or EI designed for the modes the arm's linearization gives at the m
 angles (:func:`~lumpbeam_ros.arm.statics.arm_modes`), at the exact frequency or 15 % off.
 Unshaped and shaped moves are simulated by the arm's model
 (:func:`~lumpbeam_ros.arm.simulate.simulate_arm`) and by the independent MuJoCo model of the
-arm's tests (test/arm/mujoco_arm.py: its own bodies, hinges, mass matrix and RK4), each
+arm's tests (lumpbeam_lab/mujoco_arm.py: its own bodies, hinges, mass matrix and RK4), each
 driven by the same spline of the samples. The residual vibration is the RMS of the tip's
 distance from its final rest (each model's own static equilibrium) over the 3 s after the
 move ends (the shaped move ends later, by the shaper's duration).
@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from arm.mujoco_arm import MujocoArm
+from lumpbeam_lab.mujoco_arm import MujocoArm
 from scipy.interpolate import CubicSpline
 
 from lumpbeam_ros.arm.config import ArmConfig, load_arm_config

@@ -1,0 +1,54 @@
+"""The deflection solver: its scan, rest stays rest, a violent motion refused quietly."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from arm.arm_cases import small_arm
+from lumpbeam_ros.arm.ltv import DeflectionSolver, RigidMotion, _scan
+from lumpbeam_ros.arm.model import ArmModel
+from lumpbeam_ros.arm.statics import arm_equilibrium
+
+
+def _joint_angles(model):
+    return lambda phi: np.diff(phi, axis=-1, prepend=0.0)[..., model.link_starts]
+
+
+def test_the_doubling_scan_is_the_recurrence():
+    rng = np.random.default_rng(3)
+    e = np.array([0.999 * np.exp(0.3j), 0.7 * np.exp(2j), 0.01, 1e-30])
+    g = rng.normal(size=(37, 4)) + 1j * rng.normal(size=(37, 4))
+    z = np.empty_like(g)
+    z[0] = g[0]
+    for k in range(1, 37):
+        z[k] = e * z[k - 1] + g[k]
+    assert _scan(g, e) == pytest.approx(z, abs=1e-13)
+
+
+def test_an_arm_held_at_rest_stays_there():
+    model = ArmModel.from_config(small_arm(3))
+    q = np.array([0.3, -0.8, 0.5])
+    rest = arm_equilibrium(model, q)
+    rigid_angles = model.rigid_angles(q)
+    steps = 300
+    rigid = RigidMotion(
+        np.tile(rigid_angles, (steps, 1)), np.zeros((steps, 10)), np.zeros((steps, 10))
+    )
+    solver = DeflectionSolver(model.chain, _joint_angles(model))
+    d, d_dot = solver.solve(rest - rigid_angles, np.zeros(10), rigid, 1e-3, 128)
+    assert d == pytest.approx(np.tile(rest - rigid_angles, (steps, 1)), abs=1e-10)
+    assert np.abs(d_dot).max() < 1e-8
+    assert solver.frames == 1
+
+
+def test_a_motion_too_violent_for_small_deflections_is_refused_without_warnings():
+    model = ArmModel.from_config(small_arm(1))
+    steps = 200
+    t = np.arange(steps)[:, None] * 1e-3
+    # The joint whipped at 1e5 rad/s^2: deflections of radians, beyond any linearization.
+    rigid = RigidMotion(5e4 * t**2 * np.ones(4), 1e5 * t * np.ones(4), np.full((steps, 4), 1e5))
+    solver = DeflectionSolver(model.chain, _joint_angles(model))
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        assert solver.solve(np.zeros(4), np.zeros(4), rigid, 1e-3, 64) is None
