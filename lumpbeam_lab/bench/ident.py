@@ -17,6 +17,8 @@ from __future__ import annotations
 import math
 import tempfile
 import time
+from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -279,6 +281,50 @@ def _fill(
     return time.perf_counter() - start
 
 
+def _modes(quick: bool) -> BenchResult:
+    """Several modes against one: the same 12 s window of a drop test with a visible mode 2.
+
+    The beam carries a 0.5 kg tip body (the paper's 2.5 kg hides mode 2 under the noise), so
+    the multi-mode search finds and fits mode 2 (38.7 Hz) and then refuses a third; the
+    baseline is the same identification held to one mode (``fit.max_modes`` 1).
+    """
+    beam = replace(BeamParameters(), tip_mass_kg=0.5)
+    drop = DropTestConfig(LOAD_KG, 2.0, 12.0)
+    exact = simulate_drop_test(beam, drop, RATE_HZ)
+    z = exact.z + np.random.default_rng(0).normal(0.0, NOISE_M, len(exact))
+    loads = clean_loads(np.array([0.0, drop.release_time_s]), np.array([LOAD_KG, 0.0]))
+    window = clean_window(exact.t, z, exact.pitch, loads)
+    several, one = IdentifierConfig(max_fit_s=12.0), IdentifierConfig(max_fit_s=12.0, max_modes=1)
+    # CPU time, interleaved, the best of many: on a shared machine a process waits for a core
+    # for longer than it computes, and a burst of load then hits both sides alike.
+    multi_s = single_s = math.inf
+    result = identify(window, beam, several, strict=True)
+    for _ in range(5 if quick else 25):
+        multi_s = min(multi_s, _cpu_time(lambda: identify(window, beam, several, strict=True)))
+        single_s = min(single_s, _cpu_time(lambda: identify(window, beam, one, strict=True)))
+    return BenchResult(
+        name='ident_modes_12s_window',
+        value=1e3 * multi_s,
+        unit='ms CPU',
+        baseline='the same identification held to one mode (fit.max_modes 1)',
+        baseline_value=1e3 * single_s,
+        ratio=multi_s / single_s,
+        details={
+            'samples': len(window),
+            'modes_found': len(result.modes),
+            'mode_frequencies_hz': [m.natural_frequency_hz.value for m in result.modes],
+            'target_ratio_at_most': 2.0,
+        },
+    )
+
+
+def _cpu_time(function: Callable[[], object]) -> float:
+    """The CPU time of one call, s (this process's, whatever else the machine runs)."""
+    start = time.process_time()
+    function()
+    return time.process_time() - start
+
+
 def run(quick: bool = False) -> list[BenchResult]:
     """Runs the identifier benchmarks.
 
@@ -290,4 +336,9 @@ def run(quick: bool = False) -> list[BenchResult]:
     """
     beam = BeamParameters()
     truth = model_truth(beam)
-    return [_analyze(quick, beam), _batch(quick, beam, truth), _live(quick, beam, truth)]
+    return [
+        _analyze(quick, beam),
+        _batch(quick, beam, truth),
+        _live(quick, beam, truth),
+        _modes(quick),
+    ]

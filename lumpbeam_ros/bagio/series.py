@@ -21,6 +21,8 @@ from lumpbeam_ros.interface import (
     BEAM_PARAMS,
     CAMERA_INFO,
     IMAGE,
+    JOINT_STATE_TYPE,
+    JOINT_STATES,
     POINT_STAMPED,
     POSE_STAMPED,
     TIP_LOAD,
@@ -232,3 +234,42 @@ def read_diagnostics(
     ]
     out.sort(key=lambda item: item[0])
     return out
+
+
+class JointSeries(NamedTuple):
+    """Joint angles (``/joint_states``): stamps ``t`` (s), ``angles`` (len(t), joints), names."""
+
+    t: np.ndarray
+    angles: np.ndarray
+    names: tuple[str, ...]
+
+
+def read_joint_states(bag: Bag, topic: str = JOINT_STATES) -> JointSeries:
+    """Reads a ``sensor_msgs/JointState`` topic's positions, sorted by stamp.
+
+    Raises:
+        BagError: Missing topic, another type, no message, or messages that name other
+            joints than the first one (a message that does not decode is skipped and
+            counted).
+    """
+    reader = open_bag(bag)
+    reader.require(topic, JOINT_STATE_TYPE)
+    stamps: list[float] = []
+    rows: list[np.ndarray] = []
+    names: tuple[str, ...] | None = None
+    for _, msg in reader.messages(topic, JOINT_STATE_TYPE):
+        ns, joint_names, positions = convert.joint_state_values(msg)
+        if names is None:
+            names = tuple(joint_names)
+        if tuple(joint_names) != names or positions.size != len(names):
+            raise BagError(
+                f'{reader.path}: {topic} names joints {joint_names} with {positions.size} '
+                f'positions after {list(names)}'
+            )
+        stamps.append(convert.ns_to_seconds(ns))
+        rows.append(positions)
+    if names is None:
+        raise BagError(f'{reader.path}: topic {topic} has no message')
+    t = np.asarray(stamps)
+    order = np.argsort(t, kind='stable')
+    return JointSeries(t[order], np.asarray(rows, dtype=float)[order], names)

@@ -278,6 +278,18 @@ def add_analyze(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         '--identifier-config', help='identifier parameter file (default: config/identifier.yaml)'
     )
+    parser.add_argument(
+        '--max-modes',
+        metavar='N',
+        help='report at most N modes, each only when it stands out of the noise '
+        "(default: the identifier config's fit.max_modes, 3)",
+    )
+    parser.add_argument(
+        '--arm',
+        metavar='FILE',
+        help="an arm's bag (with /joint_states): the free vibration after the last move, "
+        'beside the modes of this arm file at the final joint angles',
+    )
     add_report(parser)
 
 

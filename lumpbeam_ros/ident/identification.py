@@ -158,6 +158,52 @@ class FitQuality:
     solver_evaluations: int = 0
 
 
+@dataclass(frozen=True)
+class IdentifiedMode:
+    """One damped mode of the free vibration: an entry of ``modes`` (doc/interfaces.md).
+
+    Attributes:
+        natural_frequency_hz: f_n = f_d / sqrt(1 - zeta^2), with its std.
+        damping_ratio: zeta, with its std.
+        amplitude_m: The mode's amplitude in the tip position at the start of the fit.
+    """
+
+    natural_frequency_hz: Estimate = UNKNOWN
+    damping_ratio: Estimate = UNKNOWN
+    amplitude_m: float = NAN
+
+    def as_dict(self) -> dict[str, float]:
+        """The mode as ``lumpbeam analyze`` lists it in ``modes``."""
+        return {
+            'natural_frequency_hz': self.natural_frequency_hz.value,
+            'natural_frequency_hz_std': self.natural_frequency_hz.std,
+            'damping_ratio': self.damping_ratio.value,
+            'damping_ratio_std': self.damping_ratio.std,
+            'amplitude_m': self.amplitude_m,
+        }
+
+
+#: The ``/beam_params`` key of the number of modes; mode k >= 2 is published under
+#: ``mode_<k>_`` + each key of :data:`MODE_KEYS` (and its ``_std``).
+MODE_COUNT_KEY = 'mode_count'
+MODE_KEYS = ('natural_frequency_hz', 'damping_ratio')
+
+
+def mode_key(k: int, key: str) -> str:
+    """The ``/beam_params`` key of mode ``k`` (1-based, k >= 2), e.g. ``mode_2_damping_ratio``."""
+    return f'mode_{k}_{key}'
+
+
+def _mode_pairs(modes: tuple[IdentifiedMode, ...]) -> Iterator[tuple[str, str]]:
+    """``mode_count`` and, for k >= 2, each mode's frequency and damping with their stds."""
+    yield MODE_COUNT_KEY, str(len(modes))
+    for k, mode in enumerate(modes[1:], start=2):
+        for key in MODE_KEYS:
+            estimate = getattr(mode, key)
+            yield mode_key(k, key), repr(float(estimate.value))
+            yield mode_key(k, f'{key}_std'), repr(float(estimate.std))
+
+
 def _flat(group: Any) -> Iterator[tuple[str, Any]]:
     """A group's ``(key, value)`` pairs in field order; an estimate gives two."""
     for f in fields(group):
@@ -169,10 +215,19 @@ def _flat(group: Any) -> Iterator[tuple[str, Any]]:
         elif isinstance(value, Estimate):
             yield key, value.value
             yield f'{key}_std', value.std
-        elif is_dataclass(value):
+        elif is_dataclass(value) and not isinstance(value, type):
             yield from _flat(value)
         else:
             yield key, value
+
+
+def _plain(value: Any) -> Any:
+    """A flat value as JSON wants it: a status by its name, the modes as a list."""
+    if isinstance(value, Status):
+        return value.name
+    if isinstance(value, tuple):
+        return [mode.as_dict() for mode in value]
+    return value
 
 
 @dataclass(frozen=True)
@@ -196,6 +251,9 @@ class Identification:
         quality: The fit's quality.
         samples: The window's samples: its poses kept and those dropped (published as
             ``n_samples`` and ``n_rejected``).
+        modes: Every mode separated from the noise, ordered by frequency (the first is the
+            one of :attr:`estimates`); ``modes`` in JSON, ``mode_count`` and ``mode_<k>_*``
+            on ``/beam_params``.
     """
 
     status: Status
@@ -207,6 +265,7 @@ class Identification:
     cross_checks: CrossCheckFigures = CrossCheckFigures()
     quality: FitQuality = FitQuality()
     samples: SampleCounts = SampleCounts()
+    modes: tuple[IdentifiedMode, ...] = ()
 
     @property
     def ok(self) -> bool:
@@ -216,11 +275,10 @@ class Identification:
     def as_dict(self) -> dict[str, Any]:
         """Returns every field by its key; ``status`` as its name (``'OK'``...).
 
-        NaN stays NaN (``lumpbeam_ros.cli.output.write_json`` turns it into null).
+        NaN stays NaN (``lumpbeam_ros.cli.output.write_json`` turns it into null);
+        ``modes`` is a list of :meth:`IdentifiedMode.as_dict`, ordered by frequency.
         """
-        return {
-            key: value.name if isinstance(value, Status) else value for key, value in _flat(self)
-        }
+        return {key: _plain(value) for key, value in _flat(self)}
 
     def figure(self, key: str) -> Estimate:
         """The figure published as ``key``, with its ``key_std`` (NaN when it has none).
@@ -246,11 +304,13 @@ class Identification:
         ``status`` and ``message`` are left out: they are the DiagnosticStatus's own level
         and message. Strings (``method``, ``release_source``) are given as they are.
         """
-        return [
-            (key, value if isinstance(value, str) else repr(float(value)))
-            for key, value in _flat(self)
-            if key not in ('status', 'message')
-        ]
+        pairs: list[tuple[str, str]] = []
+        for key, value in _flat(self):
+            if key == 'modes':
+                pairs.extend(_mode_pairs(value))
+            elif key not in ('status', 'message'):
+                pairs.append((key, value if isinstance(value, str) else repr(float(value))))
+        return pairs
 
     def summary(self) -> str:
         """A few human-readable lines for a terminal."""

@@ -26,11 +26,13 @@ from lumpbeam_ros.ident.identification import (
     Estimates,
     FitQuality,
     Identification,
+    IdentifiedMode,
     ReleaseFigures,
     Status,
 )
-from lumpbeam_ros.ident.logdec import LogDecrement, LogDecrementResult, difference_noise_std
+from lumpbeam_ros.ident.logdec import LogDecrement, LogDecrementResult
 from lumpbeam_ros.ident.mode_estimate import TWO_PI, ModeEstimate
+from lumpbeam_ros.ident.modes import choose_modes, structural_modes
 from lumpbeam_ros.ident.pencil import MatrixPencil
 from lumpbeam_ros.ident.release import Release, detect_release
 from lumpbeam_ros.ident.samples import PoseWindow
@@ -43,6 +45,9 @@ NAN = float('nan')
 METHOD = 'nls_damped_sinusoid'
 #: Grid points (after block averaging) the matrix pencil sees at most: 45 s at 90 Hz.
 _PENCIL_MAX_POINTS = 4096
+#: The starting pencil's order: the offset, two modes and a spare pair (further modes are
+#: looked for in what the fit leaves, :mod:`~lumpbeam_ros.ident.modes`).
+_PENCIL_ORDER = 7
 
 
 @dataclass(frozen=True)
@@ -111,6 +116,7 @@ def identify_from(
     *,
     strict: bool = False,
     previous: FitState | None = None,
+    release: Release | None = None,
 ) -> tuple[Identification, FitState | None]:
     """:func:`identify`, started from the state of an earlier, overlapping window.
 
@@ -127,6 +133,9 @@ def identify_from(
         config: As for :func:`identify`.
         strict: As for :func:`identify`.
         previous: The state the last call returned, or ``None``.
+        release: Where the free vibration starts when it is known otherwise, e.g. where an
+            arm's joints stopped (:func:`~lumpbeam_ros.ident.ring_down.ring_down_release`);
+            ``None``: the load release found in the window.
 
     Returns:
         The identification and the state for the next call (``None`` after an ERROR).
@@ -135,7 +144,7 @@ def identify_from(
         LumpbeamError: As for :func:`identify`.
     """
     with single_threaded_blas():
-        return _identify(window, beam, config or IdentifierConfig(), strict, previous)
+        return _identify(window, beam, config or IdentifierConfig(), strict, previous, release)
 
 
 def _identify(
@@ -144,6 +153,7 @@ def _identify(
     config: IdentifierConfig,
     strict: bool,
     previous: FitState | None,
+    given: Release | None = None,
 ) -> tuple[Identification, FitState | None]:
     span = AnalysedWindow(window.start_s, window.end_s)
     dropped = window.counts.dropped
@@ -164,7 +174,7 @@ def _identify(
             f'{len(window)} valid pose samples, need at least {config.min_samples}',
             unusable=True,
         )
-    release = detect_release(window, config)
+    release = detect_release(window, config) if given is None else given
     found = ReleaseFigures(
         time_s=Estimate(release.time_s), confidence=release.confidence, source=release.source
     )
@@ -185,15 +195,14 @@ def _identify(
         )
     state = _warm_fit(t, z, start, release, previous, config)
     if state is None:
-        noise = difference_noise_std(z)
-        guesses = _initial_modes(t, z, noise, config)
+        guesses = _initial_modes(t, z, config)
         if not guesses:
             return fail('no oscillation in the window', release=found)
         try:
             params = _fit_decay(t, z, guesses, start, config)
         except LumpbeamError as exc:
             return fail(f'no oscillation in the window ({exc})', release=found)
-        rejection = _reject_mode(params.mode(0), params, config)
+        rejection = _reject_mode(params.mode(lowest_mode(params)), params, config)
         if rejection:
             return fail(rejection, release=found)
         checks = CrossChecks(
@@ -202,7 +211,7 @@ def _identify(
             _pitch_stiffness(window, release, params, float(t[-1]), _load(release, config), beam),
         )
         state = FitState(release.time_s, params, checks, window.end_s)
-    mode = state.params.mode(0)
+    mode = state.params.mode(lowest_mode(state.params))
     rejection = _reject_mode(mode, state.params, config)
     if rejection:
         return fail(rejection, release=found)
@@ -244,10 +253,8 @@ def _warm_fit(
     return FitState(release.time_s, params, previous.checks, previous.checked_at_s)
 
 
-def _initial_modes(
-    t: np.ndarray, z: np.ndarray, noise: float, config: IdentifierConfig
-) -> list[ModeGuess]:
-    """Starting modes from the matrix pencil: the strongest in band, then a second one."""
+def _initial_modes(t: np.ndarray, z: np.ndarray, config: IdentifierConfig) -> list[ModeGuess]:
+    """The starting mode from the matrix pencil: the strongest in band (or none)."""
     rate = 1.0 / float(np.median(np.diff(t)))
     # Block means down to 2.25 samples per period of the highest frequency of interest:
     # below Nyquist with a margin, and a quarter of the pencil's cost at 180 Hz.
@@ -255,9 +262,7 @@ def _initial_modes(
     # The pencil only starts the fit and cross-checks it: the head of a long record will do.
     head = slice(0, _PENCIL_MAX_POINTS * decimation)
     try:
-        pencil = MatrixPencil(order=2 * config.max_modes + 3, decimation=decimation).fit(
-            t[head], z[head]
-        )
+        pencil = MatrixPencil(order=_PENCIL_ORDER, decimation=decimation).fit(t[head], z[head])
     except LumpbeamError:
         return []
     in_band = [
@@ -269,18 +274,7 @@ def _initial_modes(
     if not in_band:
         return []
     first = in_band[0]
-    guesses = [(first.damped_frequency_hz, first.damping_ratio)]
-    if config.max_modes >= 2:
-        nyquist = 0.5 * rate / decimation
-        for m in pencil.modes:
-            if (
-                1.5 * first.damped_frequency_hz < m.damped_frequency_hz < 0.8 * nyquist
-                and 0.0 < m.damping_ratio < 0.3
-                and m.amplitude > 10.0 * noise
-            ):
-                guesses.append((m.damped_frequency_hz, m.damping_ratio))
-                break
-    return guesses
+    return [(first.damped_frequency_hz, first.damping_ratio)]
 
 
 def _fit_decay(
@@ -288,24 +282,36 @@ def _fit_decay(
 ) -> DampedSinusoidParameters:
     """The least-squares decay, with the modes and nonlinear terms the data support.
 
-    The nonlinear terms are fitted when :func:`_wants_nonlinear`; a second mode that does
-    not hold up is dropped.
+    The strongest mode first, with its nonlinear terms when :func:`_wants_nonlinear`; then
+    each further mode that stands out of the noise
+    (:func:`~lumpbeam_ros.ident.modes.choose_modes`).
     """
     nonlinear = _wants_nonlinear(guesses[0], t[-1] - start, config)
-    fit = DampedSinusoidFit(n_modes=len(guesses), drift=config.drift, nonlinear=nonlinear)
-    params = fit.fit(t, z, initial=guesses, t0=start)
-    if params.n_modes == 2:
-        second = params.mode(1)
-        sane = (
-            second.damped_frequency_hz > guesses[0][0]
-            and second.amplitude > 3.0 * second.amplitude_std
-            and second.decay_rate > 0.0
-        )
-        if not sane:
-            params = DampedSinusoidFit(n_modes=1, drift=config.drift, nonlinear=nonlinear).fit(
-                t, z, initial=guesses[:1], t0=start
-            )
+    fit = DampedSinusoidFit(n_modes=1, drift=config.drift, nonlinear=nonlinear)
+    params = fit.fit(t, z, initial=guesses[:1], t0=start)
+    if config.max_modes > 1 and params.mode(0).decay_rate > 0.0:
+        params = choose_modes(t, z, params, config).params
     return params
+
+
+def lowest_mode(params: DampedSinusoidParams) -> int:
+    """The index of the fitted mode of lowest frequency: the first mode of the report."""
+    return min(structural_modes(params), key=lambda m: params.mode(m).natural_frequency_hz)
+
+
+def identified_modes(params: DampedSinusoidParams) -> tuple[IdentifiedMode, ...]:
+    """Every fitted mode (not a harmonic) with its standard deviations, by frequency."""
+    modes = sorted(
+        (params.mode(m) for m in structural_modes(params)), key=lambda m: m.natural_frequency_hz
+    )
+    return tuple(
+        IdentifiedMode(
+            Estimate(m.natural_frequency_hz, m.natural_frequency_hz_std),
+            Estimate(m.damping_ratio, m.damping_ratio_std),
+            m.amplitude,
+        )
+        for m in modes
+    )
 
 
 def _wants_nonlinear(first: ModeGuess, span_s: float, config: IdentifierConfig) -> bool:
@@ -344,11 +350,12 @@ def _reject_mode(
 
 def _damping_total(params: DampedSinusoidParameters, mode: ModeEstimate) -> tuple[float, float]:
     """c_tE = 2 zeta omega_d (B.22) and its std from the (sigma, omega_d) covariance."""
-    s, w = params.x[params.mode_slice(0)][2:]
+    part = params.mode_slice(lowest_mode(params))
+    s, w = params.x[part][2:]
     wn = math.hypot(s, w)
     value = rules.total_damping_from_ratio(mode.damping_ratio, mode.damped_omega)
     grad = np.array([2.0 * w**3 / wn**3, 2.0 * s**3 / wn**3])
-    cov = params.covariance.matrix[params.mode_slice(0), params.mode_slice(0)][2:, 2:]
+    cov = params.covariance.matrix[part, part][2:, 2:]
     return value, float(math.sqrt(max(grad @ cov @ grad, 0.0)))
 
 
@@ -413,12 +420,16 @@ def _derive(
     tip_mass = beam.tip_mass_kg + (
         release.load_after_kg if math.isfinite(release.load_after_kg) else 0.0
     )
-    k_freq = stiffness.from_frequency(
-        mode.natural_frequency_hz,
-        mode.natural_frequency_hz_std,
-        tip_mass,
-        beam.mass_kg,
-        config.beam_mass_fraction,
+    k_freq = (
+        stiffness.from_frequency(
+            mode.natural_frequency_hz,
+            mode.natural_frequency_hz_std,
+            tip_mass,
+            beam.mass_kg,
+            config.beam_mass_fraction,
+        )
+        if release.load_kg != 0.0
+        else (NAN, NAN)  # an arm's ring-down: the clamped beam's effective mass does not apply
     )
     level_after, level_after_std = params.offset, params.offset_std
     deflection = level_after - release.level_before_m
@@ -554,13 +565,24 @@ def _report(
             amplitude_m=mode.amplitude,
             residual_rms_m=params.residual_rms,
             covariance_inflation=params.covariance.inflation,
-            second_mode_hz=params.mode(1).damped_frequency_hz if params.n_modes > 1 else NAN,
+            second_mode_hz=_second_mode_hz(params),
             amplitude_frequency_shift_hz=params.frequency_shift_hz,
             amplitude_level_shift_m=params.level_shift_m,
             solver_evaluations=params.n_evaluations,
         ),
         samples=tally,
+        modes=identified_modes(params),
     )
+
+
+def _second_mode_hz(params: DampedSinusoidParams) -> float:
+    """Damped frequency of the second-lowest fitted mode (NaN with one mode)."""
+    modes = identified_modes(params)
+    if len(modes) < 2:
+        return NAN
+    mode = modes[1]
+    f_n, zeta = mode.natural_frequency_hz.value, mode.damping_ratio.value
+    return f_n * math.sqrt(1.0 - zeta * zeta)
 
 
 def _check_rel(warnings: list[str], name: str, value: float, std: float, limit: float) -> None:

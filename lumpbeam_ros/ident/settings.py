@@ -8,10 +8,11 @@ the fields below.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.paramfile import check_known_keys, read_parameter_file
 from lumpbeam_ros.params.schema import (
     Bounds,
@@ -26,6 +27,9 @@ _POSITIVE = Bounds(0.0, low_open=True)
 _NON_NEGATIVE = Bounds(0.0)
 _FRACTION = Bounds(0.0, 1.0, low_open=True)
 
+#: The most modes ``fit.max_modes`` (and ``lumpbeam analyze --max-modes``) may ask for: a
+#: camera at 180 fps sees a beam's first few modes, not ten.
+MAX_MODES_LIMIT = 8
 #: Choices of ``fit.nonlinear``.
 NONLINEAR_CHOICES = ('auto', 'always', 'never')
 
@@ -111,10 +115,18 @@ class IdentifierConfig:
     )
     max_modes: int = setting(
         'fit.max_modes',
-        2,
-        'damped modes the least-squares model may hold: 1, or 2 to also fit a second '
-        'mode the matrix pencil finds above the noise',
-        bounds=Bounds(1, 2),
+        3,
+        'damped modes the least-squares model may hold: each mode after the first is kept '
+        'only when it stands out of the noise (fit.mode_false_alarm)',
+        bounds=Bounds(1, MAX_MODES_LIMIT),
+    )
+    mode_false_alarm: float = setting(
+        'fit.mode_false_alarm',
+        1e-3,
+        'a mode after the first is kept when its amplitude exceeds k of its standard '
+        'deviations, k = sqrt(2 ln(N / this)) for N samples fitted: the chance that noise '
+        'alone gives a mode',
+        bounds=Bounds(0.0, 0.5, low_open=True),
     )
     drift: bool = setting(
         'fit.drift', False, 'add a linear drift to the decay model (a creeping mount)'
@@ -161,6 +173,15 @@ class IdentifierConfig:
         40.0,
         "highest frequency taken as the beam's first mode (above fit.min_frequency_hz)",
         'Hz',
+        _POSITIVE,
+    )
+    rest_tolerance_rad: float = setting(
+        'ring_down.rest_tolerance_rad',
+        1e-5,
+        'an arm (with /joint_states) is at rest while every joint stays within this of its '
+        'angle when it stopped; the free vibration is fitted from that stop (for encoder '
+        'readings, a few counts)',
+        'rad',
         _POSITIVE,
     )
     beam_mass_fraction: float = setting(
@@ -245,6 +266,31 @@ def config_from_parameters(params: Mapping[str, Any], source: str | Path) -> Ide
     """
     check_known_keys(params, frozenset(spec.name for spec in IDENTIFIER_SETTINGS), source)
     return settings_from_parameters(IdentifierConfig, params, source)
+
+
+def with_max_modes(config: IdentifierConfig, text: str) -> IdentifierConfig:
+    """The settings with ``fit.max_modes`` from a command line's ``--max-modes``.
+
+    Args:
+        config: The settings.
+        text: The option's value as typed.
+
+    Returns:
+        The settings with that many modes at most.
+
+    Raises:
+        LumpbeamError: Not a whole number within the parameter's bounds, naming the option.
+    """
+    spec = next(spec for spec in IDENTIFIER_SETTINGS if spec.name == 'fit.max_modes')
+    value: object
+    try:
+        value = int(text)
+    except ValueError:
+        value = text
+    problem = spec.problem(value)
+    if problem:
+        raise LumpbeamError(f'--max-modes: {problem}')
+    return replace(config, max_modes=int(text))
 
 
 def config_to_parameters(config: IdentifierConfig) -> dict[str, Any]:

@@ -7,6 +7,10 @@ a timer at ``publish_rate_hz`` identifies the window
 (:func:`~lumpbeam_ros.ident.identify.identify_from`, warm-started from the last update) and
 publishes one DiagnosticStatus ``lumpbeam/identifier`` (doc/interfaces.md, 'Topics').
 
+On an arm (once ``/joint_states`` arrives) the free vibration is each move's ring-down: it
+starts where the joints stop (:class:`~lumpbeam_ros.ident.ring_down.RestTracker`) in place
+of a load release, and the tip is taken along its swing.
+
 Parameters: :data:`~lumpbeam_ros.params.identifier_params.IDENTIFIER_SCHEMA`
 (``doc/parameters.md``). Run it with the package's settings, on sim time when a bag is
 replayed::
@@ -28,19 +32,28 @@ from typing import Unpack
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
+from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
-from lumpbeam_ros.bagio.convert import pose_values
+from lumpbeam_ros.bagio.convert import joint_state_values, pose_values
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.identification import Identification, Status
 from lumpbeam_ros.ident.identify import FitState, identify_from
+from lumpbeam_ros.ident.ring_down import RestTracker, along_swing, ring_down_release
 from lumpbeam_ros.ident.settings import (
     IDENTIFIER_SETTINGS,
     IdentifierConfig,
     config_from_parameters,
 )
 from lumpbeam_ros.ident.window import SlidingWindow
-from lumpbeam_ros.interface import BASE_FRAME, BEAM_PARAMS, IDENTIFIER_STATUS, TIP_LOAD, TIP_POSE
+from lumpbeam_ros.interface import (
+    BASE_FRAME,
+    BEAM_PARAMS,
+    IDENTIFIER_STATUS,
+    JOINT_STATES,
+    TIP_LOAD,
+    TIP_POSE,
+)
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
@@ -72,6 +85,8 @@ class IdentifierNode(SchemaNode):
         self.beam: BeamParameters = load_beam_config(beam_file or None)[0]
         self.hardware_id = str(values['hardware_id'])
         self.window = SlidingWindow.from_config(self.config)
+        self.joints = RestTracker(self.config.rest_tolerance_rad)
+        self.bad_joint_states = 0
         self._state: FitState | None = None
         self._resets = 0
         self.wrong_frame = 0
@@ -79,6 +94,7 @@ class IdentifierNode(SchemaNode):
         self._output = publisher(self, DiagnosticArray, BEAM_PARAMS)
         subscription(self, PoseStamped, TIP_POSE, self._on_pose)
         subscription(self, Float64, TIP_LOAD, self._on_load)
+        subscription(self, JointState, JOINT_STATES, self._on_joint_state)
         self.create_timer(1.0 / self.config.publish_rate_hz, self._on_timer)
 
     def _on_pose(self, msg: PoseStamped) -> None:
@@ -100,6 +116,7 @@ class IdentifierNode(SchemaNode):
         if counts.resets != self._resets:
             self._resets = counts.resets
             self._state = None
+            self.joints.clear()
             self.get_logger().warning(
                 'tip pose stamps jumped back (a looping bag?): window emptied',
                 throttle_duration_sec=WARN_PERIOD_S,
@@ -116,12 +133,35 @@ class IdentifierNode(SchemaNode):
                 throttle_duration_sec=WARN_PERIOD_S,
             )
 
+    def _on_joint_state(self, msg: JointState) -> None:
+        stamp_ns, _, positions = joint_state_values(msg)
+        if not self.joints.push(stamp_ns * 1e-9, positions):
+            self.bad_joint_states += 1
+            self.get_logger().warning(
+                f'/joint_states at {stamp_ns * 1e-9:.3f} s ignored: a position that is not '
+                'finite, a stamp going back or another number of joints '
+                f'({self.bad_joint_states} so far)',
+                throttle_duration_sec=WARN_PERIOD_S,
+            )
+
     def _on_timer(self) -> None:
         self.updates += 1
         snapshot = self.window.snapshot()
+        release = None
+        if self.joints.current is not None:
+            # The rest must hold for as many poses as an identification needs.
+            step = float(np.median(np.diff(snapshot.t))) if len(snapshot) > 1 else math.inf
+            rest = self.joints.ring_down(self.config.min_samples * step)
+            if rest is None:
+                self._state = None
+                message = 'no ring-down yet: the joints have not stopped after a move'
+                self._output.publish(self.diagnostics(Identification(Status.ERROR, message)))
+                return
+            snapshot = along_swing(snapshot, rest.start_s, rest.end_s)
+            release = ring_down_release(rest)
         try:
             result, self._state = identify_from(
-                snapshot, self.beam, self.config, previous=self._state
+                snapshot, self.beam, self.config, previous=self._state, release=release
             )
         except (LumpbeamError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
             # Numerically hopeless windows (e.g. a constant signal) give no estimate.
@@ -150,6 +190,7 @@ class IdentifierNode(SchemaNode):
             ('samples_non_finite', str(counts.non_finite)),
             ('samples_out_of_order', str(counts.out_of_order + counts.duplicates)),
             ('window_resets', str(counts.resets)),
+            ('joint_states_ignored', str(self.bad_joint_states)),
         ]
         status = DiagnosticStatus(
             level=bytes([int(result.status)]),

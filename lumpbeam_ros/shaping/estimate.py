@@ -16,12 +16,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.identification import Status
+from lumpbeam_ros.ident.identification import MODE_COUNT_KEY, Status, mode_key
 from lumpbeam_ros.shaping.impulses import Mode
 
 FREQUENCY = 'natural_frequency_hz'
 DAMPING = 'damping_ratio'
-MODE_COUNT = 'mode_count'
 
 
 @dataclass(frozen=True)
@@ -77,9 +76,10 @@ def _figure(values: Mapping[str, str], key: str) -> tuple[float, float]:
     return value, std
 
 
-def _mode(values: Mapping[str, str], prefix: str) -> ModeEstimate:
-    frequency, frequency_std = _figure(values, f'{prefix}{FREQUENCY}')
-    damping, damping_std = _figure(values, f'{prefix}{DAMPING}')
+def _mode(values: Mapping[str, str], k: int) -> ModeEstimate:
+    """Mode ``k`` (1: the top-level keys) of a status."""
+    frequency, frequency_std = _figure(values, FREQUENCY if k == 1 else mode_key(k, FREQUENCY))
+    damping, damping_std = _figure(values, DAMPING if k == 1 else mode_key(k, DAMPING))
     return ModeEstimate(Mode(frequency, damping), frequency_std, damping_std)
 
 
@@ -101,15 +101,15 @@ def estimate_from_status(level: int, values: Mapping[str, str], max_modes: int) 
     if level not in (Status.OK, Status.WARN):
         name = Status(level).name if level in Status._value2member_map_ else str(level)
         raise LumpbeamError(f'status {name}, no estimate')
-    modes = [_mode(values, '')]
+    modes = [_mode(values, 1)]
     left_out = []
     try:
-        count = int(float(values.get(MODE_COUNT, '1')))
+        count = int(float(values.get(MODE_COUNT_KEY, '1')))
     except ValueError:
         count = 1
     for k in range(2, min(count, max_modes) + 1):
         try:
-            modes.append(_mode(values, f'mode_{k}_'))
+            modes.append(_mode(values, k))
         except LumpbeamError as exc:
             left_out.append(f'mode {k}: {exc}')
     return Estimate(tuple(modes), tuple(left_out))

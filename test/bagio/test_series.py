@@ -81,3 +81,22 @@ def test_missing_and_mistyped_topics_are_errors(tmp_path):
         with BagWriter(tmp_path / 'empty') as bag:
             bag.add_topic('/camera/camera_info', 'sensor_msgs/msg/CameraInfo')
         read_camera_info(tmp_path / 'empty')
+
+
+def test_joint_states_round_trip_and_other_joints_are_an_error(tmp_path):
+    from lumpbeam_ros.bagio import BagWriter
+    from lumpbeam_ros.bagio.series import read_joint_states
+
+    with BagWriter(tmp_path / 'arm') as bag:
+        for k in (2, 0, 1):  # written out of order: read sorted
+            bag.write_joint_state('/joint_states', 1.0 + k, ('a', 'b'), np.array([k, -k]))
+    series = read_joint_states(tmp_path / 'arm')
+    assert series.t.tolist() == [1.0, 2.0, 3.0] and series.names == ('a', 'b')
+    assert series.angles.tolist() == [[0, 0], [1, -1], [2, -2]]
+    with BagWriter(tmp_path / 'mixed') as bag:
+        bag.write_joint_state('/joint_states', 1.0, ('a', 'b'), np.array([0.0, 0.0]))
+        bag.write_joint_state('/joint_states', 2.0, ('a',), np.array([0.0]))
+    with pytest.raises(BagError, match=r"names joints \['a'\] with 1 positions after"):
+        read_joint_states(tmp_path / 'mixed')
+    with pytest.raises(BagError, match='no topic /joint_states'):
+        read_joint_states(tmp_path / 'arm', '/joint_states_other')

@@ -4,6 +4,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+from ring_downs import MODES, ring_down, write_bag
 
 from lumpbeam_ros.bagio import BagWriter
 from lumpbeam_ros.cli.analyze import CONTRACT_KEYS
@@ -11,6 +12,7 @@ from lumpbeam_ros.cli.main import main
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.modes import chain_modes
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
+from lumpbeam_ros.resources import config_path
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 
 from .helpers import rewritten
@@ -67,9 +69,21 @@ def test_analyze_json_keeps_the_keys_their_order_and_values(drop_bag, tmp_path):
     assert main(['analyze', str(drop_bag), '--json', str(out)]) == 0
     data = json.loads(out.read_text())
     expected = GOLDEN['analyze_json']
-    assert list(data) == list(expected)
+    # The modes came later, after every golden key; the top-level keys are the first mode's.
+    assert list(data) == [*expected, 'modes']
     assert set(CONTRACT_KEYS) | {f'{key}_std' for key in CONTRACT_KEYS} <= set(data)
     assert [key for key in expected if not same_value(data[key], expected[key])] == []
+    # The drop's second mode (35 Hz, about 20 um at the start, damped in 0.1 s) is under the
+    # 20 um noise: one mode, the top-level one.
+    assert data['modes'] == [
+        {
+            'natural_frequency_hz': data['natural_frequency_hz'],
+            'natural_frequency_hz_std': data['natural_frequency_hz_std'],
+            'damping_ratio': data['damping_ratio'],
+            'damping_ratio_std': data['damping_ratio_std'],
+            'amplitude_m': data['amplitude_m'],
+        }
+    ]
 
 
 def _bag(path, poses=(), frame='beam_base', loads=()):
@@ -150,9 +164,9 @@ def test_no_oscillation_keeps_partial_results(tmp_path, capsys):
 
 def test_bad_identifier_config_is_one_line(drop_bag, tmp_path, capsys):
     bad = tmp_path / 'ident.yaml'
-    bad.write_text('/**:\n  ros__parameters:\n    fit:\n      max_modes: 7\n')
+    bad.write_text('/**:\n  ros__parameters:\n    fit:\n      max_modes: 9\n')
     assert main(['analyze', str(drop_bag), '--identifier-config', str(bad)]) == 2
-    assert 'fit.max_modes: must be in [1, 2], got 7' in _error_line(capsys)
+    assert 'fit.max_modes: must be in [1, 8], got 9' in _error_line(capsys)
 
 
 def _warnings(err):
@@ -223,3 +237,67 @@ def test_a_jump_in_the_stamps_keeps_the_release_segment(drop_bag, tmp_path, caps
         assert code == 0
         data = _check_estimates(out, 2.0 + jump_s, 'WARN')
         assert data['message'].startswith('/tip_load ')
+
+
+@pytest.mark.parametrize(
+    ('value', 'problem'),
+    [
+        ('0', 'must be in [1, 8], got 0'),
+        ('-2', 'must be in [1, 8], got -2'),
+        ('1000000', 'must be in [1, 8], got 1000000'),
+        ('1.5', "must be an integer, got '1.5'"),
+        ('many', "must be an integer, got 'many'"),
+    ],
+)
+def test_bad_max_modes_is_one_line(drop_bag, capsys, value, problem):
+    assert main(['analyze', str(drop_bag), f'--max-modes={value}']) == 2
+    assert _error_line(capsys) == f'lumpbeam analyze: error: --max-modes: {problem}'
+
+
+@pytest.fixture(scope='module')
+def arm_bag(tmp_path_factory):
+    return write_bag(tmp_path_factory.mktemp('arm') / 'rotary', ring_down())
+
+
+def test_an_arm_bag_gives_the_modes_after_the_last_move(arm_bag, tmp_path, capsys):
+    out = tmp_path / 'arm.json'
+    arm = str(config_path('arm_rotary.yaml'))
+    assert main(['analyze', str(arm_bag), '--arm', arm, '--json', str(out)]) == 0
+    text = capsys.readouterr().out
+    assert 'joints at rest from 0.300 s at q = 0.5 rad' in text
+    assert '(arm model: 4.2041 Hz' in text
+    data = json.loads(out.read_text())
+    assert data['release_source'] == 'joint_states' and data['joint_angles_rad'] == [0.5]
+    assert data['stiffness_total_nm_per_rad'] is None  # no load left: B.12 does not apply
+    assert [list(mode) for mode in data['modes']] == [
+        [
+            'natural_frequency_hz',
+            'natural_frequency_hz_std',
+            'damping_ratio',
+            'damping_ratio_std',
+            'amplitude_m',
+        ]
+    ] * len(MODES)
+    for mode, (f, zeta, amplitude) in zip(data['modes'], MODES, strict=True):
+        assert abs(mode['natural_frequency_hz'] - f) < 4 * mode['natural_frequency_hz_std']
+        assert abs(mode['damping_ratio'] - zeta) < 4 * mode['damping_ratio_std']
+        assert mode['amplitude_m'] == pytest.approx(amplitude, rel=0.1)
+    assert data['natural_frequency_hz'] == data['modes'][0]['natural_frequency_hz']
+    # At most one mode when asked.
+    assert (
+        main(['analyze', str(arm_bag), '--arm', arm, '--max-modes', '1', '--json', str(out)]) == 0
+    )
+    assert len(json.loads(out.read_text())['modes']) == 1
+
+
+def test_an_arm_bag_with_other_joints_or_no_move_is_one_line(arm_bag, tmp_path, capsys):
+    three = str(config_path('arm_3link.yaml'))
+    assert main(['analyze', str(arm_bag), '--arm', three]) == 2
+    assert '/joint_states has 1 joint(s) (joint_1), the arm 3' in _error_line(capsys)
+    still = ring_down(end_rad=0.0)
+    bag = write_bag(tmp_path / 'still', still)
+    rotary = str(config_path('arm_rotary.yaml'))
+    assert main(['analyze', str(bag), '--arm', rotary]) == 2
+    assert 'the joints never move' in _error_line(capsys)
+    assert main(['analyze', str(_bag(tmp_path / 'b', poses=[(0.0, 0.0)])), '--arm', rotary]) == 2
+    assert 'no topic /joint_states (topics: /tip_pose)' in _error_line(capsys)

@@ -35,8 +35,8 @@ def test_round_trip_through_parameters():
     [
         ('window.length_s', -1.0, 'must be positive'),
         ('window.length_s', 'long', 'must be a number'),
-        ('fit.max_modes', 3, r'must be in \[1, 2\], got 3'),
-        ('fit.max_modes', 0, r'must be in \[1, 2\], got 0'),
+        ('fit.max_modes', 9, r'must be in \[1, 8\], got 9'),
+        ('fit.max_modes', 0, r'must be in \[1, 8\], got 0'),
         ('fit.drift', 'yes', 'true or false'),
         ('fit.nonlinear', 'sometimes', 'one of'),
         ('fit.nonlinear_min_decay', 0.0, 'must be positive'),

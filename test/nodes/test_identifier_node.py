@@ -11,7 +11,9 @@ from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import PoseStamped
 from harness import ros_env
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from ring_downs import MODES, ring_down
 from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio import read_tip_poses
@@ -29,6 +31,7 @@ from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.model.statics import static_tip_deflection
 from lumpbeam_ros.nodes.identifier_node import IdentifierNode
 from lumpbeam_ros.resources import config_path
+from lumpbeam_ros.shaping.estimate import estimate_from_status
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -277,7 +280,7 @@ def test_parameters_are_validated():
     try:
         for overrides, problem in [
             ({'window.length_s': -1.0}, 'window.length_s: must be positive'),
-            ({'fit.max_modes': 3}, 'fit.max_modes'),
+            ({'fit.max_modes': 9}, 'fit.max_modes'),
             ({'fit.nonlinear': 'maybe'}, 'fit.nonlinear'),
             ({'beam_config': '/nonexistent.yaml'}, 'nonexistent'),
         ]:
@@ -328,7 +331,10 @@ def test_beam_params_keep_the_keys_their_order_and_values(ros_graph, tmp_path):
     status = node.diagnostics(result).status[0]
     pairs = [(kv.key, kv.value) for kv in status.values]
     counts = ['samples_wrong_frame', 'samples_non_finite', 'samples_out_of_order', 'window_resets']
-    expected = [*map(tuple, golden['beam_params']), *((key, '0') for key in counts)]
+    counts.append('joint_states_ignored')
+    # The modes came later, after the golden keys: one mode, the top-level one.
+    modes = [('mode_count', '1')]
+    expected = [*map(tuple, golden['beam_params']), *modes, *((key, '0') for key in counts)]
     assert [key for key, _ in pairs] == [key for key, _ in expected]
     # 1e-6 relative, as analyze's golden test: the stds lose digits to cancellation that
     # another numpy or CPU rounds differently.
@@ -369,3 +375,44 @@ def test_two_replays_feeding_the_node_are_never_ok(ros_graph, drop_record):
     assert 'the poses may mix two streams' in message
     assert int(values['samples_out_of_order']) == len(poses) - 1
     assert float(values['n_rejected']) > 0.4 * float(values['n_samples'])
+
+
+def _joint_state(stamp, angles):
+    msg = JointState()
+    msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(int(round(stamp * 1e9)), 10**9)
+    msg.name = [f'joint_{i + 1}' for i in range(len(angles))]
+    msg.position = [float(a) for a in angles]
+    return msg
+
+
+def test_an_arm_ring_down_gives_every_mode_on_beam_params(ros_graph):
+    """Each move's ring-down from /joint_states; the shaper reads back exactly those keys."""
+    record = ring_down()
+    node = IdentifierNode(context=ros_graph.context, parameter_overrides={'publish_rate_hz': 1.0})
+    ros_graph.add_node(node)
+    params = ros_graph.collect('/beam_params', DiagnosticArray, 10)
+    moving = record.t < 0.2
+    for t, q, x, z in zip(record.t, record.q, record.x, record.z, strict=True):
+        node._on_joint_state(_joint_state(float(t), q))
+        node._on_pose(_pose(float(t), float(z), x=float(x)))
+        if t == record.t[moving][-1]:
+            node._on_timer()  # still moving: no ring-down yet
+    node._on_joint_state(_joint_state(7.0, [math.nan]))  # ignored and counted
+    node._on_timer()
+    assert ros_graph.spin_until(lambda: len(params) >= 2, 10.0)
+    (first_level, first_message, _), (level, message, values) = _statuses(params)[:2]
+    assert first_level == 2 and 'the joints have not stopped after a move' in first_message
+    assert level == 0, message
+    assert values['release_source'] == 'joint_states' and values['joint_states_ignored'] == '1'
+    assert values['mode_count'] == str(len(MODES))
+    for k, (f, zeta, _) in enumerate(MODES, start=1):
+        prefix = '' if k == 1 else f'mode_{k}_'
+        found = float(values[f'{prefix}natural_frequency_hz'])
+        assert abs(found - f) < 4 * float(values[f'{prefix}natural_frequency_hz_std'])
+        found = float(values[f'{prefix}damping_ratio'])
+        assert abs(found - zeta) < 4 * float(values[f'{prefix}damping_ratio_std'])
+    shaped = estimate_from_status(level, values, max_modes=3)
+    assert [m.mode.frequency_hz for m in shaped.modes] == [
+        float(values['natural_frequency_hz']),
+        float(values['mode_2_natural_frequency_hz']),
+    ]

@@ -11,7 +11,14 @@ def test_quick_run_reports_both_figures_with_baselines():
         'analyze_bag_throughput',
         'ident_batch_throughput',
         'ident_window_update_10s_180hz',
+        'ident_modes_12s_window',
     }
+    modes = results['ident_modes_12s_window']
+    assert modes.unit == 'ms CPU' and modes.ratio == pytest.approx(
+        modes.value / modes.baseline_value
+    )
+    # The 0.5 kg tip body's modes 1 and 2 (5.37 and 38.7 Hz); a third is refused.
+    assert modes.details['mode_frequencies_hz'] == pytest.approx([5.374, 38.70], rel=2e-3)
     bag = results['analyze_bag_throughput']
     assert bag.unit == 'pose msgs/s' and bag.details['status'] == 'OK'
     assert bag.details['poses'] == 30 * 180 + 1

@@ -1,0 +1,1 @@
+"""Accuracy and coverage of the identification against the models' truth."""
