@@ -25,6 +25,7 @@ from urllib.parse import unquote
 import pytest
 
 from lumpbeam_lab.bench.bench_result import BenchResult
+from lumpbeam_ros.arm.link_fit import MeasuredMode
 from lumpbeam_ros.campaign.task import ID_COLUMNS
 from lumpbeam_ros.cli.analyze import CONTRACT_KEYS
 from lumpbeam_ros.cli.main import COMMANDS, build_parser
@@ -155,6 +156,10 @@ def json_keys() -> dict[str, set[str]]:
         'bench': dict_keys('cli/bench.py', 'run') | field_names(BenchResult),
         'demo': dict_keys('demo/steps.py', 'summarize'),
         'campaign': set(ID_COLUMNS),
+        'fit-links': dict_keys('arm/link_fit.py', 'LinkEstimate.as_dict')
+        | dict_keys('arm/link_fit.py', 'LinkFit.as_json')
+        | dict_keys('cli/fit_links.py', 'run_fit_links')
+        | {f.name for f in fields(MeasuredMode)},
         'shape': dict_keys('cli/shape.py', 'run')
         | dict_keys('shaping/vibration.py', 'vibration_summary')
         | dict_keys('shaping/impulses.py', 'Impulses.as_list'),

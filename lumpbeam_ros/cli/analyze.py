@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from lumpbeam_ros.cli.output import write_json
+from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.bag_analysis import (
     CONTRACT_KEYS,
     POSE_TOPIC,
@@ -28,6 +29,13 @@ __all__ = ['CONTRACT_KEYS', 'Progress', 'read_window', 'result_json', 'run']
 
 def run(args: argparse.Namespace) -> int:
     """Reads the bag, identifies the whole record, prints a summary, writes JSON and plots."""
+    if args.fit_links or args.arm:
+        from lumpbeam_ros.cli.fit_links import run_fit_links
+
+        return run_fit_links(args)
+    if len(args.bag) > 1:
+        raise LumpbeamError(f'{len(args.bag)} bags given: several bags only with --fit-links')
+    args.bag = args.bag[0]
     beam, _ = load_beam_config(args.config)
     config = load_identifier_config(args.identifier_config)
     if args.max_modes is not None:

@@ -271,7 +271,12 @@ def add_track(parser: argparse.ArgumentParser) -> None:
 @_subcommand('analyze', help='identify frequency, damping and stiffness')
 def add_analyze(parser: argparse.ArgumentParser) -> None:
     """Declares ``lumpbeam analyze``."""
-    parser.add_argument('bag', help='rosbag2 folder with /tip_pose (and /tip_load)')
+    parser.add_argument(
+        'bag',
+        nargs='+',
+        metavar='BAG',
+        help='rosbag2 folder with /tip_pose (and /tip_load); several with --fit-links',
+    )
     parser.add_argument('--json', help='write the result as JSON to this file')
     parser.add_argument('--plots', help='write figures (PNG) into this folder')
     parser.add_argument('--config', help='beam parameter file (default: config/paper_beam.yaml)')
@@ -291,6 +296,14 @@ def add_analyze(parser: argparse.ArgumentParser) -> None:
         'beside the modes of this arm file at the final joint angles',
     )
     add_report(parser)
+    arm = parser.add_argument_group("an arm's links from its ring-downs (doc/arm.md)")
+    arm.add_argument('--arm', metavar='FILE', help='arm configuration file (nominal values)')
+    arm.add_argument(
+        '--fit-links',
+        action='store_true',
+        help="fit each link's k_total_nm_per_rad and damping_beta to the modes measured after "
+        'the last move of each BAG (moves ending in different configurations); with --arm',
+    )
 
 
 @_subcommand(

@@ -24,6 +24,11 @@ def paper_beam_arm(beam: BeamParameters) -> ArmConfig:
 
 def small_arm(n_links: int, plane: str = 'vertical') -> ArmConfig:
     """A light arm of 1 to 3 links with few segments (fast to simulate), unequal links."""
+    return arm_from_mapping(small_arm_document(n_links, plane), 'small')
+
+
+def small_arm_document(n_links: int, plane: str = 'vertical') -> dict:
+    """:func:`small_arm` as the mapping of its arm file."""
     links = [
         {'length_m': 1.0, 'n_segments': 4, 'ei_nm2': 500.0, 'mass_kg': 1.0, 'damping_beta': 1e-3},
         {
@@ -43,8 +48,7 @@ def small_arm(n_links: int, plane: str = 'vertical') -> ArmConfig:
             'joint_mass_kg': 0.4,
         },
     ]
-    doc = {'arm': {'plane': plane, 'payload_kg': 0.3, 'links': links[:n_links]}}
-    return arm_from_mapping(doc, 'small')
+    return {'arm': {'plane': plane, 'payload_kg': 0.3, 'links': links[:n_links]}}
 
 
 def smooth_move(amplitude: np.ndarray, duration: float) -> SmoothMotion:
@@ -60,3 +64,20 @@ def smooth_move(amplitude: np.ndarray, duration: float) -> SmoothMotion:
         return amplitude * (1 - np.cos(2 * np.pi * s)) / duration
 
     return SmoothMotion(angles, rates, amplitude.size, duration)
+
+
+def write_move_bag(out, arm: ArmConfig, final, move_s=0.5, record_s=4.0, names=()):
+    """A synthetic bag of the arm moved from 0 to ``final`` (minimum jerk) and left to ring.
+
+    Returns:
+        ``out``.
+    """
+    from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
+    from lumpbeam_ros.synthetic.arm_bag import ArmSynthOptions, write_arm_bag
+
+    t = np.linspace(0.0, move_s, int(round(move_s * 1000)) + 1)
+    s = t / move_s
+    s = 10 * s**3 - 15 * s**4 + 6 * s**5
+    trajectory = JointTrajectory(t, np.outer(s, np.asarray(final, dtype=float)), tuple(names))
+    write_arm_bag(out, arm, trajectory, ArmSynthOptions(duration_s=record_s))
+    return out
