@@ -49,7 +49,7 @@ STEP_S = 1e-3
 OUTPUT_S = 2e-3
 
 #: The arms' moves: (file, start angles, end angles, duration s, modes shaped). The rotary
-#: link (first mode 4.2 Hz, period 0.24 s) turns 1 rad in 0.3 s; the three-link arm (modes
+#: link (first mode 3.5 Hz, period 0.29 s) turns 1 rad in 0.3 s; the three-link arm (modes
 #: 1.2 and 6.8 Hz at the end) moves all joints in 1 s, lifting against gravity.
 ARMS = {
     'rotary': ('arm_rotary.yaml', [0.0], [1.0], 0.3, 1),
