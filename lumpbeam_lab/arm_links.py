@@ -177,21 +177,18 @@ def run_bags(case: ArmCase, folder: Path, move_s: float = 2.0, record_s: float =
     Returns:
         The table, one line per link.
     """
+    from lumpbeam_lab.shaping_loop import minimum_jerk
     from lumpbeam_ros.arm.bag_modes import bag_observations
-    from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
     from lumpbeam_ros.synthetic.arm_bag import ArmSynthOptions, write_arm_bag
 
     truth = load_arm_config(case.config)
     bags = []
-    t = np.linspace(0.0, move_s, int(round(move_s * 1000)) + 1)
-    s = t / move_s
-    s = 10 * s**3 - 15 * s**4 + 6 * s**5  # minimum jerk, rest to rest
     start = np.zeros(truth.n_joints)
     for k, q in enumerate(case.finals):
         path = folder / f'{case.name}_{k}'
         shutil.rmtree(path, ignore_errors=True)
-        angles = start + np.outer(s, np.asarray(q) - start)
-        write_arm_bag(path, truth, JointTrajectory(t, angles), ArmSynthOptions(record_s))
+        move = minimum_jerk(start, np.asarray(q, dtype=float), move_s)
+        write_arm_bag(path, truth, move, ArmSynthOptions(record_s))
         bags.append(path)
     obs = bag_observations(bags, truth)
     nominal = nominal_arm(truth, np.random.default_rng(1))
@@ -217,7 +214,9 @@ def run_bags(case: ArmCase, folder: Path, move_s: float = 2.0, record_s: float =
 def main(argv: Sequence[str] | None = None) -> int:
     """Prints the trials' table (and with ``--bags`` the whole path's)."""
     parser = argparse.ArgumentParser(prog='python -m lumpbeam_lab.arm_links')
-    parser.add_argument('--trials', type=int, default=100, help='seeded trials per arm (100)')
+    parser.add_argument(
+        '--trials', type=int, default=100, help='seeded trials per arm (100; 0: none)'
+    )
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--only', choices=[c.name for c in CASES], help='one arm')
     parser.add_argument('--bags', action='store_true', help='also the whole path from bags')
@@ -225,12 +224,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     for case in CASES:
         if args.only and case.name != args.only:
             continue
-        result = run_trials(case, args.trials, args.seed)
-        print(
-            f'{case.name}: {len(case.finals)} configurations x {case.n_modes} modes, nominal '
-            f'{NOMINAL_ERROR:.0%} off, {args.trials} trials'
-        )
-        print('\n'.join(result.rows()))
+        if args.trials > 0:
+            result = run_trials(case, args.trials, args.seed)
+            print(
+                f'{case.name}: {len(case.finals)} configurations x {case.n_modes} modes, '
+                f'nominal {NOMINAL_ERROR:.0%} off, {args.trials} trials'
+            )
+            print('\n'.join(result.rows()))
         if args.bags:
             with tempfile.TemporaryDirectory() as folder:
                 print(run_bags(case, Path(folder)))

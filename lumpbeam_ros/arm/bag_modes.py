@@ -15,7 +15,7 @@ amplitude, frequency and damping stand out of their standard deviations.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,8 +39,16 @@ MIN_SIGNIFICANCE = 5.0
 #: A mode within this fraction of an integer multiple of a stronger mode's frequency is
 #: taken for its overtone.
 HARMONIC_TOLERANCE = 2e-3
+#: A mode within this fraction of a stronger mode's frequency is taken for the stronger
+#: mode's drift with amplitude (an arm's modes lie much further apart).
+SHADOW_TOLERANCE = 0.02
 #: Damping ratios above this are not a ringing mode (a slow drift the fit soaked up).
 MAX_DAMPING_RATIO = 0.5
+
+
+#: What identifies the modes of a ring-down: ``(t, x, z, max_modes)`` of the tip (s, m, m)
+#: from the moment the joints stop, to the modes that stand out of the noise.
+RingdownIdentifier = Callable[[np.ndarray, np.ndarray, np.ndarray, int], Sequence[MeasuredMode]]
 
 
 @dataclass(frozen=True)
@@ -206,18 +214,20 @@ def _stands_out(mode: ModeEstimate) -> bool:
 
 
 def _harmonic(mode: ModeEstimate, modes: Sequence[ModeEstimate]) -> bool:
-    """Whether ``mode`` is an overtone of a stronger, slower one, not a mode of its own.
+    """Whether ``mode`` is an artefact of a stronger one, not a mode of its own.
 
-    A large ring-down's geometric nonlinearity puts overtones at integer multiples.
+    A large ring-down's geometric nonlinearity puts overtones at integer multiples of a
+    mode's frequency, and its frequency drifting with the amplitude shows as a weaker mode
+    beside it.
     """
     for other in modes:
+        if not other.amplitude > mode.amplitude:
+            continue
         ratio = mode.damped_frequency_hz / other.damped_frequency_hz
         order = round(ratio)
-        if (
-            other.amplitude > mode.amplitude
-            and order >= 2
-            and abs(ratio - order) < HARMONIC_TOLERANCE * order
-        ):
+        if order >= 2 and abs(ratio - order) < HARMONIC_TOLERANCE * order:
+            return True
+        if abs(ratio - 1.0) < SHADOW_TOLERANCE:
             return True
     return False
 
@@ -230,17 +240,23 @@ def _principal_displacement(x: np.ndarray, z: np.ndarray) -> np.ndarray:
 
 
 def bag_observation(
-    bag: str | Path, joints: FinalJoints | None = None, max_modes: int = 3
+    bag: str | Path,
+    joints: FinalJoints | None = None,
+    max_modes: int = 3,
+    identify: RingdownIdentifier = ringdown_modes,
 ) -> ModeObservation:
     """A bag's final joint angles and the modes of its ring-down after the last move.
 
     This is the seam between the bags and the link fit: the observation it returns is all
-    :class:`~lumpbeam_ros.arm.link_fit.LinkParameterFit` needs.
+    :class:`~lumpbeam_ros.arm.link_fit.LinkParameterFit` needs, and ``identify`` is the one
+    call that finds the modes.
 
     Args:
         bag: An arm's bag: ``/joint_states`` and ``/tip_pose``.
         joints: Its :func:`read_final_joints`, when already read.
         max_modes: At most this many modes.
+        identify: ``(t, x, z, max_modes) -> modes`` of the tip's free vibration from the
+            moment the joints stop (:func:`ringdown_modes` by default).
 
     Returns:
         The observation.
@@ -258,7 +274,7 @@ def bag_observation(
             f'{bag}: no ring-down after the last move: {span:.2f} s of {TIP_POSE} after the '
             f'joints stop at {joints.rest_from_s:.3f} s (at least {MIN_RINGDOWN_S:g} s needed)'
         )
-    modes = ringdown_modes(after.t, after.x, after.z, max_modes)
+    modes = tuple(identify(after.t, after.x, after.z, max_modes))
     if not modes:
         raise BagError(
             f'{bag}: no ring-down after the last move: no mode stands out of the noise in '
@@ -268,9 +284,12 @@ def bag_observation(
 
 
 def bag_observations(
-    bags: Sequence[str | Path], arm: ArmConfig, max_modes: int = 3
+    bags: Sequence[str | Path],
+    arm: ArmConfig,
+    max_modes: int = 3,
+    identify: RingdownIdentifier = ringdown_modes,
 ) -> list[ModeObservation]:
-    """Every bag's observation, once all are checked to come from one arm: this one.
+    """Every bag's :func:`bag_observation`, once all are checked to come from this arm.
 
     Raises:
         BagError: As :func:`read_final_joints` and :func:`bag_observation`.
@@ -290,5 +309,6 @@ def bag_observations(
                 f'{list(finals[0].names)}: bags from different arms'
             )
     return [
-        bag_observation(bag, joints, max_modes) for bag, joints in zip(bags, finals, strict=True)
+        bag_observation(bag, joints, max_modes, identify)
+        for bag, joints in zip(bags, finals, strict=True)
     ]

@@ -4,9 +4,10 @@ An arm's modes change with its configuration: in a vertical arm gravity stiffens
 each spring by ``g G sin(phi)``, and in any arm of two links or more the mass matrix turns
 with the relative joint angles. Modes measured at rest in several configurations therefore
 pin down each link's total stiffness k_tE (B.12, B.13) and its damping ``beta = c / k``
-(B.23), which one configuration alone rarely can: the model's modes (statics, then B.16
-linearized about the rest at the final joint angles q) are fitted to the measured ones by
-weighted nonlinear least squares, each residual over the measurement's standard deviation.
+(B.23), which one configuration can only when it shows at least one mode per link: the
+model's modes (statics, then B.16 linearized about the rest at the final joint angles q) are
+fitted to the measured ones by weighted nonlinear least squares, each residual over the
+measurement's standard deviation.
 
 The unknowns are log factors on the nominal arm's values, one for each link's stiffness and
 one for its damping, so both stay positive and the solver sees relative changes. A link given
@@ -29,8 +30,8 @@ Example::
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
@@ -74,6 +75,22 @@ class MeasuredMode:
     natural_frequency_hz_std: float
     damping_ratio: float
     damping_ratio_std: float
+
+    @classmethod
+    def from_json(cls, entry: Mapping[str, Any], where: str) -> MeasuredMode:
+        """A mode from an entry of ``lumpbeam analyze``'s ``modes`` list (extra keys ignored).
+
+        Raises:
+            LumpbeamError: A key missing, or a value that is not a number (null: no
+                estimate).
+        """
+        values = []
+        for key in (f.name for f in fields(cls)):
+            value = entry.get(key)
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise LumpbeamError(f'{where}: {key} is {value!r}, not a number')
+            values.append(float(value))
+        return cls(*values)
 
     def check(self, where: str) -> None:
         """Refuses a mode that cannot be fitted.

@@ -39,6 +39,8 @@ def plot_shaping_outcome(outcome: ShapingOutcome, path: str | Path) -> Path:
             color=color,
             label=f'{label}: residual {1e3 * residual.residual_m:.3g} mm RMS',
         )
+    top = max(float(outcome.unshaped.distance_m.max(initial=0.0)), 1e-9) * 1e3
+    ax.set_ylim(0.0, 1.3 * top)  # room for the legend above the curves
     ax.set_xlabel('time after the move ends (s)')
     ax.set_ylabel("tip's distance from its rest (mm)")
     ax.set_title(f'residual vibration {100 * outcome.reduction:.1f} % less with input shaping')

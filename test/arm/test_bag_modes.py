@@ -11,6 +11,7 @@ from lumpbeam_ros.arm.bag_modes import (
     read_joint_states,
     ringdown_modes,
 )
+from lumpbeam_ros.arm.link_fit import MeasuredMode
 from lumpbeam_ros.arm.model import ArmModel
 from lumpbeam_ros.arm.statics import arm_modes
 from lumpbeam_ros.bagio import BagWriter
@@ -90,3 +91,17 @@ def test_a_joint_state_recorded_twice_counts_once(tmp_path):
     joints = read_joint_states(tmp_path / 'twice')
     assert joints.t == pytest.approx([0.0, 0.1, 0.2])
     assert read_final_joints(tmp_path / 'twice').rest_from_s == pytest.approx(0.1)
+
+
+def test_another_identifier_plugs_into_the_seam(bags):
+    seen = {}
+
+    def identify(t, x, z, max_modes):
+        seen.update(start=t[0], count=t.size, max_modes=max_modes)
+        return [MeasuredMode(2.0, 0.01, 0.02, 0.001)]
+
+    (observation,) = bag_observations([bags['a']], ONE, max_modes=5, identify=identify)
+    assert observation.modes == (MeasuredMode(2.0, 0.01, 0.02, 0.001),)
+    assert seen['start'] == pytest.approx(0.5, abs=1 / 180) and seen['max_modes'] == 5
+    with pytest.raises(BagError, match='no mode stands out of the noise'):
+        bag_observation(bags['a'], identify=lambda *_: [])

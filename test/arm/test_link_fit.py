@@ -210,3 +210,18 @@ def test_more_modes_than_the_model_has_is_refused():
     mode = MeasuredMode(2.0, 0.01, 0.01, 0.001)
     with pytest.raises(LumpbeamError, match='2 modes measured, more than the arm model has'):
         LinkParameterFit(arm).fit([ModeObservation(np.zeros(1), (mode, mode), 'bag_d')])
+
+
+def test_a_mode_from_the_json_of_analyze():
+    entry = {
+        'natural_frequency_hz': 2.0,
+        'natural_frequency_hz_std': 0.01,
+        'damping_ratio': 0.02,
+        'damping_ratio_std': 0.001,
+        'amplitude_m': 0.004,
+    }
+    assert MeasuredMode.from_json(entry, 'bag') == MeasuredMode(2.0, 0.01, 0.02, 0.001)
+    with pytest.raises(LumpbeamError, match='bag: mode 2: damping_ratio_std is None, not a'):
+        MeasuredMode.from_json({**entry, 'damping_ratio_std': None}, 'bag: mode 2')
+    with pytest.raises(LumpbeamError, match='natural_frequency_hz is None'):
+        MeasuredMode.from_json({}, 'bag')
