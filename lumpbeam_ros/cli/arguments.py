@@ -296,8 +296,8 @@ def add_analyze(parser: argparse.ArgumentParser) -> None:
         'beside the modes of this arm file at the final joint angles',
     )
     add_report(parser)
+    # --arm (above) names the arm file --fit-links starts from: declared once.
     arm = parser.add_argument_group("an arm's links from its ring-downs (doc/arm.md)")
-    arm.add_argument('--arm', metavar='FILE', help='arm configuration file (nominal values)')
     arm.add_argument(
         '--fit-links',
         action='store_true',
@@ -584,6 +584,15 @@ def add_demo(parser: argparse.ArgumentParser) -> None:
         metavar='NAME=VALUE',
         help='effect hidden in the data for the diagnosis (repeatable; default '
         'sensor_latency=0.015); --effect none hides nothing',
+    )
+    parser.add_argument(
+        '--arm',
+        nargs='?',
+        const='',
+        metavar='FILE',
+        help='the input-shaping loop on a simulated flexible arm instead of the drop test: an '
+        'unshaped move rings, its modes are identified live, the move back is shaped '
+        '(arm file; default config/arm_rotary.yaml)',
     )
 
 

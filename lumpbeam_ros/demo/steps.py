@@ -30,7 +30,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol, TypeVar
 
 from lumpbeam_ros.bagio import BagReader, read_tip_poses
 from lumpbeam_ros.demo.graph import (
@@ -236,6 +236,14 @@ class DemoRun:
 Step = tuple[str, Callable[[DemoRun], None]]
 
 
+class _HasOut(Protocol):
+    @property
+    def out(self) -> Path: ...
+
+
+RunT = TypeVar('RunT', bound=_HasOut)
+
+
 def module_available(name: str) -> bool:
     """Whether a module of this package is installed (without importing it)."""
     try:
@@ -249,7 +257,7 @@ def synthesize(run: DemoRun) -> None:
     from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
     from lumpbeam_ros.synthetic.images import ImageOptions
 
-    bags = _fresh_bags_dir(run.out / BAGS_DIR)
+    bags = fresh_bags_dir(run.out / BAGS_DIR)
     run.input_bag = bags / 'input'
     run.recorded_bag = bags / 'recorded'
     run.normalized_bag = bags / 'recorded_sim_time'
@@ -659,16 +667,29 @@ def run_demo(
             f'{drop.release_time_s:g} s'
         )
     run = DemoRun(options=options, beam=beam, drop=drop, echo=echo)
-    steps = list(default_steps() if steps is None else steps)
+    run_steps(run, list(default_steps() if steps is None else steps), run.step_seconds, echo)
+    return run
+
+
+def run_steps(
+    run: RunT,
+    steps: Sequence[tuple[str, Callable[[RunT], None]]],
+    step_seconds: dict[str, float],
+    echo: Callable[[str], None],
+) -> None:
+    """Runs steps on a run in order, numbering them and timing each into ``step_seconds``.
+
+    Raises:
+        LumpbeamError: What a step raised.
+    """
     started = time.monotonic()
     for index, (name, step) in enumerate(steps, start=1):
         echo(f'[{index}/{len(steps)}] {name}')
         t0 = time.monotonic()
         step(run)
-        run.step_seconds[name] = round(time.monotonic() - t0, 2)
-    run.step_seconds['total'] = round(time.monotonic() - started, 2)
-    echo(f'demo finished in {run.step_seconds["total"]:.1f} s; results in {options.out}')
-    return run
+        step_seconds[name] = round(time.monotonic() - t0, 2)
+    step_seconds['total'] = round(time.monotonic() - started, 2)
+    echo(f'demo finished in {step_seconds["total"]:.1f} s; results in {run.out}')
 
 
 def _analysis(run: DemoRun) -> RecordingAnalysis:
@@ -677,7 +698,12 @@ def _analysis(run: DemoRun) -> RecordingAnalysis:
     return run.analysis
 
 
-def _fresh_bags_dir(path: Path) -> Path:
+def fresh_bags_dir(path: Path) -> Path:
+    """Empties (or makes) the demo's bags folder, refusing one the demo did not make.
+
+    Raises:
+        LumpbeamError: ``path`` exists without the demo's marker.
+    """
     if path.exists():
         if not (path / MARKER).exists():
             raise LumpbeamError(f'{path} exists and was not made by lumpbeam demo; move it away')

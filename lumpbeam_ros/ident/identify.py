@@ -294,12 +294,12 @@ def _fit_decay(
     return params
 
 
-def lowest_mode(params: DampedSinusoidParams) -> int:
+def lowest_mode(params: DampedSinusoidParameters) -> int:
     """The index of the fitted mode of lowest frequency: the first mode of the report."""
     return min(structural_modes(params), key=lambda m: params.mode(m).natural_frequency_hz)
 
 
-def identified_modes(params: DampedSinusoidParams) -> tuple[IdentifiedMode, ...]:
+def identified_modes(params: DampedSinusoidParameters) -> tuple[IdentifiedMode, ...]:
     """Every fitted mode (not a harmonic) with its standard deviations, by frequency."""
     modes = sorted(
         (params.mode(m) for m in structural_modes(params)), key=lambda m: m.natural_frequency_hz
@@ -575,7 +575,7 @@ def _report(
     )
 
 
-def _second_mode_hz(params: DampedSinusoidParams) -> float:
+def _second_mode_hz(params: DampedSinusoidParameters) -> float:
     """Damped frequency of the second-lowest fitted mode (NaN with one mode)."""
     modes = identified_modes(params)
     if len(modes) < 2:

@@ -35,7 +35,7 @@ from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.mode_estimate import TWO_PI, ModeEstimate
 from lumpbeam_ros.ident.pencil import MatrixPencil
 from lumpbeam_ros.ident.settings import IdentifierConfig
-from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParams, ModeGuess
+from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParameters, ModeGuess
 
 #: A mode must lie below this fraction of the Nyquist frequency (aliasing, the camera's
 #: own response near Nyquist).
@@ -57,7 +57,7 @@ _PENCIL_MAX_POINTS = 1024
 _SCREEN_FRACTION = 0.5
 
 
-def harmonic_of(params: DampedSinusoidParams, index: int) -> int | None:
+def harmonic_of(params: DampedSinusoidParameters, index: int) -> int | None:
     """The stronger mode whose harmonic the fitted mode ``index`` is, or ``None``.
 
     A large swing puts harmonics of a mode into the tip's motion (the tip's arc, a stiffening
@@ -82,7 +82,7 @@ def _harmonic_of(modes: list[ModeEstimate], index: int) -> int | None:
     return None
 
 
-def structural_modes(params: DampedSinusoidParams) -> list[int]:
+def structural_modes(params: DampedSinusoidParameters) -> list[int]:
     """The indices of the fitted modes that are not harmonics of another."""
     modes = [params.mode(m) for m in range(params.n_modes)]
     return [m for m in range(len(modes)) if _harmonic_of(modes, m) is None]
@@ -98,7 +98,7 @@ class ModeChoice:
         refused: Why the search stopped: the refused mode's figures, or what was missing.
     """
 
-    params: DampedSinusoidParams
+    params: DampedSinusoidParameters
     threshold: float
     refused: str
 
@@ -116,7 +116,7 @@ def detection_threshold(n_samples: int, false_alarm: float) -> float:
     return math.sqrt(2.0 * math.log(max(n_samples, 2) / false_alarm))
 
 
-def mode_significance(params: DampedSinusoidParams, index: int) -> float:
+def mode_significance(params: DampedSinusoidParameters, index: int) -> float:
     """The Wald statistic ``sqrt([a b] C^-1 [a b]^T)`` of one fitted mode's amplitude.
 
     Args:
@@ -137,7 +137,7 @@ def mode_significance(params: DampedSinusoidParams, index: int) -> float:
 
 
 def choose_modes(
-    t: np.ndarray, z: np.ndarray, params: DampedSinusoidParams, config: IdentifierConfig
+    t: np.ndarray, z: np.ndarray, params: DampedSinusoidParameters, config: IdentifierConfig
 ) -> ModeChoice:
     """Adds modes to a fitted decay while each new one passes the noise test.
 
@@ -182,7 +182,7 @@ def choose_modes(
     return ModeChoice(params, threshold, refused)
 
 
-def _fitted_frequencies(params: DampedSinusoidParams) -> list[float]:
+def _fitted_frequencies(params: DampedSinusoidParameters) -> list[float]:
     """Damped frequencies of the fitted modes, Hz (from the parameters alone)."""
     return [float(params.x[params.mode_slice(m)][3]) / TWO_PI for m in range(params.n_modes)]
 
@@ -190,7 +190,7 @@ def _fitted_frequencies(params: DampedSinusoidParams) -> list[float]:
 def _next_mode(
     t: np.ndarray,
     z: np.ndarray,
-    params: DampedSinusoidParams,
+    params: DampedSinusoidParameters,
     band: tuple[float, float],
     resolution: float,
 ) -> ModeGuess | None:
@@ -213,8 +213,8 @@ def _next_mode(
 
 
 def _screened(
-    t: np.ndarray, z: np.ndarray, params: DampedSinusoidParams, guess: ModeGuess
-) -> tuple[float, DampedSinusoidParams]:
+    t: np.ndarray, z: np.ndarray, params: DampedSinusoidParameters, guess: ModeGuess
+) -> tuple[float, DampedSinusoidParameters]:
     """The guessed mode's amplitude in sigmas with its pole held, and the refit's start.
 
     With the pole fixed the mode is linear in ``(a, b)``: its statistic is
@@ -237,14 +237,16 @@ def _screened(
     return screen, replace(params, x=x, n_modes=params.n_modes + 1)
 
 
-def _refit(t: np.ndarray, z: np.ndarray, start: DampedSinusoidParams) -> DampedSinusoidParams:
+def _refit(
+    t: np.ndarray, z: np.ndarray, start: DampedSinusoidParameters
+) -> DampedSinusoidParameters:
     """The least-squares fit from ``start`` (the last solution with the new mode added)."""
     fit = DampedSinusoidFit(n_modes=start.n_modes, drift=start.drift, nonlinear=start.nonlinear)
     return fit.fit(t, z, t0=start.t0, start=start)
 
 
 def _why_not(
-    trial: DampedSinusoidParams,
+    trial: DampedSinusoidParameters,
     band: tuple[float, float],
     resolution: float,
     threshold: float,
