@@ -218,8 +218,6 @@ def loop(run: ArmDemoRun) -> None:
         '-r',
         f'{TIP_POSE_PREDICTED[1:]}:={TIP_POSE_TRUTH[1:]}',
         '-r',
-        f'{TIP_POSE[1:]}:={REAL_ARM}/measured_tip_unused',
-        '-r',
         f'{JOINT_STATES[1:]}:={REAL_ARM}{JOINT_STATES}',
         '-r',
         f'{BEAM_MARKERS[1:]}:={REAL_ARM}{BEAM_MARKERS}',
