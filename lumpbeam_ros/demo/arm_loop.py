@@ -103,6 +103,8 @@ LEAD_S = 1.0
 MARGIN_S = 0.5
 #: Move 2 waits until move 1's vibration has decayed to this fraction of its amplitude.
 LEFT_RINGING = 0.02
+#: ... but at most this long, s (a lightly damped arm would keep the demo waiting minutes).
+MAX_GAP_S = 30.0
 #: Longest wait for the identifier's OK estimate and the shaper's adoption after move 1, s.
 ESTIMATE_TIMEOUT_S = 60.0
 #: Longest wait for the simulators to publish past a residual window, s (wall time: a busy
@@ -373,8 +375,15 @@ def _drive(graph: ProcessGraph, run: ArmDemoRun) -> None:
         )
         # What move 1 leaves ringing adds to move 2's residual (the arm inherits it): wait
         # until the identified modes have decayed enough that it cannot count.
-        gap = max(WINDOW_S + MARGIN_S, settle_time(seen['ok']))
+        settle = settle_time(seen['ok'])
+        gap = min(max(WINDOW_S + MARGIN_S, settle), MAX_GAP_S)
         run.echo(f'  move 2 starts {gap:.1f} s after move 1 ends (the ring-down below 2 %)')
+        if settle > gap:
+            left = LEFT_RINGING ** (gap / settle)
+            run.echo(
+                f'  warning: the ring-down takes {settle:.0f} s to fall below 2 %; after '
+                f'{gap:g} s, {100 * left:.0f} % of it is left and counts against move 2'
+            )
         spin_until(
             lambda: seen['tip_s'] >= end_1 + gap - LEAD_S,
             gap + RECORD_TIMEOUT_S,
