@@ -34,6 +34,7 @@ import numpy as np
 from lumpbeam_ros.arm.config import ArmConfig, load_arm_config
 from lumpbeam_ros.arm.residual import WINDOW_S
 from lumpbeam_ros.demo.graph import ProcessGraph, node_command, python_command, wait_for_graph
+from lumpbeam_ros.demo.steps import BAGS_DIR, DemoFolders, fresh_bags_dir, run_steps
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.interface import (
     BEAM_MARKERS,
@@ -136,7 +137,7 @@ class ArmDemoOptions:
 
 
 @dataclass
-class ArmDemoRun:
+class ArmDemoRun(DemoFolders):
     """The state the steps share and fill in.
 
     Attributes:
@@ -164,16 +165,6 @@ class ArmDemoRun:
     figure: Path = Path()
     summary: dict[str, Any] = field(default_factory=dict)
     step_seconds: dict[str, float] = field(default_factory=dict)
-
-    @property
-    def out(self) -> Path:
-        """The output folder."""
-        return self.options.out
-
-    @property
-    def log_dir(self) -> Path:
-        """Where the child processes' logs go."""
-        return self.options.out / 'logs'
 
 
 def minimum_jerk(start: np.ndarray, end: np.ndarray, duration_s: float) -> JointTrajectory:
@@ -205,8 +196,6 @@ def the_moves(arm: ArmConfig) -> tuple[JointTrajectory, JointTrajectory]:
 
 def loop(run: ArmDemoRun) -> None:
     """Runs the live graph through both moves and records it (``out/bags/recorded``)."""
-    from lumpbeam_ros.demo.steps import BAGS_DIR, fresh_bags_dir
-
     bags = fresh_bags_dir(run.out / BAGS_DIR)
     run.recorded_bag = bags / 'recorded'
     arm = str(run.options.arm_config)
@@ -539,8 +528,6 @@ def run_arm_demo(options: ArmDemoOptions, echo: Callable[[str], None] = print) -
         LumpbeamError: A step failed (its child processes are stopped first), or the
             shaped move rang less than 90 % less.
     """
-    from lumpbeam_ros.demo.steps import run_steps
-
     run = ArmDemoRun(options=options, arm=load_arm_config(options.arm_config), echo=echo)
     run_steps(run, arm_steps(), run.step_seconds, echo)
     return run

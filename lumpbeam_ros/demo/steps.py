@@ -30,7 +30,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol, TypeVar
+from typing import Any, TypeVar
 
 from lumpbeam_ros.bagio import BagReader, read_tip_poses
 from lumpbeam_ros.demo.graph import (
@@ -175,8 +175,24 @@ class DemoOptions:
     effects: Mapping[str, float] = field(default_factory=lambda: dict(HIDDEN_EFFECT))
 
 
+class DemoFolders:
+    """The folders of a demo run under its ``options.out`` (a base of the runs' state)."""
+
+    options: Any
+
+    @property
+    def out(self) -> Path:
+        """The output folder."""
+        return Path(self.options.out)
+
+    @property
+    def log_dir(self) -> Path:
+        """Where the child processes' logs go."""
+        return self.out / 'logs'
+
+
 @dataclass
-class DemoRun:
+class DemoRun(DemoFolders):
     """The state the steps share and fill in.
 
     Attributes:
@@ -218,16 +234,6 @@ class DemoRun:
     step_seconds: dict[str, float] = field(default_factory=dict)
 
     @property
-    def out(self) -> Path:
-        """The output folder."""
-        return self.options.out
-
-    @property
-    def log_dir(self) -> Path:
-        """Where the child processes' logs go."""
-        return self.options.out / 'logs'
-
-    @property
     def counts_dir(self) -> Path:
         """Where the nodes leave their message counts."""
         return self.log_dir / 'counts'
@@ -236,12 +242,7 @@ class DemoRun:
 Step = tuple[str, Callable[[DemoRun], None]]
 
 
-class _HasOut(Protocol):
-    @property
-    def out(self) -> Path: ...
-
-
-RunT = TypeVar('RunT', bound=_HasOut)
+RunT = TypeVar('RunT', bound=DemoFolders)
 
 
 def module_available(name: str) -> bool:
