@@ -46,12 +46,12 @@ setup(
     python_requires='>=3.10',
     entry_points={
         'console_scripts': [
-            'lumpbeam = lumpbeam_ros.cli.main:main',
-            'identifier_node = lumpbeam_ros.nodes.identifier_node:main',
-            'simulator_node = lumpbeam_ros.nodes.simulator_node:main',
-            'camera_node = lumpbeam_ros.nodes.camera_node:main',
-            'diagnosis_node = lumpbeam_ros.nodes.diagnosis_node:main',
-            'shaper_node = lumpbeam_ros.nodes.shaper_node:main',
+            'lumpbeam = lumpbeam_ros.cli.script:lumpbeam',
+            'identifier_node = lumpbeam_ros.nodes.scripts:identifier_node',
+            'simulator_node = lumpbeam_ros.nodes.scripts:simulator_node',
+            'camera_node = lumpbeam_ros.nodes.scripts:camera_node',
+            'diagnosis_node = lumpbeam_ros.nodes.scripts:diagnosis_node',
+            'shaper_node = lumpbeam_ros.nodes.scripts:shaper_node',
         ],
     },
 )

@@ -585,6 +585,15 @@ def add_demo(parser: argparse.ArgumentParser) -> None:
         help='effect hidden in the data for the diagnosis (repeatable; default '
         'sensor_latency=0.015); --effect none hides nothing',
     )
+    parser.add_argument(
+        '--arm',
+        nargs='?',
+        const='',
+        metavar='FILE',
+        help='the input-shaping loop on a simulated flexible arm instead of the drop test: an '
+        'unshaped move rings, its modes are identified live, the move back is shaped '
+        '(arm file; default config/arm_rotary.yaml)',
+    )
 
 
 def workers_count(text: str) -> int:

@@ -1,4 +1,7 @@
-"""``lumpbeam demo [--out DIR]``: the whole pipeline on the built-in synthetic experiment."""
+"""``lumpbeam demo [--out DIR] [--arm [FILE]]``: the pipeline on the built-in experiment.
+
+Without ``--arm`` the synthetic drop test; with it the input-shaping loop on an arm.
+"""
 
 from __future__ import annotations
 
@@ -27,6 +30,8 @@ def run(args: argparse.Namespace) -> int:
         )
     if args.out.exists() and not args.out.is_dir():
         raise LumpbeamError(f'--out {args.out} is a file, not a folder')
+    if args.arm is not None:
+        return _run_arm(args)
     from lumpbeam_ros.demo.steps import HIDDEN_EFFECT
     from lumpbeam_ros.synthetic.drop_test import parse_effect
     from lumpbeam_ros.synthetic.images import parse_image_size
@@ -49,6 +54,38 @@ def run(args: argparse.Namespace) -> int:
         effects=effects,
     )
     result = run_demo(options, echo=lambda line: print(line, flush=True))
+    if args.json is not None:
+        write_json(args.json, result.summary)
+    return 0
+
+
+#: The options of the drop test that the arm demo has no use for, with their defaults.
+BEAM_ONLY = {
+    'duration': 12.0,
+    'seed': 0,
+    'adopt': False,
+    'config': None,
+    'effect': None,
+    'image_size': '640x480',
+    'no_images': False,
+}
+
+
+def _run_arm(args: argparse.Namespace) -> int:
+    """Runs the arm demo (``--arm``); refuses the drop test's options beside it."""
+    from pathlib import Path
+
+    from lumpbeam_ros.demo.arm_loop import ArmDemoOptions, run_arm_demo
+    from lumpbeam_ros.errors import LumpbeamError
+    from lumpbeam_ros.resources import config_path
+
+    given = [name for name, default in BEAM_ONLY.items() if getattr(args, name) != default]
+    if given:
+        option = '--' + given[0].replace('_', '-')
+        raise LumpbeamError(f'{option} is an option of the drop-test demo, not of --arm')
+    arm = Path(args.arm) if args.arm else config_path('arm_rotary.yaml')
+    options = ArmDemoOptions(arm_config=arm, out=args.out, domain_id=args.domain_id)
+    result = run_arm_demo(options, echo=lambda line: print(line, flush=True))
     if args.json is not None:
         write_json(args.json, result.summary)
     return 0

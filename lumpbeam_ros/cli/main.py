@@ -7,25 +7,24 @@ that runs it, imported only once the command is chosen: ``lumpbeam --help`` and
 :class:`~lumpbeam_ros.errors.LumpbeamError`, a missing optional package or a path the
 system refuses (an ``OSError`` naming a file: a name too long, no permission, no space)
 becomes one line on stderr and exit code 2. SIGTERM stops a command as Ctrl-C does (files
-being written are closed or removed on the way out), exit code 128 + the signal.
+being written are closed or removed on the way out), exit code 128 + the signal, also under
+``python -m lumpbeam_ros.cli.main`` (:mod:`lumpbeam_ros.interrupts` says why that needs care).
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
-import signal
 import sys
-import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
-from types import FrameType
 from typing import NamedTuple
 
 from lumpbeam_ros import __version__
 from lumpbeam_ros.cli import arguments
 from lumpbeam_ros.cli.dependencies import missing_package_message
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interrupts import interrupt_on_signals, restore_handlers, signal_number
 
 USAGE_ERROR = 2
 
@@ -115,7 +114,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         else the subcommand's code.
     """
     args = build_parser().parse_args(argv)
-    with _sigterm_interrupts() as received:
+    with _signals_interrupt():
         try:
             return int(load_target(args.target)(args) or 0)
         except LumpbeamError as exc:
@@ -132,9 +131,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                 raise
             print(f'lumpbeam {args.command}: error: {_os_error_line(exc)}', file=sys.stderr)
             return USAGE_ERROR
-        except KeyboardInterrupt:
+        except KeyboardInterrupt as exc:
             print(f'lumpbeam {args.command}: interrupted', file=sys.stderr)
-            return 128 + (received[0] if received else signal.SIGINT)
+            return 128 + signal_number(exc)
 
 
 def _os_error_line(exc: OSError) -> str:
@@ -144,30 +143,18 @@ def _os_error_line(exc: OSError) -> str:
 
 
 @contextmanager
-def _sigterm_interrupts() -> Iterator[list[int]]:
-    """Within the block, SIGTERM raises ``KeyboardInterrupt`` as Ctrl-C does.
+def _signals_interrupt() -> Iterator[None]:
+    """Within the block, SIGINT and SIGTERM raise an interrupt (``KeyboardInterrupt``).
 
     Python's default SIGTERM ends the process at once, leaving a bag being written without
     its summary. A command that handles its signals itself (``play``, ``record``) installs
     its own handlers inside the block. Outside the main thread nothing is changed.
-
-    Yields:
-        The signals received (SIGTERM), for the exit code.
     """
-    received: list[int] = []
-    if threading.current_thread() is not threading.main_thread():
-        yield received
-        return
-
-    def interrupt(signum: int, _frame: FrameType | None) -> None:
-        received.append(signum)
-        raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGTERM, interrupt)
+    previous = interrupt_on_signals()
     try:
-        yield received
+        yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        restore_handlers(previous)
 
 
 if __name__ == '__main__':

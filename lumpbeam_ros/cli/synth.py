@@ -86,7 +86,7 @@ def _write_arm(args: argparse.Namespace) -> int:
     """``--arm FILE --trajectory FILE``: the arm moved along the trajectory."""
     from lumpbeam_ros.arm.config import load_arm_config
     from lumpbeam_ros.motion.joint_trajectory import read_trajectory_csv
-    from lumpbeam_ros.synthetic.arm_bag import ArmSynthOptions, write_arm_bag
+    from lumpbeam_ros.synthetic.arm_bag import CAMERA_FILE, ArmSynthOptions, write_arm_bag
 
     if args.arm is None or args.trajectory is None:
         raise LumpbeamError('--arm and --trajectory go together')
@@ -97,7 +97,6 @@ def _write_arm(args: argparse.Namespace) -> int:
             ('--config', args.config is not None),
             ('--effect', bool(args.effect)),
             ('--tracker', args.tracker),
-            ('--images', args.images),
         )
         if given
     ]
@@ -108,10 +107,20 @@ def _write_arm(args: argparse.Namespace) -> int:
     options = ArmSynthOptions(
         duration_s=args.duration, rate_hz=args.rate, noise_m=args.noise, seed=args.seed
     )
-    motion = write_arm_bag(args.out, config, trajectory, options)
+    images = None
+    if args.images:
+        width, height = parse_image_size(args.image_size)
+        images = ImageOptions(width, height, args.camera_config, args.seed)
+    motion = write_arm_bag(args.out, config, trajectory, options, images)
     print(
         f'wrote {args.out}: {config.n_joints}-link arm along {args.trajectory} '
         f'({trajectory.duration_s:g} s), {motion.t.size} poses and joint states at '
         f'{args.rate:g} Hz over {args.duration:g} s, noise {args.noise * 1e6:g} um'
     )
+    if images is not None:
+        print(
+            f'  + {motion.t.size} mono8 frames of {images.width}x{images.height} px from the tip '
+            f'camera; the board faces it at rest after the move: track with '
+            f'--config {args.out}/{CAMERA_FILE}'
+        )
     return 0

@@ -40,11 +40,13 @@ def python_command(module: str, *args: str) -> list[str]:
 
 
 def node_command(module: str, *ros_args: str) -> list[str]:
-    """The command that runs a node module's ``main()`` with ``--ros-args ros_args``.
+    """The command that runs a node as its console script does, with ``--ros-args ros_args``.
 
-    ``main()`` is called directly, so the module needs no ``__main__`` guard.
+    Through :mod:`lumpbeam_ros.nodes.scripts`: the signal handlers come before the node's
+    imports, so stopping the demo early stops a node that is still starting.
     """
-    code = f'import sys; from {module} import main; sys.exit(main())'
+    script = module.rpartition('.')[2]
+    code = f'import sys; from lumpbeam_ros.nodes.scripts import {script}; sys.exit({script}())'
     return [sys.executable, '-c', code, '--ros-args', *ros_args]
 
 

@@ -30,7 +30,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from lumpbeam_ros.bagio import BagReader, read_tip_poses
 from lumpbeam_ros.demo.graph import (
@@ -175,8 +175,24 @@ class DemoOptions:
     effects: Mapping[str, float] = field(default_factory=lambda: dict(HIDDEN_EFFECT))
 
 
+class DemoFolders:
+    """The folders of a demo run under its ``options.out`` (a base of the runs' state)."""
+
+    options: Any
+
+    @property
+    def out(self) -> Path:
+        """The output folder."""
+        return Path(self.options.out)
+
+    @property
+    def log_dir(self) -> Path:
+        """Where the child processes' logs go."""
+        return self.out / 'logs'
+
+
 @dataclass
-class DemoRun:
+class DemoRun(DemoFolders):
     """The state the steps share and fill in.
 
     Attributes:
@@ -218,22 +234,15 @@ class DemoRun:
     step_seconds: dict[str, float] = field(default_factory=dict)
 
     @property
-    def out(self) -> Path:
-        """The output folder."""
-        return self.options.out
-
-    @property
-    def log_dir(self) -> Path:
-        """Where the child processes' logs go."""
-        return self.options.out / 'logs'
-
-    @property
     def counts_dir(self) -> Path:
         """Where the nodes leave their message counts."""
         return self.log_dir / 'counts'
 
 
 Step = tuple[str, Callable[[DemoRun], None]]
+
+
+RunT = TypeVar('RunT', bound=DemoFolders)
 
 
 def module_available(name: str) -> bool:
@@ -249,7 +258,7 @@ def synthesize(run: DemoRun) -> None:
     from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
     from lumpbeam_ros.synthetic.images import ImageOptions
 
-    bags = _fresh_bags_dir(run.out / BAGS_DIR)
+    bags = fresh_bags_dir(run.out / BAGS_DIR)
     run.input_bag = bags / 'input'
     run.recorded_bag = bags / 'recorded'
     run.normalized_bag = bags / 'recorded_sim_time'
@@ -659,16 +668,29 @@ def run_demo(
             f'{drop.release_time_s:g} s'
         )
     run = DemoRun(options=options, beam=beam, drop=drop, echo=echo)
-    steps = list(default_steps() if steps is None else steps)
+    run_steps(run, list(default_steps() if steps is None else steps), run.step_seconds, echo)
+    return run
+
+
+def run_steps(
+    run: RunT,
+    steps: Sequence[tuple[str, Callable[[RunT], None]]],
+    step_seconds: dict[str, float],
+    echo: Callable[[str], None],
+) -> None:
+    """Runs steps on a run in order, numbering them and timing each into ``step_seconds``.
+
+    Raises:
+        LumpbeamError: What a step raised.
+    """
     started = time.monotonic()
     for index, (name, step) in enumerate(steps, start=1):
         echo(f'[{index}/{len(steps)}] {name}')
         t0 = time.monotonic()
         step(run)
-        run.step_seconds[name] = round(time.monotonic() - t0, 2)
-    run.step_seconds['total'] = round(time.monotonic() - started, 2)
-    echo(f'demo finished in {run.step_seconds["total"]:.1f} s; results in {options.out}')
-    return run
+        step_seconds[name] = round(time.monotonic() - t0, 2)
+    step_seconds['total'] = round(time.monotonic() - started, 2)
+    echo(f'demo finished in {step_seconds["total"]:.1f} s; results in {run.out}')
 
 
 def _analysis(run: DemoRun) -> RecordingAnalysis:
@@ -677,7 +699,12 @@ def _analysis(run: DemoRun) -> RecordingAnalysis:
     return run.analysis
 
 
-def _fresh_bags_dir(path: Path) -> Path:
+def fresh_bags_dir(path: Path) -> Path:
+    """Empties (or makes) the demo's bags folder, refusing one the demo did not make.
+
+    Raises:
+        LumpbeamError: ``path`` exists without the demo's marker.
+    """
     if path.exists():
         if not (path / MARKER).exists():
             raise LumpbeamError(f'{path} exists and was not made by lumpbeam demo; move it away')

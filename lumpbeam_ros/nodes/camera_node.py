@@ -23,7 +23,12 @@ a topic cannot carry): a bag with ``bag_path`` (:meth:`CameraNode.run_bag`; ``Im
 with ``video_device`` (a device index such as ``0``, a device path such as ``/dev/video2``,
 or any file or URL OpenCV opens; each frame is stamped with the node's clock when it
 arrives) (:meth:`CameraNode.run_footage`). The readers are the ROS-free ones of
-:mod:`lumpbeam_ros.vision.sources`, shared with ``lumpbeam track``.
+:mod:`lumpbeam_ros.vision.sources`, shared with ``lumpbeam track``. A bag or footage is
+finite and read faster than real time, so the node first waits (``wait_for_subscriber_s``,
+bounded) until ``/tip_pose`` has a subscriber, as ``lumpbeam play --delay`` does, and before
+exiting until reliable subscribers have every pose: a subscriber started beside the node
+still gets the whole run. It does not pace the frames at the recording's rate: the
+in-process reading is there to track faster than a topic would carry the frames.
 
 The intrinsics come from ``/camera/camera_info``, or from a ROS camera calibration file
 given as ``camera_info_url`` (``file:///path/camera.yaml``, as camera_info_manager takes it),
@@ -45,6 +50,7 @@ import numpy as np
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
+from rclpy.duration import Duration
 from sensor_msgs.msg import CameraInfo as CameraInfoMsg
 from sensor_msgs.msg import Image
 
@@ -184,7 +190,8 @@ class CameraNode(SchemaNode):
     def run_bag(self, should_stop: Callable[[], bool] = lambda: False) -> None:
         """Tracks every frame of ``bag_path`` in recording order, publishing the poses.
 
-        A corrupt message is a lost frame, not the end of the bag.
+        A corrupt message is a lost frame, not the end of the bag. Once the bag is open, the
+        first frame waits for a subscriber (:meth:`wait_for_subscriber`).
 
         Args:
             should_stop: Polled between frames; ``True`` ends early.
@@ -198,6 +205,7 @@ class CameraNode(SchemaNode):
         msgtype = reader.require(image_topic).msgtype
         if msgtype not in IMAGE_TYPES:
             raise BagError(f'{reader.path}: topic {image_topic} has type {msgtype}, not an image')
+        self.wait_for_subscriber(should_stop)
         items = bag_frames(
             reader,
             self.session,
@@ -251,6 +259,8 @@ class CameraNode(SchemaNode):
             FootageError: The source cannot be opened (see :meth:`open_source`).
         """
         source = self.open_source()
+        if not self.video_device:  # a live camera's frames come at its pace, not faster
+            self.wait_for_subscriber(should_stop)
         try:
             for frame in source:
                 if frame.pixels is None:
@@ -265,6 +275,42 @@ class CameraNode(SchemaNode):
             self.get_logger().warning(
                 f'footage stopped: {exc}', throttle_duration_sec=self._warning_period
             )
+
+    def wait_for_subscriber(self, should_stop: Callable[[], bool] = lambda: False) -> bool:
+        """Waits until ``/tip_pose`` has a subscriber, at most ``wait_for_subscriber_s``.
+
+        A pose published before a subscriber is matched is lost to it, and a bag is read
+        through in seconds: a subscriber started with the node would miss the start or all.
+
+        Args:
+            should_stop: Polled while waiting; ``True`` ends the wait.
+
+        Returns:
+            Whether a subscriber is there (a warning says when none came).
+        """
+        wait_s = float(self._param('wait_for_subscriber_s'))
+        deadline = time.monotonic() + wait_s
+        while self.pose_publisher.get_subscription_count() == 0:
+            if time.monotonic() >= deadline or should_stop():
+                if wait_s > 0:
+                    self.get_logger().warning(
+                        f'no subscriber on {TIP_POSE} after {wait_s:g} s: tracking anyway'
+                    )
+                return False
+            time.sleep(0.02)
+        return True
+
+    def wait_for_delivery(self) -> bool:
+        """Waits until reliable subscribers acknowledged every pose (``wait_for_subscriber_s``).
+
+        A node that exits right after its last pose can take the poses still on their way
+        with it.
+
+        Returns:
+            Whether everything was acknowledged in time.
+        """
+        wait = Duration(seconds=float(self._param('wait_for_subscriber_s')))
+        return bool(self.pose_publisher.wait_for_all_acked(wait))
 
     # -- output -----------------------------------------------------------------------------
 
@@ -393,6 +439,7 @@ def _run(node: CameraNode) -> None:
         node.run_bag(should_stop)
     else:
         node.run_footage(should_stop)
+    node.wait_for_delivery()
     s = node.session.stats
     name = node.bag_path or node.footage_path or f'video device {node.video_device}'
     print(f'camera_node: {name}: {s.frames_in} frames, {s.poses_out} poses')

@@ -17,13 +17,11 @@ and their rclpy session and stop request from :func:`stoppable_session`.
 
 from __future__ import annotations
 
-import signal
 import sys
-import threading
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from types import FrameType
-from typing import Any, TypeVar
+from typing import TypeVar
 
 import rclpy
 from rclpy.exceptions import (
@@ -40,6 +38,7 @@ from rclpy.validate_namespace import validate_namespace
 from rclpy.validate_topic_name import validate_topic_name
 
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interrupts import interrupt_on_signals, restore_handlers
 from lumpbeam_ros.nodes.counts import write_counts
 
 #: Exit code of a node whose configuration is invalid.
@@ -70,10 +69,14 @@ def run_node(
         0 after a clean stop, :data:`CONFIG_ERROR` when the node cannot be built or ``run``
         fails on its configuration.
     """
-    previous = _interrupting_signals()
-    rclpy.init(args=list(args) if args is not None else None)
+    # Before rclpy.init: rclpy's handler shuts the context down (which ends a wait) and then
+    # calls the handler it found, this one, which interrupts a callback that computes.
+    # Without it SIGTERM, and SIGINT in a process started with SIGINT ignored (a background
+    # job), only shut the context down, and a callback busy in a long solve runs on.
+    previous = interrupt_on_signals()
     node: _N | None = None
     try:
+        rclpy.init(args=list(args) if args is not None else None)
         node = make()
         run(node)
     except (LumpbeamError, ParameterException) as exc:
@@ -91,29 +94,8 @@ def run_node(
             write_counts(name, published(node), received(node) if received else None)
             node.destroy_node()
         rclpy.try_shutdown()
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        restore_handlers(previous)
     return 0
-
-
-def _interrupt(_signum: int, _frame: FrameType | None) -> None:
-    raise KeyboardInterrupt
-
-
-def _interrupting_signals() -> dict[int, Any]:
-    """Makes SIGINT and SIGTERM raise ``KeyboardInterrupt`` in the main thread.
-
-    Installed before ``rclpy.init``: rclpy's handler shuts the context down (which ends a
-    wait) and then calls the handler it found, this one, which interrupts a callback that
-    computes. Without it SIGTERM, and SIGINT in a process started with SIGINT ignored (a
-    background job), only shut the context down, and a callback busy in a long solve runs on.
-
-    Returns:
-        The handlers replaced, to restore (nothing outside the main thread).
-    """
-    if threading.current_thread() is not threading.main_thread():
-        return {}
-    return {s: signal.signal(s, _interrupt) for s in (signal.SIGINT, signal.SIGTERM)}
 
 
 def checked_namespace(namespace: str | None) -> str:
@@ -193,11 +175,10 @@ def stoppable_session() -> Iterator[StopRequest]:
         The stop request the caller's loop polls.
     """
     stop = StopRequest()
-    previous = {s: signal.signal(s, stop._handle) for s in (signal.SIGINT, signal.SIGTERM)}
+    previous = interrupt_on_signals(stop._handle)
     try:
         rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
         yield stop
     finally:
         rclpy.try_shutdown()
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        restore_handlers(previous)

@@ -8,6 +8,16 @@ timer advances a :class:`~lumpbeam_ros.model.stream.PredictionStream` to the nod
 tick, each stamped with its model time. Another, at ``markers_rate_hz``, publishes
 ``/beam_markers`` (visualization_msgs/MarkerArray, :mod:`lumpbeam_ros.viz.markers`): the
 model's latest shape, its tip, the last ``/tip_pose`` it received, the load and the board.
+With ``arm_config`` naming an arm file (doc/arm.md) the node simulates the flexible arm
+instead (:class:`ArmMode`): it follows the JointTrajectory commands of ``arm_commands``
+(``/joint_trajectory`` or ``/joint_trajectory_shaped``) through
+:class:`~lumpbeam_ros.arm.stream.ArmStream` and publishes ``/joint_states`` (the commanded
+angles), ``/tip_pose_predicted`` (the last link's free end) and the whole arm on
+``/beam_markers``. A command is refused with a throttled warning, and the prediction left as
+it was, when it names a joint the arm does not have or not every joint once, has a point
+without one position per joint, a position or time that is not finite, times that do not
+increase, or a first point at time 0 away from the joints' angles. A command stamped 0 (or
+in the past) starts at the node's present, one stamped in the future at its stamp.
 Parameters: :data:`~lumpbeam_ros.params.simulator_params.SIMULATOR_SCHEMA`
 (``doc/parameters.md``); their defaults are the values of ``config/simulator.yaml``, where
 each is documented.
@@ -15,6 +25,7 @@ each is documented.
 Run it::
 
     simulator_node --ros-args --params-file config/simulator.yaml -p use_sim_time:=true
+    simulator_node --ros-args -p arm_config:=config/arm_3link.yaml
 """
 
 from __future__ import annotations
@@ -26,20 +37,34 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any, Unpack
 
+import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseStamped
 from rclpy.clock import Clock, ClockType
 from rclpy.parameter import Parameter
+from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
+from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
 from visualization_msgs.msg import MarkerArray
 
-from lumpbeam_ros.bagio.convert import NS_PER_S, pitch_to_quaternion, seconds_to_ns
+from lumpbeam_ros.arm.config import load_arm_config
+from lumpbeam_ros.arm.model import ArmModel
+from lumpbeam_ros.arm.stream import ArmSamples, ArmStream
+from lumpbeam_ros.bagio.convert import (
+    NS_PER_S,
+    joint_state,
+    pitch_to_quaternion,
+    seconds_to_ns,
+    time_ns,
+)
+from lumpbeam_ros.bagio.typestore import serialize
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.interface import (
     BASE_FRAME,
     BEAM_MARKERS,
     BEAM_PARAMS,
     IDENTIFIER_STATUS,
+    JOINT_STATES,
     TIP_LOAD,
     TIP_POSE,
     TIP_POSE_PREDICTED,
@@ -105,6 +130,13 @@ class SimulatorNode(SchemaNode):
         super().__init__(SIMULATOR_SCHEMA, self._on_change, **options)
         values = self.parameter_values
         self._settings = values
+        #: The arm being simulated (``arm_config`` given), else ``None``: the clamped beam.
+        self.arm: ArmMode | None = None
+        self.published = 0
+        self.markers_published = 0
+        if values['arm_config']:
+            self.arm = ArmMode(self, values)
+            return
         self._base_beam = load_beam(values['beam_config'])
         self._stream: PredictionStream | None = None
         self._load_kg = float(values['initial_load_kg'])
@@ -291,6 +323,8 @@ class SimulatorNode(SchemaNode):
 
     def _on_change(self, changes: Mapping[str, Any]) -> str | None:
         """Applies parameter changes the schema accepted; refuses a beam file that fails."""
+        if self.arm is not None:
+            return 'the arm mode takes its parameters at start only'
         new_beam = None
         effects = {
             effect: float(changes[effect_parameter_name(effect)])
@@ -395,6 +429,160 @@ class SimulatorNode(SchemaNode):
             self.published += 1
 
 
+class ArmMode:
+    """The simulator node's arm mode: commands in, the arm's prediction out.
+
+    Args:
+        node: The node (its clock, logger, endpoints).
+        values: Its parameter values.
+
+    Attributes:
+        stream: The arm's prediction.
+        accepted: Commands followed.
+        refused: Commands refused.
+        last_refusal: Why the last one was refused.
+
+    Raises:
+        ConfigError: The arm file is missing or malformed.
+    """
+
+    def __init__(self, node: SimulatorNode, values: Mapping[str, Any]):
+        self.node = node
+        self.values = values
+        config = load_arm_config(values['arm_config'])
+        self.model = ArmModel.from_config(config)
+        self.stream = ArmStream(
+            self.model, values['rate_hz'], values['arm_ring_down_s'], values['arm_history_s']
+        )
+        self.accepted = 0
+        self.refused = 0
+        self.last_refusal = ''
+        self.joint_states_published = 0
+        self._lengths = self.model.chain.segment_lengths
+        self._link_starts = tuple(int(k) for k in self.model.link_starts)
+        self._board = load_board(values['camera_config']) if values['camera_config'] else None
+        self._latest: ArmSamples | None = None
+        self._measured: tuple[float, TipPoint] | None = None
+        self._markers_stamp = -math.inf
+        self._time = -math.inf  # the clock at the last tick
+        self._pose_out = publisher(node, PoseStamped, TIP_POSE_PREDICTED)
+        self._joints_out = publisher(node, JointState, JOINT_STATES)
+        self._markers_out = publisher(node, MarkerArray, BEAM_MARKERS)
+        topic = values['arm_commands']
+        subscription(node, JointTrajectoryMsg, topic, self._on_command)
+        subscription(node, PoseStamped, TIP_POSE, self._on_measured)
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        node.create_timer(1.0 / values['tick_rate_hz'], self._tick, clock=steady)
+        if values['markers_rate_hz'] > 0.0:
+            period = 1.0 / values['markers_rate_hz']
+            node.create_timer(period, self._publish_markers, clock=steady)
+        node.get_logger().info(
+            f'simulator ready: {config.n_joints}-link arm ({self.model.chain.n} segments) from '
+            f'{values["arm_config"]}, following {topic}, {values["rate_hz"]:g} Hz'
+        )
+
+    def _now(self) -> float:
+        return float(self.node.get_clock().now().nanoseconds / NS_PER_S)
+
+    def _warn(self, text: str) -> None:
+        self.node.get_logger().warning(text, throttle_duration_sec=WARN_PERIOD_S)
+
+    def _on_command(self, msg: JointTrajectoryMsg) -> None:
+        now = self._now()
+        stamp = time_ns(msg.header.stamp) / NS_PER_S
+        start = max(stamp, now) if stamp > 0.0 else now
+        names = list(msg.joint_names)
+        try:
+            for i, point in enumerate(msg.points):
+                if len(point.positions) != len(names):
+                    raise LumpbeamError(
+                        f'point {i} has {len(point.positions)} positions for {len(names)} joints'
+                    )
+            times = [time_ns(p.time_from_start) / NS_PER_S for p in msg.points]
+            positions = np.array([list(p.positions) for p in msg.points], dtype=float)
+            self.stream.command(names, times, positions.reshape(len(times), len(names)), start)
+        except LumpbeamError as exc:
+            self.refused += 1
+            self.last_refusal = str(exc)
+            self._warn(
+                f'{self.values["arm_commands"]}: command refused ({exc}); '
+                f'{self.refused} refused so far'
+            )
+            return
+        self.accepted += 1
+        self.node.get_logger().info(
+            f'following a command of {len(times)} points from {start:.3f} s '
+            f'({times[-1]:.3f} s long)'
+        )
+
+    def _on_measured(self, msg: PoseStamped) -> None:
+        p = msg.pose.position
+        tip = TipPoint(float(p.x), float(p.z))
+        if msg.header.frame_id != BASE_FRAME or not tip.is_finite():
+            self._warn(f'ignoring /tip_pose in frame {msg.header.frame_id!r} at {tip}')
+            return
+        self._measured = (time_ns(msg.header.stamp) / NS_PER_S, tip)
+
+    def _tick(self) -> None:
+        now = self._now()
+        if now <= 0.0:
+            return  # under use_sim_time, no /clock yet
+        jumped_back = now < self._time - self.values['reset_jump_back_s']
+        jumped_ahead = now - self._time > self.values['max_catch_up_s']
+        if self.stream.started and self._time > 0.0 and (jumped_back or jumped_ahead):
+            self.node.get_logger().info(
+                f'clock jumped from {self._time:.3f} s to {now:.3f} s: the arm restarts at rest'
+            )
+            self.stream.restart_at(now)
+        self._time = now
+        try:
+            samples = self.stream.advance_to(now)
+        except LumpbeamError as exc:
+            self._warn(f'arm simulation failed: {exc}')
+            return
+        if len(samples):
+            self._latest = samples
+        for i in range(len(samples)):
+            self._publish(samples, i)
+
+    def _publish(self, samples: ArmSamples, i: int) -> None:
+        stamp_ns = seconds_to_ns(float(samples.t[i]))
+        msg = PoseStamped()
+        msg.header.frame_id = BASE_FRAME
+        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp_ns, NS_PER_S)
+        msg.pose.position.x = float(samples.tip_x[i])
+        msg.pose.position.z = float(samples.tip_z[i])
+        q = msg.pose.orientation
+        q.x, q.y, q.z, q.w = pitch_to_quaternion(float(samples.tip_pitch[i]))
+        self._pose_out.publish(msg)
+        self.node.published += 1
+        self._joints_out.publish(
+            serialize(joint_state(stamp_ns, self.stream.joint_names, samples.q[i]))
+        )
+        self.joint_states_published += 1
+
+    def _publish_markers(self) -> None:
+        latest = self._latest
+        if latest is None or latest.t[-1] == self._markers_stamp:
+            return
+        stamp = float(latest.t[-1])
+        measured = None
+        if self._measured is not None and abs(self._measured[0] - stamp) <= MEASURED_MAX_AGE_S:
+            measured = self._measured[1]
+        scene = BeamScene(
+            self._lengths,
+            phi=latest.phi[-1],
+            measured=measured,
+            predicted=TipPoint(float(latest.tip_x[-1]), float(latest.tip_z[-1])),
+            board=self._board,
+            link_starts=self._link_starts,
+        )
+        lifetime = lifetime_for_rate(self.values['markers_rate_hz'])
+        self._markers_out.publish(scene_cdr(scene, seconds_to_ns(stamp), lifetime))
+        self.node.markers_published += 1
+        self._markers_stamp = stamp
+
+
 def _carries(beam: BeamParameters, load_kg: float) -> bool:
     """Whether the beam has a static equilibrium under ``load_kg`` at its tip."""
     try:
@@ -409,6 +597,13 @@ def _level(status: DiagnosticStatus) -> int:
     return level[0] if isinstance(level, bytes) else int(level)
 
 
+def _published(node: SimulatorNode) -> dict[str, int]:
+    counts = {TIP_POSE_PREDICTED: node.published, BEAM_MARKERS: node.markers_published}
+    if node.arm is not None:
+        counts[JOINT_STATES] = node.arm.joint_states_published
+    return counts
+
+
 def main(args: Sequence[str] | None = None) -> int:
     """Runs the simulator node until Ctrl-C (console script ``simulator_node``).
 
@@ -421,7 +616,7 @@ def main(args: Sequence[str] | None = None) -> int:
     return run_node(
         SIMULATOR_SCHEMA.node,
         SimulatorNode,
-        lambda node: {TIP_POSE_PREDICTED: node.published, BEAM_MARKERS: node.markers_published},
+        _published,
         args,
     )
 

@@ -96,6 +96,15 @@ _NODE = (
         "extrinsics, the camera's pose in the board's frame)",
         choices=POSE_MODELS,
     ),
+    _double(
+        'wait_for_subscriber_s',
+        5.0,
+        'with bag_path or footage_path: wait at most this long for a /tip_pose subscriber '
+        'before the first frame, and for reliable subscribers to acknowledge the last poses '
+        'before exiting (0: neither)',
+        's',
+        _NON_NEGATIVE,
+    ),
     _double('diagnostics_period_s', 1.0, 'period of /diagnostics', 's'),
     _double(
         'warning_period_s',

@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
-from lumpbeam_ros.interface import MARKERS_RATE_HZ, POSE_RATE_HZ, SIMULATOR_NODE
+from lumpbeam_ros.interface import (
+    JOINT_TRAJECTORY,
+    JOINT_TRAJECTORY_SHAPED,
+    MARKERS_RATE_HZ,
+    POSE_RATE_HZ,
+    SIMULATOR_NODE,
+)
 from lumpbeam_ros.model.parameters import EFFECTS, EffectRecord
 from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec
 
@@ -29,8 +35,9 @@ def _effect_spec(record: EffectRecord) -> ParameterSpec:
 SIMULATOR_SCHEMA = ParameterSchema(
     node=SIMULATOR_NODE,
     summary=(
-        'The lumped beam run in step with the node clock, publishing the predicted tip pose. '
-        'Every parameter can be changed while it runs (`ros2 param set`).'
+        'The lumped beam run in step with the node clock, publishing the predicted tip pose; '
+        'or, with an arm file, the flexible arm following its joint commands. Every parameter '
+        'but the arm ones can be changed while it runs (`ros2 param set`).'
     ),
     config_file='simulator.yaml',
     parameters=(
@@ -111,6 +118,40 @@ SIMULATOR_SCHEMA = ParameterSchema(
             'camera parameter file whose checkerboard /beam_markers draws; empty: the '
             "package's camera.yaml",
             read_only=False,
+        ),
+        ParameterSpec(
+            'arm_config',
+            'string',
+            '',
+            'arm file (as config/arm_3link.yaml); empty: the clamped beam of beam_config. Given, '
+            'the node simulates the arm following its joint commands and publishes /joint_states '
+            'too; the beam parameters (loads, effects, adoption) are then unused',
+        ),
+        ParameterSpec(
+            'arm_commands',
+            'string',
+            JOINT_TRAJECTORY,
+            "the arm follows the joint trajectories of this topic: the planner's, or the "
+            "shaper node's",
+            choices=(JOINT_TRAJECTORY, JOINT_TRAJECTORY_SHAPED),
+        ),
+        ParameterSpec(
+            'arm_ring_down_s',
+            'double',
+            10.0,
+            "each simulation of the arm reaches this far past the last command's end (then "
+            'it is extended)',
+            's',
+            Bounds(0.1, 3600.0),
+        ),
+        ParameterSpec(
+            'arm_history_s',
+            'double',
+            60.0,
+            'a command re-simulates the arm from the last time it was at rest, at most this far '
+            'back; beyond it the arm restarts at rest at the held angles',
+            's',
+            Bounds(1.0, 3600.0),
         ),
         *(_effect_spec(record) for record in EFFECTS.values()),
     ),

@@ -17,7 +17,7 @@ from lumpbeam_ros.bagio import BagWriter
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.interface import CAMERA_FRAME, CAMERA_INFO, IMAGE
 from lumpbeam_ros.model.trajectory import TipTrajectory
-from lumpbeam_ros.vision.config import load_camera_config
+from lumpbeam_ros.vision.config import CameraConfig, load_camera_config
 from lumpbeam_ros.vision.messages import camera_info_to_data
 from lumpbeam_ros.vision.synthetic import SyntheticCamera, SyntheticFrame
 
@@ -84,14 +84,22 @@ class ImageStream:
         trajectory: What the camera films (the measured motion: effects such as a sensor
             latency are already in it); one frame per sample, stamped with its time.
         options: Size, camera file and seed.
+        config: The camera configuration to film with, in place of ``options``' file (an
+            arm's, its board placed for the arm).
 
     Raises:
         ConfigError: A bad camera file.
         LumpbeamError: A trajectory the camera cannot render (too short, not finite).
     """
 
-    def __init__(self, trajectory: TipTrajectory, options: ImageOptions):
-        config = load_camera_config(options.camera_config)
+    def __init__(
+        self,
+        trajectory: TipTrajectory,
+        options: ImageOptions,
+        config: CameraConfig | None = None,
+    ):
+        if config is None:
+            config = load_camera_config(options.camera_config)
         self.config = config.with_resolution(options.width, options.height)
         camera = SyntheticCamera(self.config, options.seed)
         self._info = camera_info_to_data(self.config.camera_info, CAMERA_FRAME)

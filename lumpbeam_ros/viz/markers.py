@@ -9,7 +9,10 @@ them up, and a lifetime, so a stream that stops leaves nothing stale on screen; 
 whose object is gone (the load after the drop) is deleted explicitly.
 
 The chain's joints follow B.17: joint ``i + 1`` lies ``L_s`` from joint ``i`` along segment
-``i``, whose absolute angle ``phi_i`` is positive when it points downward.
+``i``, whose absolute angle ``phi_i`` is positive when it points downward. An arm
+(:mod:`lumpbeam_ros.arm`) is the same chain with a length per segment; it is drawn as one line
+strip per link (namespace ``arm_link``, id = link index from 0, through every segment's end)
+and its joints as spheres (``arm_joints``), in place of the beam's single strip.
 """
 
 from __future__ import annotations
@@ -34,6 +37,8 @@ NS_MEASURED = 'tip_measured'
 NS_PREDICTED = 'tip_predicted'
 NS_LOAD = 'load'
 NS_BOARD = 'board'
+NS_LINK = 'arm_link'
+NS_JOINTS = 'arm_joints'
 
 #: Drawn sizes, m: the beam's line width, the tips' spheres, the board's thickness.
 BEAM_WIDTH_M = 0.02
@@ -48,6 +53,11 @@ BEAM_COLOR = (0.25, 0.45, 0.85, 1.0)
 MEASURED_COLOR = (0.9, 0.2, 0.15, 1.0)
 PREDICTED_COLOR = (0.1, 0.7, 0.3, 0.8)
 LOAD_COLOR = (0.5, 0.5, 0.5, 1.0)
+#: An arm's links alternate these colours, joint 1 outward; its joints are dark.
+LINK_COLORS = (BEAM_COLOR, (0.95, 0.6, 0.1, 1.0))
+JOINT_COLOR = (0.15, 0.15, 0.15, 1.0)
+#: Drawn diameter of an arm's joints, m.
+JOINT_DIAMETER_M = 0.04
 BOARD_COLOR = (0.85, 0.85, 0.8, 0.6)
 
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
@@ -59,6 +69,7 @@ class Shape(IntEnum):
     CUBE = 1
     SPHERE = 2
     LINE_STRIP = 4
+    SPHERE_LIST = 7
 
 
 class Action(IntEnum):
@@ -136,34 +147,37 @@ class BeamScene:
     """What is known at one instant; ``None`` leaves an object out.
 
     Attributes:
-        segment_length_m: ``L_s``, m.
+        segment_length_m: ``L_s``, m (an arm: one per segment).
         phi: The model's absolute segment angles (n_s,), rad; ``None``: no model shape.
         measured: The measured tip.
         predicted: The model's tip.
         load_kg: The mass hanging at the tip, kg (0: none; its marker is deleted).
         board: The checkerboard.
+        link_starts: An arm's first segment of each link (empty: the clamped beam).
     """
 
-    segment_length_m: float
+    segment_length_m: float | np.ndarray
     phi: np.ndarray | None = None
     measured: TipPoint | None = None
     predicted: TipPoint | None = None
     load_kg: float = 0.0
     board: BoardPlacement | None = None
+    link_starts: tuple[int, ...] = ()
 
 
-def joint_positions(segment_length_m: float, phi: np.ndarray) -> np.ndarray:
+def joint_positions(segment_length_m: float | np.ndarray, phi: np.ndarray) -> np.ndarray:
     """The chain's joints and its free end in ``beam_base`` (B.17).
 
     Args:
-        segment_length_m: ``L_s``, m.
+        segment_length_m: ``L_s``, m: one for all segments, or one per segment.
         phi: Absolute segment angles (n_s,), rad, positive pointing down.
 
     Returns:
         (n_s + 1) x 3 points: joint 1 at the clamp (the origin), ..., the free end last.
     """
     phi = np.asarray(phi, dtype=float)
-    steps = segment_length_m * np.column_stack([np.cos(phi), np.zeros_like(phi), -np.sin(phi)])
+    lengths = np.reshape(np.asarray(segment_length_m, dtype=float), (-1, 1))
+    steps = lengths * np.column_stack([np.cos(phi), np.zeros_like(phi), -np.sin(phi)])
     return np.vstack([np.zeros((1, 3)), np.cumsum(steps, axis=0)])
 
 
@@ -207,6 +221,35 @@ def _tip_marker(
     )
 
 
+def _arm_markers(
+    points: np.ndarray, link_starts: tuple[int, ...], lifetime_s: float
+) -> list[MarkerSpec]:
+    """An arm's links (a strip each, through its segments' ends) and its joints."""
+    ends = (*link_starts[1:], points.shape[0] - 1)
+    links = [
+        MarkerSpec(
+            NS_LINK,
+            i,
+            Shape.LINE_STRIP,
+            scale=(BEAM_WIDTH_M, 0.0, 0.0),
+            color=LINK_COLORS[i % len(LINK_COLORS)],
+            points=points[start : end + 1],
+            lifetime_s=lifetime_s,
+        )
+        for i, (start, end) in enumerate(zip(link_starts, ends, strict=True))
+    ]
+    joints = MarkerSpec(
+        NS_JOINTS,
+        0,
+        Shape.SPHERE_LIST,
+        scale=(JOINT_DIAMETER_M,) * 3,
+        color=JOINT_COLOR,
+        points=points[list(link_starts)],
+        lifetime_s=lifetime_s,
+    )
+    return [*links, joints]
+
+
 def scene_markers(scene: BeamScene, lifetime_s: float) -> list[MarkerSpec]:
     """The markers of one instant.
 
@@ -215,7 +258,8 @@ def scene_markers(scene: BeamScene, lifetime_s: float) -> list[MarkerSpec]:
         lifetime_s: Each added marker's lifetime, s (a few of the stream's periods).
 
     Returns:
-        The beam (line strip through the joints), the measured and predicted tips (spheres),
+        The beam (line strip through the joints; an arm: a strip per link and its joints),
+        the measured and predicted tips (spheres),
         the load (a cube below the model's tip, else below the measured one; a delete when
         no load hangs) and the board (a thin cube), each present in the scene.
 
@@ -228,17 +272,20 @@ def scene_markers(scene: BeamScene, lifetime_s: float) -> list[MarkerSpec]:
         if not np.all(np.isfinite(scene.phi)):
             raise ValueError('segment angles must be finite')
         points = joint_positions(scene.segment_length_m, scene.phi)
-        markers.append(
-            MarkerSpec(
-                NS_BEAM,
-                0,
-                Shape.LINE_STRIP,
-                scale=(BEAM_WIDTH_M, 0.0, 0.0),
-                color=BEAM_COLOR,
-                points=points,
-                lifetime_s=lifetime_s,
+        if scene.link_starts:
+            markers.extend(_arm_markers(points, scene.link_starts, lifetime_s))
+        else:
+            markers.append(
+                MarkerSpec(
+                    NS_BEAM,
+                    0,
+                    Shape.LINE_STRIP,
+                    scale=(BEAM_WIDTH_M, 0.0, 0.0),
+                    color=BEAM_COLOR,
+                    points=points,
+                    lifetime_s=lifetime_s,
+                )
             )
-        )
         model_tip = model_tip or TipPoint(float(points[-1, 0]), float(points[-1, 2]))
     if scene.measured is not None and scene.measured.is_finite():
         markers.append(_tip_marker(NS_MEASURED, scene.measured, MEASURED_COLOR, lifetime_s))

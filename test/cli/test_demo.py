@@ -68,6 +68,23 @@ def test_demo_refuses_bad_options(tmp_path, capsys, args, message):
     assert message in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.parametrize(
+    ('args', 'message'),
+    [
+        (['--arm', 'config/paper_beam.yaml'], 'expected a mapping under the key arm'),
+        (['--arm', '/no/such.yaml'], 'no such file'),
+        (['--arm', '--effect', 'none'], '--effect is an option of the drop-test demo'),
+        (['--arm', '--no-images'], '--no-images is an option of the drop-test demo'),
+        (['--arm', '--domain-id', '500'], '--domain-id must be in 1..101'),
+    ],
+)
+def test_arm_demo_refuses_bad_input(tmp_path, capsys, args, message):
+    assert main(['demo', '--out', str(tmp_path / 'r'), *args]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / 'r' / 'bags').exists()  # refused before anything ran
+
+
 def test_demo_never_deletes_a_folder_it_did_not_make(tmp_path, capsys):
     (tmp_path / 'bags' / 'mine').mkdir(parents=True)
     assert main(['demo', '--out', str(tmp_path)]) == 2

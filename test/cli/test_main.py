@@ -153,14 +153,11 @@ def test_sigterm_interrupts_a_command_as_ctrl_c_does(tmp_path):
     import time
 
     out = tmp_path / 'long'
-    # Started as the installed `lumpbeam` script starts it: `python -m` was seen to report the
-    # handled interrupt as a death by SIGINT (exit -2) from the interpreter's own exit path.
-    script = 'import sys; from lumpbeam_ros.cli.main import main; sys.exit(main())'
     process = subprocess.Popen(
         [
             sys.executable,
-            '-c',
-            script,
+            '-m',
+            'lumpbeam_ros.cli.main',
             'synth',
             str(out),
             '--duration',

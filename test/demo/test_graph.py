@@ -162,8 +162,9 @@ def test_wait_for_quiet_returns_on_a_topic_without_publisher(tmp_path, monkeypat
 
 def test_commands_and_domain_ids():
     assert python_command('a.b', 'x') == [sys.executable, '-m', 'a.b', 'x']
-    command = node_command('pkg.node', '-p', 'x:=1')
-    assert command[:2] == [sys.executable, '-c'] and 'from pkg.node import main' in command[2]
+    command = node_command('lumpbeam_ros.nodes.camera_node', '-p', 'x:=1')
+    assert command[:2] == [sys.executable, '-c']
+    assert 'from lumpbeam_ros.nodes.scripts import camera_node' in command[2]
     assert command[3:] == ['--ros-args', '-p', 'x:=1']
     assert 0 not in DOMAIN_IDS and graph_module.STOP_GRACE_S > 0
 

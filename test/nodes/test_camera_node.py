@@ -215,16 +215,30 @@ def test_bag_source_survives_a_corrupt_frame(ros_graph, frames, info_bytes, tmp_
 def test_main_reads_a_bag_with_a_params_file_and_rejects_a_missing_bag(
     ros_graph, frames, info_bytes, tmp_path
 ):
+    """A subscriber that comes once the node is up still gets every pose of the bag.
+
+    The node tracked a bag as fast as it could and exited: a subscriber that matched later
+    than the first frame missed poses, one that matched after the last missed them all.
+    """
     _write_bag(tmp_path / 'bag', frames[:6], info_bytes)
     env = ros_env(ros_graph.domain_id)
     base = [sys.executable, '-m', 'lumpbeam_ros.nodes.camera_node', '--ros-args']
-    params = ['--params-file', 'config/camera.yaml']
-    done = subprocess.run(
+    params = ['--params-file', 'config/camera.yaml', '-p', 'diagnostics_period_s:=0.1']
+    statuses = ros_graph.collect('/diagnostics', DiagnosticArray, 10)
+    process = subprocess.Popen(
         [*base, *params, '-p', f'bag_path:={tmp_path / "bag"}'],
-        env=env, capture_output=True, text=True, timeout=60,
+        env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
-    assert done.returncode == 0, done.stderr
-    assert '6 frames, 6 poses' in done.stdout
+    try:
+        # The node is up (its diagnostics come) before /tip_pose has a subscriber.
+        assert ros_graph.spin_until(lambda: len(statuses) > 0, 30.0)
+        poses = ros_graph.collect('/tip_pose', PoseStamped, QoSProfile(depth=100))
+        stdout, stderr = process.communicate(timeout=30)
+    finally:
+        process.kill()
+    assert process.returncode == 0, stderr
+    assert '6 frames, 6 poses' in stdout
+    assert ros_graph.spin_until(lambda: len(poses) == 6, 5.0), len(poses)
     missing = subprocess.run(
         [*base, '-p', f'bag_path:={tmp_path / "nope"}'],
         env=env, capture_output=True, text=True, timeout=60,
