@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -41,30 +40,6 @@ from lumpbeam_ros.motion.joint_trajectory import JointTrajectory, default_joint_
 _GRID_SLACK = 1e-6
 #: A command's first point at time 0 may differ from the held angles by this much, rad.
 JUMP_TOLERANCE_RAD = 1e-6
-
-
-@dataclass(frozen=True)
-class ArmSamples:
-    """The arm at the stamps due since the last call.
-
-    Attributes:
-        t: Stamps, s.
-        q: Commanded joint angles, rad, (len(t), n_joints).
-        phi: Segment angles, rad, (len(t), n).
-        tip_x: x of the last link's free end, m.
-        tip_z: z of it, m.
-        tip_pitch: Its pitch, rad.
-    """
-
-    t: np.ndarray
-    q: np.ndarray
-    phi: np.ndarray
-    tip_x: np.ndarray
-    tip_z: np.ndarray
-    tip_pitch: np.ndarray
-
-    def __len__(self) -> int:
-        return int(self.t.size)
 
 
 class ArmStream:
@@ -236,7 +211,7 @@ class ArmStream:
         self._times, self._angles, self._motion = history.time_s, history.angles_rad, motion
         self._first_k, self._offset = first, 0 if on_grid else 1
 
-    def advance_to(self, now: float) -> ArmSamples:
+    def advance_to(self, now: float) -> ArmMotion:
         """The samples stamped after the last call's and at or before ``now``.
 
         The first call after the first command starts at the first grid stamp at or after
@@ -261,10 +236,11 @@ class ArmStream:
         if index.size == 0:
             return _empty(self.model)
         self._last_k = int(keys[index[-1] - self._offset])
-        return ArmSamples(
+        return ArmMotion(
             motion.t[index],
             motion.q[index],
             motion.phi[index],
+            motion.phi_dot[index],
             motion.tip_x[index],
             motion.tip_z[index],
             motion.tip_pitch[index],
@@ -297,8 +273,8 @@ class ArmStream:
         self._last_k = None
 
 
-def _empty(model: ArmModel) -> ArmSamples:
+def _empty(model: ArmModel) -> ArmMotion:
     n, j = model.chain.n, model.n_joints
-    return ArmSamples(
-        np.empty(0), np.empty((0, j)), np.empty((0, n)), np.empty(0), np.empty(0), np.empty(0)
+    return ArmMotion(
+        np.empty(0), np.empty((0, j)), np.empty((0, n)), np.empty((0, n)), *np.empty((3, 0))
     )

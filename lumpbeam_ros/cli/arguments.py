@@ -195,9 +195,9 @@ def add_synth(parser: argparse.ArgumentParser) -> None:
     arm.add_argument(
         '--arm',
         metavar='FILE',
-        help='arm configuration file: write /joint_states, /tip_pose and /tip_pose_truth of '
-        'the arm following --trajectory (--duration: the whole record, at least the '
-        "trajectory's)",
+        help='arm configuration file: write /joint_states, /tip_pose, /tip_pose_truth and '
+        '/beam_markers of the arm following --trajectory (--duration: the whole record, at '
+        "least the trajectory's; --images: a tip camera, its board in view after the move)",
     )
     arm.add_argument('--trajectory', metavar='FILE', help='joint trajectory file (CSV) with --arm')
 
