@@ -123,8 +123,9 @@ class ArmStream:
         Raises:
             LumpbeamError: Unknown or missing joint names, the wrong number of positions,
                 no point, NaN, times that do not increase, a start before the last sample
-                produced, a jump at time 0, or a simulation that failed; the stream is then
-                unchanged.
+                produced, a command longer than ``history_s`` or starting more than that after
+                the last sample, a jump at time 0, or a simulation that failed; the stream is
+                then unchanged.
         """
         trajectory = self._checked(names, times_s, positions, start_s)
         times, angles = trajectory.time_s, trajectory.angles_rad
@@ -135,12 +136,16 @@ class ArmStream:
                     f'the first point at time 0 is {np.max(np.abs(angles[0] - held)):.3g} rad '
                     'from where the joints are: a servo cannot jump (start it at a later time)'
                 )
-            keep = self._times < start_s
-            if start_s - float(self._times[0]) > self.history_s:
-                keep[:] = False  # re-anchored: at rest at the held angles
-            head_t = np.append(self._times[keep], start_s)
-            head_q = np.vstack([self._angles[keep], held])
-            if times[0] == start_s:
+            anchor = float(self._times[0])
+            if start_s - anchor > self.history_s:
+                # Re-anchored at rest at the held angles, from the next stamp due.
+                anchor = start_s
+                if self._last_k is not None:
+                    anchor = min(start_s, max(anchor, (self._last_k + 1) / self.rate_hz))
+            keep = (self._times > anchor) & (self._times < start_s)
+            head_t = np.concatenate([[anchor], self._times[keep], [start_s]])
+            head_q = np.vstack([self.held_angles(anchor), self._angles[keep], held])
+            if times[0] == start_s or anchor == start_s:
                 head_t, head_q = head_t[:-1], head_q[:-1]
             times = np.concatenate([head_t, times])
             angles = np.vstack([head_q, angles])
@@ -183,6 +188,16 @@ class ArmStream:
             raise LumpbeamError(
                 f'starts at {start_s:.3f} s, before the last sample predicted '
                 f'({self._last_k / self.rate_hz:.3f} s)'
+            )
+        if times[-1] > self.history_s:
+            raise LumpbeamError(
+                f'lasts {times[-1]:.6g} s, longer than the history simulated '
+                f'({self.history_s:g} s)'
+            )
+        if self._last_k is not None and start_s - self._last_k / self.rate_hz > self.history_s:
+            raise LumpbeamError(
+                f'starts {start_s - self._last_k / self.rate_hz:.6g} s after the last sample, '
+                f'more than the history simulated ({self.history_s:g} s)'
             )
         order = [names.index(n) for n in self.joint_names]
         absolute = start_s + times

@@ -98,3 +98,25 @@ def test_a_start_before_the_last_sample_is_refused(model):
     stream.advance_to(0.5)
     with pytest.raises(LumpbeamError, match='before the last sample'):
         stream.command(['joint_1', 'joint_2'], [0.1], [[0.1, 0.0]], start_s=0.2)
+
+
+def test_commands_too_long_or_too_far_ahead_are_refused(model):
+    stream = ArmStream(model, RATE, ring_down_s=0.2, history_s=5.0)
+    with pytest.raises(LumpbeamError, match='longer than the history'):
+        stream.command(['joint_1', 'joint_2'], [1e6], [[0.1, 0.0]], start_s=0.0)
+    stream.command(['joint_1', 'joint_2'], [0.1], [[0.1, 0.0]], start_s=0.0)
+    stream.advance_to(0.1)
+    with pytest.raises(LumpbeamError, match='after the last sample'):
+        stream.command(['joint_1', 'joint_2'], [0.1], [[0.1, 0.0]], start_s=1e9)
+
+
+def test_a_restart_holds_the_joints_at_rest_from_the_new_time(model):
+    stream = ArmStream(model, RATE, ring_down_s=0.3)
+    t, q = _move()
+    stream.command(['joint_1', 'joint_2'], t, q, start_s=5.0)
+    stream.advance_to(5.2)
+    stream.restart_at(2.0)  # a clock that jumped back: at rest at the angles held then
+    got = _drain(stream, 2.0, 2.3)
+    assert got['t'][0] == pytest.approx(2.0) and np.allclose(np.diff(got['t']), 1 / RATE)
+    np.testing.assert_allclose(got['q'], 0.0)  # before the command's start: its first row
+    assert np.ptp(got['tip_z']) < 1e-9  # at rest
