@@ -631,3 +631,9 @@ def add_view(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--rate', type=positive_float, default=1.0, help='bag speed factor')
     parser.add_argument('--loop', action='store_true', help='replay the bag again at its end')
     parser.add_argument('--duration', type=positive_float, help='stop after this many seconds')
+    parser.add_argument(
+        '--arm',
+        metavar='FILE',
+        help="with --bag: draw a recorded arm's bag on /beam_markers, the arm of FILE moved "
+        "along its /joint_states (in place of the bag's own markers)",
+    )

@@ -24,6 +24,11 @@ def paper_beam_arm(beam: BeamParameters) -> ArmConfig:
 
 def small_arm(n_links: int, plane: str = 'vertical') -> ArmConfig:
     """A light arm of 1 to 3 links with few segments (fast to simulate), unequal links."""
+    return arm_from_mapping(small_arm_document(n_links, plane), 'small')
+
+
+def small_arm_document(n_links: int, plane: str = 'vertical') -> dict:
+    """The arm file of :func:`small_arm`, as parsed YAML."""
     links = [
         {'length_m': 1.0, 'n_segments': 4, 'ei_nm2': 500.0, 'mass_kg': 1.0, 'damping_beta': 1e-3},
         {
@@ -43,8 +48,7 @@ def small_arm(n_links: int, plane: str = 'vertical') -> ArmConfig:
             'joint_mass_kg': 0.4,
         },
     ]
-    doc = {'arm': {'plane': plane, 'payload_kg': 0.3, 'links': links[:n_links]}}
-    return arm_from_mapping(doc, 'small')
+    return {'arm': {'plane': plane, 'payload_kg': 0.3, 'links': links[:n_links]}}
 
 
 def smooth_move(amplitude: np.ndarray, duration: float) -> SmoothMotion:

@@ -11,7 +11,8 @@ import sys
 
 import numpy as np
 import pytest
-from arm.arm_cases import small_arm
+import yaml
+from arm.arm_cases import small_arm, small_arm_document
 
 from lumpbeam_ros.bagio.typestore import deserialize
 from lumpbeam_ros.cli.main import main
@@ -49,16 +50,18 @@ def arm_bag(tmp_path_factory):
     return path
 
 
-def _serve(bag):
+def _serve(bag, *extra):
     """``lumpbeam view --bag BAG --port 0 --loop`` in a child process, and its port."""
     process = subprocess.Popen(
-        [sys.executable, '-m', 'lumpbeam_ros.cli.main', 'view', '--bag', str(bag)]
+        [sys.executable, '-m', 'lumpbeam_ros.cli.main', 'view', '--bag', str(bag), *extra]
         + ['--port', '0', '--loop', '--duration', '60'],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
     )
     line = process.stdout.readline()
+    if extra:
+        line = process.stdout.readline()  # after the line on the markers drawn
     match = re.search(r'at ws://127\.0\.0\.1:(\d+)', line)
     assert match, f'no address announced: {line!r} {process.stderr.read() if not line else ""}'
     return process, int(match.group(1))
@@ -139,6 +142,32 @@ def test_an_arm_bag_is_served_with_the_whole_arm(arm_bag):
     links = [m for m in markers if m.ns == 'arm_link']
     assert [len(m.points) for m in links] == [5, 4]  # 4 and 3 segments, joint to joint
     assert {m.ns for m in markers} >= {'arm_joints', 'tip_measured'}
+
+
+@pytest.mark.slow  # the child simulates the arm before serving: some 8 s on a loaded machine
+def test_a_recorded_arm_is_drawn_from_its_joint_states(tmp_path):
+    # A real arm's bag: joint states and tip poses, no markers; --arm draws the model's arm.
+    t = np.arange(0.0, 0.2 + 1e-9, 0.01)
+    move = JointTrajectory(t, np.outer(t, [2.0, -2.0]))
+    options = ArmSynthOptions(duration_s=0.5, rate_hz=40.0, markers_rate_hz=0)
+    write_arm_bag(tmp_path / 'recorded', small_arm(2), move, options)
+    arm = tmp_path / 'arm.yaml'
+    arm.write_text(yaml.safe_dump(small_arm_document(2)))
+    wanted = {'/beam_markers': 'visualization_msgs/msg/MarkerArray'}
+    process, port = _serve(tmp_path / 'recorded', '--arm', str(arm))
+    try:
+        channels, payloads = asyncio.run(_watch(port, wanted=wanted))
+    finally:
+        _stop(process)
+    assert '/beam_markers' in channels and '/joint_states' in channels
+    markers = deserialize(payloads['/beam_markers'], wanted['/beam_markers']).markers
+    assert [len(m.points) for m in markers if m.ns == 'arm_link'] == [5, 4]
+
+
+def test_arm_without_a_bag_is_one_line_and_exit_2(capsys, tmp_path):
+    assert main(['view', '--port', '0', '--arm', str(tmp_path / 'arm.yaml')]) == 2
+    err = capsys.readouterr().err
+    assert '--arm draws a bag: give --bag too' in err and len(err.strip().splitlines()) == 1
 
 
 def test_a_taken_port_is_one_line_and_exit_2(bag, capsys):
