@@ -82,6 +82,7 @@ from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA, effect_parame
 from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.viz.marker_messages import scene_cdr
 from lumpbeam_ros.viz.markers import (
+    MEASURED_MAX_AGE_S,
     BeamScene,
     BoardPlacement,
     TipPoint,
@@ -93,8 +94,6 @@ from lumpbeam_ros.viz.markers import (
 OK_LEVEL = 0
 #: A throttled warning repeats at most this often, s.
 WARN_PERIOD_S = 5.0
-#: /beam_markers shows a measured tip only this close in time to the model's, s.
-MEASURED_MAX_AGE_S = 0.5
 
 
 def load_beam(path: str) -> BeamParameters:

@@ -31,14 +31,12 @@ from lumpbeam_ros.interface import (
 from lumpbeam_ros.motion.joint_trajectory import JointTrajectory, default_joint_names
 from lumpbeam_ros.viz.marker_messages import scene_cdr
 from lumpbeam_ros.viz.markers import (
+    MEASURED_MAX_AGE_S,
     BeamScene,
     TipPoint,
     lifetime_for_rate,
     marker_sample_indices,
 )
-
-#: A measured tip is drawn with the model's arm only this close in time, s.
-MEASURED_MAX_AGE_S = 0.5
 
 
 def _joint_trajectory(reader: BagReader, config: ArmConfig) -> JointTrajectory:
