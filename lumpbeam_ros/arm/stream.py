@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -41,30 +40,6 @@ from lumpbeam_ros.motion.joint_trajectory import JointTrajectory, default_joint_
 _GRID_SLACK = 1e-6
 #: A command's first point at time 0 may differ from the held angles by this much, rad.
 JUMP_TOLERANCE_RAD = 1e-6
-
-
-@dataclass(frozen=True)
-class ArmSamples:
-    """The arm at the stamps due since the last call.
-
-    Attributes:
-        t: Stamps, s.
-        q: Commanded joint angles, rad, (len(t), n_joints).
-        phi: Segment angles, rad, (len(t), n).
-        tip_x: x of the last link's free end, m.
-        tip_z: z of it, m.
-        tip_pitch: Its pitch, rad.
-    """
-
-    t: np.ndarray
-    q: np.ndarray
-    phi: np.ndarray
-    tip_x: np.ndarray
-    tip_z: np.ndarray
-    tip_pitch: np.ndarray
-
-    def __len__(self) -> int:
-        return int(self.t.size)
 
 
 class ArmStream:
@@ -148,8 +123,9 @@ class ArmStream:
         Raises:
             LumpbeamError: Unknown or missing joint names, the wrong number of positions,
                 no point, NaN, times that do not increase, a start before the last sample
-                produced, a jump at time 0, or a simulation that failed; the stream is then
-                unchanged.
+                produced, a command longer than ``history_s`` or starting more than that after
+                the last sample, a jump at time 0, or a simulation that failed; the stream is
+                then unchanged.
         """
         trajectory = self._checked(names, times_s, positions, start_s)
         times, angles = trajectory.time_s, trajectory.angles_rad
@@ -160,12 +136,16 @@ class ArmStream:
                     f'the first point at time 0 is {np.max(np.abs(angles[0] - held)):.3g} rad '
                     'from where the joints are: a servo cannot jump (start it at a later time)'
                 )
-            keep = self._times < start_s
-            if start_s - float(self._times[0]) > self.history_s:
-                keep[:] = False  # re-anchored: at rest at the held angles
-            head_t = np.append(self._times[keep], start_s)
-            head_q = np.vstack([self._angles[keep], held])
-            if times[0] == start_s:
+            anchor = float(self._times[0])
+            if start_s - anchor > self.history_s:
+                # Re-anchored at rest at the held angles, from the next stamp due.
+                anchor = start_s
+                if self._last_k is not None:
+                    anchor = min(start_s, max(anchor, (self._last_k + 1) / self.rate_hz))
+            keep = (self._times > anchor) & (self._times < start_s)
+            head_t = np.concatenate([[anchor], self._times[keep], [start_s]])
+            head_q = np.vstack([self.held_angles(anchor), self._angles[keep], held])
+            if times[0] == start_s or anchor == start_s:
                 head_t, head_q = head_t[:-1], head_q[:-1]
             times = np.concatenate([head_t, times])
             angles = np.vstack([head_q, angles])
@@ -209,6 +189,16 @@ class ArmStream:
                 f'starts at {start_s:.3f} s, before the last sample predicted '
                 f'({self._last_k / self.rate_hz:.3f} s)'
             )
+        if times[-1] > self.history_s:
+            raise LumpbeamError(
+                f'lasts {times[-1]:.6g} s, longer than the history simulated '
+                f'({self.history_s:g} s)'
+            )
+        if self._last_k is not None and start_s - self._last_k / self.rate_hz > self.history_s:
+            raise LumpbeamError(
+                f'starts {start_s - self._last_k / self.rate_hz:.6g} s after the last sample, '
+                f'more than the history simulated ({self.history_s:g} s)'
+            )
         order = [names.index(n) for n in self.joint_names]
         absolute = start_s + times
         if absolute.size == 1:
@@ -236,7 +226,7 @@ class ArmStream:
         self._times, self._angles, self._motion = history.time_s, history.angles_rad, motion
         self._first_k, self._offset = first, 0 if on_grid else 1
 
-    def advance_to(self, now: float) -> ArmSamples:
+    def advance_to(self, now: float) -> ArmMotion:
         """The samples stamped after the last call's and at or before ``now``.
 
         The first call after the first command starts at the first grid stamp at or after
@@ -261,10 +251,11 @@ class ArmStream:
         if index.size == 0:
             return _empty(self.model)
         self._last_k = int(keys[index[-1] - self._offset])
-        return ArmSamples(
+        return ArmMotion(
             motion.t[index],
             motion.q[index],
             motion.phi[index],
+            motion.phi_dot[index],
             motion.tip_x[index],
             motion.tip_z[index],
             motion.tip_pitch[index],
@@ -297,8 +288,8 @@ class ArmStream:
         self._last_k = None
 
 
-def _empty(model: ArmModel) -> ArmSamples:
+def _empty(model: ArmModel) -> ArmMotion:
     n, j = model.chain.n, model.n_joints
-    return ArmSamples(
-        np.empty(0), np.empty((0, j)), np.empty((0, n)), np.empty(0), np.empty(0), np.empty(0)
+    return ArmMotion(
+        np.empty(0), np.empty((0, j)), np.empty((0, n)), np.empty((0, n)), *np.empty((3, 0))
     )

@@ -195,9 +195,9 @@ def add_synth(parser: argparse.ArgumentParser) -> None:
     arm.add_argument(
         '--arm',
         metavar='FILE',
-        help='arm configuration file: write /joint_states, /tip_pose and /tip_pose_truth of '
-        'the arm following --trajectory (--duration: the whole record, at least the '
-        "trajectory's)",
+        help='arm configuration file: write /joint_states, /tip_pose, /tip_pose_truth and '
+        '/beam_markers of the arm following --trajectory (--duration: the whole record, at '
+        "least the trajectory's; --images: a tip camera, its board in view after the move)",
     )
     arm.add_argument('--trajectory', metavar='FILE', help='joint trajectory file (CSV) with --arm')
 
@@ -665,3 +665,9 @@ def add_view(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--rate', type=positive_float, default=1.0, help='bag speed factor')
     parser.add_argument('--loop', action='store_true', help='replay the bag again at its end')
     parser.add_argument('--duration', type=positive_float, help='stop after this many seconds')
+    parser.add_argument(
+        '--arm',
+        metavar='FILE',
+        help="with --bag: draw a recorded arm's bag on /beam_markers, the arm of FILE moved "
+        "along its /joint_states (in place of the bag's own markers)",
+    )

@@ -1,4 +1,8 @@
-"""``lumpbeam view [--bag BAG] [--port 8765]``: the live graph, or a bag, served to Foxglove.
+"""``lumpbeam view [--bag BAG [--arm FILE]] [--port 8765]``: the live graph, or a bag, served.
+
+``--arm FILE`` draws a recorded arm's bag (``/joint_states``, ``/tip_pose``, no markers): the
+arm of the file moved along the bag's joint angles, on ``/beam_markers``
+(:mod:`lumpbeam_ros.viz.arm_scenes`).
 
 Open Foxglove, connect to ``ws://localhost:8765`` (Open connection, Foxglove WebSocket) and
 import ``config/foxglove_layout.json``. No ROS installation is needed for a bag; the live
@@ -12,6 +16,9 @@ import signal
 import sys
 import time
 from typing import Any
+
+from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.interface import BEAM_MARKERS, MARKER_ARRAY
 
 
 def run(args: argparse.Namespace) -> int:
@@ -32,6 +39,7 @@ def run(args: argparse.Namespace) -> int:
     )
 
     reader = BagReader(args.bag) if args.bag is not None else None  # bad bag: before binding
+    markers = _arm_markers(reader, args.arm) if args.arm is not None else []
     stop = {'requested': False}
     deadline = None if args.duration is None else time.monotonic() + args.duration
 
@@ -47,10 +55,15 @@ def run(args: argparse.Namespace) -> int:
     try:
         if reader is not None:
             topics = open_bag_channels(reader, sink, args.topics)
+            if markers:
+                topics = [t for t in topics if t != BEAM_MARKERS]  # drawn anew
+                if not sink.has_topic(BEAM_MARKERS):
+                    sink.add_topic(BEAM_MARKERS, MARKER_ARRAY)
             _announce(server.port, args.host, f'{reader.path} ({len(topics)} topics)')
             replay_bag(
-                reader, sink, topics, rate=args.rate, loop=args.loop, should_stop=should_stop
-            )
+                reader, sink, topics, rate=args.rate, loop=args.loop, should_stop=should_stop,
+                extra=markers,
+            )  # fmt: skip
         else:
             _announce(server.port, args.host, 'the live ROS graph')
             _serve_graph(sink, args.topics, should_stop)
@@ -61,6 +74,18 @@ def run(args: argparse.Namespace) -> int:
             signal.signal(sig, handler)
     print(f'lumpbeam view: stopped after {sum(sink.sent.values())} messages', flush=True)
     return 0
+
+
+def _arm_markers(reader: Any, arm: str) -> list[Any]:
+    """``--arm``: the arm of the file drawn along the bag's joint states."""
+    from lumpbeam_ros.arm.config import load_arm_config
+    from lumpbeam_ros.viz.arm_scenes import recorded_arm_markers
+
+    if reader is None:
+        raise LumpbeamError('--arm draws a bag: give --bag too')
+    markers = recorded_arm_markers(reader, load_arm_config(arm))
+    print(f'lumpbeam view: {len(markers)} marker arrays of the arm of {arm}', flush=True)
+    return markers
 
 
 def _announce(port: int, host: str, what: str) -> None:

@@ -49,7 +49,8 @@ from visualization_msgs.msg import MarkerArray
 
 from lumpbeam_ros.arm.config import load_arm_config
 from lumpbeam_ros.arm.model import ArmModel
-from lumpbeam_ros.arm.stream import ArmSamples, ArmStream
+from lumpbeam_ros.arm.simulate import ArmMotion
+from lumpbeam_ros.arm.stream import ArmStream
 from lumpbeam_ros.bagio.convert import (
     NS_PER_S,
     joint_state,
@@ -81,6 +82,7 @@ from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA, effect_parame
 from lumpbeam_ros.vision.config import load_camera_config
 from lumpbeam_ros.viz.marker_messages import scene_cdr
 from lumpbeam_ros.viz.markers import (
+    MEASURED_MAX_AGE_S,
     BeamScene,
     BoardPlacement,
     TipPoint,
@@ -92,8 +94,6 @@ from lumpbeam_ros.viz.markers import (
 OK_LEVEL = 0
 #: A throttled warning repeats at most this often, s.
 WARN_PERIOD_S = 5.0
-#: /beam_markers shows a measured tip only this close in time to the model's, s.
-MEASURED_MAX_AGE_S = 0.5
 
 
 def load_beam(path: str) -> BeamParameters:
@@ -461,7 +461,7 @@ class ArmMode:
         self._lengths = self.model.chain.segment_lengths
         self._link_starts = tuple(int(k) for k in self.model.link_starts)
         self._board = load_board(values['camera_config']) if values['camera_config'] else None
-        self._latest: ArmSamples | None = None
+        self._latest: ArmMotion | None = None
         self._measured: tuple[float, TipPoint] | None = None
         self._markers_stamp = -math.inf
         self._time = -math.inf  # the clock at the last tick
@@ -540,12 +540,12 @@ class ArmMode:
         except LumpbeamError as exc:
             self._warn(f'arm simulation failed: {exc}')
             return
-        if len(samples):
+        if samples.t.size:
             self._latest = samples
-        for i in range(len(samples)):
+        for i in range(samples.t.size):
             self._publish(samples, i)
 
-    def _publish(self, samples: ArmSamples, i: int) -> None:
+    def _publish(self, samples: ArmMotion, i: int) -> None:
         stamp_ns = seconds_to_ns(float(samples.t[i]))
         msg = PoseStamped()
         msg.header.frame_id = BASE_FRAME

@@ -12,12 +12,14 @@ their log times instead.
 
 from __future__ import annotations
 
+import heapq
 import socket
 import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
 from lumpbeam_ros.bagio import BagReader
+from lumpbeam_ros.bagio.reader import RawMessage
 from lumpbeam_ros.bagio.typestore import is_known, type_description
 from lumpbeam_ros.errors import BagError, LumpbeamError
 
@@ -176,6 +178,7 @@ def replay_bag(
     rate: float = 1.0,
     loop: bool = False,
     should_stop: Callable[[], bool] = lambda: False,
+    extra: Sequence[RawMessage] = (),
 ) -> int:
     """Sends a bag's messages with their original relative timing.
 
@@ -186,6 +189,8 @@ def replay_bag(
         rate: Speed factor.
         loop: Start again at the end.
         should_stop: Polled between messages and while waiting; true stops the replay.
+        extra: More messages (their channels opened), in log-time order, sent among the
+            bag's by log time (markers drawn for the bag).
 
     Returns:
         How many messages were sent.
@@ -193,7 +198,8 @@ def replay_bag(
     sent = 0
     while True:
         start_wall, first_log = time.monotonic(), None
-        for raw in reader.iter_raw(list(topics)):
+        stream = heapq.merge(reader.iter_raw(list(topics)), extra, key=lambda m: m.log_time_ns)
+        for raw in stream:
             first_log = raw.log_time_ns if first_log is None else first_log
             due = start_wall + (raw.log_time_ns - first_log) / 1e9 / rate
             while (wait := due - time.monotonic()) > 0.0:

@@ -40,6 +40,9 @@ NS_BOARD = 'board'
 NS_LINK = 'arm_link'
 NS_JOINTS = 'arm_joints'
 
+#: A measured tip is drawn beside the model only this close in time to the model's stamp, s.
+MEASURED_MAX_AGE_S = 0.5
+
 #: Drawn sizes, m: the beam's line width, the tips' spheres, the board's thickness.
 BEAM_WIDTH_M = 0.02
 TIP_DIAMETER_M = 0.05

@@ -19,7 +19,7 @@ def model():
     return ArmModel.from_config(small_arm(2))
 
 
-def _move(amplitude=(0.4, -0.3), duration=0.3, step=0.01):
+def _move(amplitude=(0.4, -0.3), duration=0.3, step=0.05):
     t = np.arange(0.0, duration + 1e-9, step)
     s = t / duration
     return t, np.outer(s - np.sin(2 * np.pi * s) / (2 * np.pi), amplitude)
@@ -32,7 +32,7 @@ def _drain(stream, start, end):
 
 def test_samples_are_the_offline_simulation_of_the_move(model):
     stream = ArmStream(model, RATE, ring_down_s=0.5)
-    assert len(stream.advance_to(10.0)) == 0 and not stream.started
+    assert stream.advance_to(10.0).t.size == 0 and not stream.started
     t, q = _move()
     stream.command(['joint_2', 'joint_1'], t, q[:, ::-1], start_s=10.0)
     got = _drain(stream, 10.0, 11.2)
@@ -52,7 +52,7 @@ def test_a_second_command_inherits_the_vibration(model):
     first = _drain(stream, 0.0, 0.5)
     back = q[-1] - q
     stream.command(['joint_1', 'joint_2'], t + 0.05, back, start_s=0.5)
-    second = _drain(stream, 0.5, 1.3)
+    second = _drain(stream, 0.5, 1.2)
     rows = JointTrajectory(np.concatenate([t, [0.5], 0.55 + t]), np.vstack([q, q[-1:], back]))
     stamps = np.concatenate([first['t'], second['t']])
     offline = simulate_arm(model, SampledMotion(rows), stamps)
@@ -61,10 +61,10 @@ def test_a_second_command_inherits_the_vibration(model):
 
 
 def test_the_span_extends_and_the_history_is_bounded(model):
-    stream = ArmStream(model, RATE, ring_down_s=0.2, history_s=1.0)
+    stream = ArmStream(model, RATE, ring_down_s=0.5, history_s=1.0)
     t, q = _move()
     stream.command(['joint_1', 'joint_2'], t, q, start_s=0.0)
-    got = _drain(stream, 0.0, 2.5)
+    got = _drain(stream, 0.0, 1.6)
     assert np.allclose(np.diff(got['t']), 1 / RATE)
     assert stream.anchor_s > 1.0  # re-anchored at rest at the held angles
     np.testing.assert_allclose(got['q'][-1], q[-1])
@@ -98,3 +98,25 @@ def test_a_start_before_the_last_sample_is_refused(model):
     stream.advance_to(0.5)
     with pytest.raises(LumpbeamError, match='before the last sample'):
         stream.command(['joint_1', 'joint_2'], [0.1], [[0.1, 0.0]], start_s=0.2)
+
+
+def test_commands_too_long_or_too_far_ahead_are_refused(model):
+    stream = ArmStream(model, RATE, ring_down_s=0.2, history_s=5.0)
+    with pytest.raises(LumpbeamError, match='longer than the history'):
+        stream.command(['joint_1', 'joint_2'], [1e6], [[0.1, 0.0]], start_s=0.0)
+    stream.command(['joint_1', 'joint_2'], [0.1], [[0.1, 0.0]], start_s=0.0)
+    stream.advance_to(0.1)
+    with pytest.raises(LumpbeamError, match='after the last sample'):
+        stream.command(['joint_1', 'joint_2'], [0.1], [[0.1, 0.0]], start_s=1e9)
+
+
+def test_a_restart_holds_the_joints_at_rest_from_the_new_time(model):
+    stream = ArmStream(model, RATE, ring_down_s=0.3)
+    t, q = _move()
+    stream.command(['joint_1', 'joint_2'], t, q, start_s=5.0)
+    stream.advance_to(5.2)
+    stream.restart_at(2.0)  # a clock that jumped back: at rest at the angles held then
+    got = _drain(stream, 2.0, 2.3)
+    assert got['t'][0] == pytest.approx(2.0) and np.allclose(np.diff(got['t']), 1 / RATE)
+    np.testing.assert_allclose(got['q'], 0.0)  # before the command's start: its first row
+    assert np.ptp(got['tip_z']) < 1e-9  # at rest

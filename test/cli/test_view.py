@@ -9,11 +9,16 @@ import struct
 import subprocess
 import sys
 
+import numpy as np
 import pytest
+import yaml
+from arm.arm_cases import small_arm, small_arm_document
 
 from lumpbeam_ros.bagio.typestore import deserialize
 from lumpbeam_ros.cli.main import main
 from lumpbeam_ros.model.parameters import load_beam_config
+from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
+from lumpbeam_ros.synthetic.arm_bag import ArmSynthOptions, write_arm_bag
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 from lumpbeam_ros.viz.foxglove_server import SUBPROTOCOL
 
@@ -35,41 +40,62 @@ def bag(tmp_path_factory):
     return path
 
 
-@pytest.fixture
-def server(bag):
+@pytest.fixture(scope='module')
+def arm_bag(tmp_path_factory):
+    """A two-link arm's synthetic bag (``lumpbeam synth --arm``): it carries the arm's markers."""
+    path = tmp_path_factory.mktemp('view') / 'arm'
+    t = np.arange(0.0, 0.2 + 1e-9, 0.01)
+    move = JointTrajectory(t, np.outer(t, [2.0, -2.0]))
+    write_arm_bag(path, small_arm(2), move, ArmSynthOptions(duration_s=0.5))
+    return path
+
+
+def _serve(bag, *extra):
     """``lumpbeam view --bag BAG --port 0 --loop`` in a child process, and its port."""
     process = subprocess.Popen(
-        [sys.executable, '-m', 'lumpbeam_ros.cli.main', 'view', '--bag', str(bag)]
+        [sys.executable, '-m', 'lumpbeam_ros.cli.main', 'view', '--bag', str(bag), *extra]
         + ['--port', '0', '--loop', '--duration', '60'],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
     )
     line = process.stdout.readline()
+    if extra:
+        line = process.stdout.readline()  # after the line on the markers drawn
     match = re.search(r'at ws://127\.0\.0\.1:(\d+)', line)
     assert match, f'no address announced: {line!r} {process.stderr.read() if not line else ""}'
-    yield process, int(match.group(1))
+    return process, int(match.group(1))
+
+
+def _stop(process):
     if process.poll() is None:
         process.send_signal(signal.SIGINT)
         process.wait(10)
 
 
-async def _watch(port, timeout_s=20.0):
-    """Connects, subscribes to WANTED and returns (channels, first payload per topic)."""
+@pytest.fixture
+def server(bag):
+    process, port = _serve(bag)
+    yield process, port
+    _stop(process)
+
+
+async def _watch(port, timeout_s=20.0, wanted=WANTED):
+    """Connects, subscribes to ``wanted`` and returns (channels, first payload per topic)."""
     uri = f'ws://127.0.0.1:{port}'
     async with websockets.connect(uri, subprotocols=[SUBPROTOCOL], max_size=None) as ws:
         assert ws.subprotocol == SUBPROTOCOL
         channels, payloads, subscriptions = {}, {}, {}
         loop = asyncio.get_running_loop()
         deadline = loop.time() + timeout_s
-        while len(payloads) < len(WANTED):
+        while len(payloads) < len(wanted):
             frame = await asyncio.wait_for(ws.recv(), deadline - loop.time())
             if isinstance(frame, str):
                 message = json.loads(frame)
                 if message['op'] == 'advertise':
                     channels.update({c['topic']: c for c in message['channels']})
-                    if not subscriptions and set(WANTED) <= set(channels):
-                        subscriptions = {i: t for i, t in enumerate(WANTED, start=1)}
+                    if not subscriptions and set(wanted) <= set(channels):
+                        subscriptions = {i: t for i, t in enumerate(wanted, start=1)}
                         request = [
                             {'id': i, 'channelId': channels[t]['id']}
                             for i, t in subscriptions.items()
@@ -97,6 +123,51 @@ def test_a_client_gets_the_channels_and_messages_of_a_bag(server):
     process.send_signal(signal.SIGINT)
     assert process.wait(10) == 0
     assert 'stopped after' in process.stdout.read()
+
+
+def test_an_arm_bag_is_served_with_the_whole_arm(arm_bag):
+    wanted = {
+        '/joint_states': 'sensor_msgs/msg/JointState',
+        '/beam_markers': 'visualization_msgs/msg/MarkerArray',
+    }
+    process, port = _serve(arm_bag)
+    try:
+        channels, payloads = asyncio.run(_watch(port, wanted=wanted))
+    finally:
+        _stop(process)
+    assert {'/joint_states', '/tip_pose', '/tip_pose_truth', '/beam_markers'} == set(channels)
+    joints = deserialize(payloads['/joint_states'], wanted['/joint_states'])
+    assert list(joints.name) == ['joint_1', 'joint_2']
+    markers = deserialize(payloads['/beam_markers'], wanted['/beam_markers']).markers
+    links = [m for m in markers if m.ns == 'arm_link']
+    assert [len(m.points) for m in links] == [5, 4]  # 4 and 3 segments, joint to joint
+    assert {m.ns for m in markers} >= {'arm_joints', 'tip_measured'}
+
+
+@pytest.mark.slow  # the child simulates the arm before serving: some 8 s on a loaded machine
+def test_a_recorded_arm_is_drawn_from_its_joint_states(tmp_path):
+    # A real arm's bag: joint states and tip poses, no markers; --arm draws the model's arm.
+    t = np.arange(0.0, 0.2 + 1e-9, 0.01)
+    move = JointTrajectory(t, np.outer(t, [2.0, -2.0]))
+    options = ArmSynthOptions(duration_s=0.5, rate_hz=40.0, markers_rate_hz=0)
+    write_arm_bag(tmp_path / 'recorded', small_arm(2), move, options)
+    arm = tmp_path / 'arm.yaml'
+    arm.write_text(yaml.safe_dump(small_arm_document(2)))
+    wanted = {'/beam_markers': 'visualization_msgs/msg/MarkerArray'}
+    process, port = _serve(tmp_path / 'recorded', '--arm', str(arm))
+    try:
+        channels, payloads = asyncio.run(_watch(port, wanted=wanted))
+    finally:
+        _stop(process)
+    assert '/beam_markers' in channels and '/joint_states' in channels
+    markers = deserialize(payloads['/beam_markers'], wanted['/beam_markers']).markers
+    assert [len(m.points) for m in markers if m.ns == 'arm_link'] == [5, 4]
+
+
+def test_arm_without_a_bag_is_one_line_and_exit_2(capsys, tmp_path):
+    assert main(['view', '--port', '0', '--arm', str(tmp_path / 'arm.yaml')]) == 2
+    err = capsys.readouterr().err
+    assert '--arm draws a bag: give --bag too' in err and len(err.strip().splitlines()) == 1
 
 
 def test_a_taken_port_is_one_line_and_exit_2(bag, capsys):

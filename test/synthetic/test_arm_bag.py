@@ -8,11 +8,21 @@ import yaml
 from arm.arm_cases import small_arm
 from rosbags.highlevel import AnyReader
 
+from lumpbeam_ros.arm.model import ArmModel
 from lumpbeam_ros.bagio import read_tip_poses
 from lumpbeam_ros.cli.main import main
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.motion.joint_trajectory import JointTrajectory, write_trajectory_csv
-from lumpbeam_ros.synthetic.arm_bag import ArmSynthOptions, simulate_arm_record, write_arm_bag
+from lumpbeam_ros.synthetic.arm_bag import (
+    ArmSynthOptions,
+    board_at_rest,
+    rest_tip_pose,
+    simulate_arm_record,
+    write_arm_bag,
+)
+from lumpbeam_ros.vision.config import load_camera_config
+from lumpbeam_ros.vision.geometry import rotation_y
+from lumpbeam_ros.vision.pose import PlaneModel
 
 
 def _move(joints: int, start: float = 0.0) -> JointTrajectory:
@@ -105,7 +115,8 @@ def test_the_command_writes_the_bag(tmp_path, files, capsys):
     [
         (['--trajectory', None], '--arm and --trajectory go together'),
         (['--arm', None], '--arm and --trajectory go together'),
-        (['--arm', 'A', '--trajectory', 'T', '--images'], '--images: not for an arm'),
+        (['--arm', 'A', '--trajectory', 'T', '--tracker'], '--tracker: not for an arm'),
+        (['--arm', 'A', '--trajectory', 'T', '--images', '--image-size', '9x9'], 'at least 64'),
         (['--arm', 'A', '--trajectory', 'T', '--effect', 'added_mass=1'], '--effect'),
         (['--arm', 'A', '--trajectory', 'T', '--duration', '0.1'], 'shorter than'),
         (['--arm', 'missing.yaml', '--trajectory', 'T'], 'no such file'),
@@ -120,3 +131,56 @@ def test_bad_command_lines_are_one_line_exit_2(tmp_path, files, capsys, extra, w
     assert main(['synth', str(tmp_path / 'out'), *extra]) == 2
     err = capsys.readouterr().err
     assert words in err and err.count('\n') == 1
+
+
+def test_the_board_faces_the_tip_camera_at_rest_after_the_move():
+    model = ArmModel.from_config(small_arm(3))
+    tip = rest_tip_pose(model, np.array([0.4, -0.5, 0.3]))
+    assert abs(tip[2]) > 0.1  # the tip is turned: the board must turn with it
+    params, placed = board_at_rest(None, tip)
+    default = load_camera_config()
+    np.testing.assert_allclose(
+        placed.rig.base_board.rotation, rotation_y(tip[2]) @ default.rig.base_board.rotation
+    )
+    assert params['board.xyz_m'] == pytest.approx([tip[0], 1.0, tip[1]])
+    # From that pose the camera sees the board as the beam rig's camera sees its own board
+    # from the pose straight across from it.
+    seen = PlaneModel(placed.rig, placed.camera_info).project(np.array(tip))
+    centre = default.rig.base_board.translation
+    beam = PlaneModel(default.rig, default.camera_info).project(
+        np.array([centre[0], centre[2], 0.0])
+    )
+    np.testing.assert_allclose(seen, beam, atol=1e-6)
+
+
+@pytest.mark.slow
+def test_track_recovers_the_tip_pose_once_the_arm_has_stopped(tmp_path, capsys):
+    """``synth --arm --images`` then ``track``: prints the errors (``pytest -m slow -s``)."""
+    move = tmp_path / 'move.csv'
+    t = np.arange(0.0, 0.5 + 1e-9, 1e-3)
+    s = t / 0.5
+    write_trajectory_csv(
+        move, JointTrajectory(t, (s - np.sin(2 * np.pi * s) / (2 * np.pi))[:, None] * 0.8)
+    )
+    bag, out = tmp_path / 'bag', tmp_path / 'tracked'
+    arm = Path(__file__).resolve().parents[2] / 'config' / 'arm_rotary.yaml'
+    argv = ['synth', str(bag), '--arm', str(arm), '--trajectory', str(move)]
+    assert main([*argv, '--duration', '2', '--images', '--image-size', '320x240']) == 0
+    assert f'--config {bag}/camera.yaml' in capsys.readouterr().out
+    assert main(['track', str(bag), str(out), '--config', str(bag / 'camera.yaml')]) == 0
+    tracked = read_tip_poses(out)
+    truth = read_tip_poses(bag, '/tip_pose_truth')
+    index = np.searchsorted(truth.t, tracked.t)
+    assert np.allclose(truth.t[index], tracked.t, atol=1e-9)
+    # The board is in view once the arm has stopped: every frame after the move is tracked.
+    after = truth.t > 0.5
+    assert np.isin(truth.t[after], tracked.t).all()
+    print(f'\n{tracked.t.size} of {truth.t.size} frames tracked (the board in view)')
+    for name, unit, scale in (('x', 'um', 1e6), ('z', 'um', 1e6), ('pitch', 'urad', 1e6)):
+        error = (getattr(tracked, name) - getattr(truth, name)[index]) * scale
+        rms = np.sqrt(np.mean(error**2))
+        print(
+            f'  {name}: RMS {rms:.2f} {unit} (bias {error.mean():.2f}, std {error.std():.2f}, '
+            f'max {np.abs(error).max():.2f})'
+        )
+        assert rms < (100.0 if name == 'pitch' else 30.0)

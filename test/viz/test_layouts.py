@@ -8,10 +8,15 @@ import json
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
+import yaml
+from arm.arm_cases import small_arm
 
 from lumpbeam_ros.bagio import BagReader, BagWriter
+from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
 from lumpbeam_ros.resources import config_path
+from lumpbeam_ros.synthetic.arm_bag import ArmSynthOptions, write_arm_bag
 from lumpbeam_ros.viz.layouts import (
     check_uses,
     evaluate,
@@ -20,10 +25,13 @@ from lumpbeam_ros.viz.layouts import (
     rviz_uses,
     split_message_path,
 )
+from lumpbeam_ros.viz.marker_messages import read_marker_arrays
 
 ROOT = Path(__file__).resolve().parents[2]
 #: Topics doc/interfaces.md marks planned: a layout may show them before any node has them.
 PLANNED = set(re.findall(r'`(/[\w/]+)` \(planned\)', (ROOT / 'doc' / 'interfaces.md').read_text()))
+#: Topics only an arm has: checked against an arm's bag, not the beam demo's.
+ARM_TOPICS = {'/joint_states'}
 
 
 @pytest.fixture(scope='module')
@@ -56,11 +64,29 @@ def test_layouts_use_the_topics_the_issue_asks_for():
 
 
 def test_every_panel_topic_is_in_the_demo_bag_with_its_type(demo_bag):
-    uses = [u for u in _uses() if u.topic not in PLANNED]
+    uses = [u for u in _uses() if u.topic not in PLANNED | ARM_TOPICS]
     assert len(uses) >= 12
     assert check_uses(uses, demo_bag) == []
     topics = BagReader(demo_bag).topics
     assert topics['/beam_markers'].count >= 30  # a 30 Hz stream over the run
+
+
+def test_the_arm_is_served_by_an_arm_bag(tmp_path):
+    t = np.arange(0.0, 0.2 + 1e-9, 0.01)
+    move = JointTrajectory(t, np.outer(t, [1.0, -1.0, 0.5]))
+    write_arm_bag(tmp_path / 'arm', small_arm(3), move, ArmSynthOptions(duration_s=0.3))
+    uses = [u for u in _uses() if u.topic in ARM_TOPICS | {'/beam_markers', '/tip_pose'}]
+    assert {u.topic for u in uses} == {'/joint_states', '/beam_markers', '/tip_pose'}
+    assert check_uses(uses, tmp_path / 'arm') == []
+    _, markers = next(read_marker_arrays(tmp_path / 'arm'))
+    assert {m.namespace for m in markers} >= {'arm_link', 'arm_joints'}
+    rviz = yaml.safe_load(config_path('lumpbeam.rviz').read_text())
+    display = next(
+        d
+        for d in rviz['Visualization Manager']['Displays']
+        if d.get('Name', '').endswith('(/beam_markers)')
+    )
+    assert {'arm_link', 'arm_joints', 'beam'} <= {k for k, v in display['Namespaces'].items() if v}
 
 
 def test_no_panel_shows_a_planned_topic():

@@ -13,6 +13,8 @@ from lumpbeam_ros.viz.markers import (
     LOAD_HOOK_M,
     NS_BEAM,
     NS_BOARD,
+    NS_JOINTS,
+    NS_LINK,
     NS_LOAD,
     NS_MEASURED,
     NS_PREDICTED,
@@ -194,3 +196,23 @@ def test_a_marker_rate_that_is_not_positive_is_refused(rate):
 @pytest.mark.parametrize(('rate', 'lifetime'), [(30.0, 0.1), (10.0, 0.3), (1.0, 3.0)])
 def test_the_lifetime_spans_three_periods(rate, lifetime):
     assert lifetime_for_rate(rate) == pytest.approx(lifetime)
+
+
+def test_an_arm_is_drawn_link_by_link_with_its_joints():
+    lengths = np.array([0.5, 0.5, 0.3, 0.3, 0.3])
+    phi = np.array([0.1, 0.2, -0.4, -0.3, -0.2])
+    scene = BeamScene(lengths, phi=phi, link_starts=(0, 2))
+    markers = scene_markers(scene, 0.1)
+    assert not [m for m in markers if m.namespace == NS_BEAM]
+    links = [m for m in markers if m.namespace == NS_LINK]
+    points = joint_positions(lengths, phi)
+    assert [m.marker_id for m in links] == [0, 1]
+    assert all(m.shape == Shape.LINE_STRIP for m in links)
+    np.testing.assert_array_equal(links[0].points, points[:3])  # joint 1 to joint 2
+    np.testing.assert_array_equal(links[1].points, points[2:])  # joint 2 to the free end
+    joints = next(m for m in markers if m.namespace == NS_JOINTS)
+    assert joints.shape == Shape.SPHERE_LIST
+    np.testing.assert_array_equal(joints.points, points[[0, 2]])
+    # Each segment its own length: the free end is the sum of the steps (B.17).
+    assert points[-1, 0] == pytest.approx(np.sum(lengths * np.cos(phi)))
+    assert points[-1, 2] == pytest.approx(-np.sum(lengths * np.sin(phi)))
