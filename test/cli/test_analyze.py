@@ -265,7 +265,7 @@ def test_an_arm_bag_gives_the_modes_after_the_last_move(arm_bag, tmp_path, capsy
     assert main(['analyze', str(arm_bag), '--arm', arm, '--json', str(out)]) == 0
     text = capsys.readouterr().out
     assert 'joints at rest from 0.300 s at q = 0.5 rad' in text
-    assert '(arm model: 3.4780 Hz' in text  # the rotary arm file's first mode at q = 0.5
+    assert '(arm model: 3.478 Hz' in text  # the rotary arm file's first mode at q = 0.5
     data = json.loads(out.read_text())
     assert data['release_source'] == 'joint_states' and data['joint_angles_rad'] == [0.5]
     assert data['stiffness_total_nm_per_rad'] is None  # no load left: B.12 does not apply
