@@ -42,7 +42,7 @@ ALLOWED_S = {1: 10.0, 2: 30.0}
 NOMINAL_SEEDS = 20
 
 
-def _diagnose_bag(
+def diagnose_bag(
     effects: Mapping[str, float], seed: int, duration_s: float, exhaustive: bool = False
 ) -> tuple[float, Diagnosis]:
     """CPU seconds of reading and diagnosing one synthetic bag, and the diagnosis."""
@@ -85,8 +85,8 @@ def _found(result: Diagnosis) -> str:
 
 
 def _case(hidden: Mapping[str, float], seed: int, duration_s: float) -> BenchResult:
-    cpu, result = _diagnose_bag(hidden, seed, duration_s)
-    baseline, _ = _diagnose_bag(hidden, seed, duration_s, exhaustive=True)
+    cpu, result = diagnose_bag(hidden, seed, duration_s)
+    baseline, _ = diagnose_bag(hidden, seed, duration_s, exhaustive=True)
     return BenchResult(
         name=f'diagnose_{"+".join(hidden)}',
         value=cpu,
@@ -105,8 +105,8 @@ def _case(hidden: Mapping[str, float], seed: int, duration_s: float) -> BenchRes
 
 
 def _nominal(seeds: int, duration_s: float) -> BenchResult:
-    runs = [_diagnose_bag({}, 100 + seed, duration_s) for seed in range(seeds)]
-    baseline, _ = _diagnose_bag({}, 100, duration_s, exhaustive=True)
+    runs = [diagnose_bag({}, 100 + seed, duration_s) for seed in range(seeds)]
+    baseline, _ = diagnose_bag({}, 100, duration_s, exhaustive=True)
     nones = sum(r.missing_effect == 'none' for _, r in runs)
     mean = sum(cpu for cpu, _ in runs) / seeds
     return BenchResult(
