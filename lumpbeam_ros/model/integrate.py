@@ -17,6 +17,7 @@ the reference integrator, ``scipy.integrate.solve_ivp(method='Radau')`` on the s
 
 from __future__ import annotations
 
+from contextlib import nullcontext
 from dataclasses import dataclass
 
 import numpy as np
@@ -197,23 +198,11 @@ class ModalSolver:
             The solution on the grid (starting at 0), or ``None`` when the sweeps did not
             converge and a general integrator is needed.
         """
-        if self._n > SINGLE_THREAD_MAX_SEGMENTS:
-            return self._solve_warm(state, duration, step, tol, max_sweeps, remainder)
-        with single_threaded_blas():
-            return self._solve_warm(state, duration, step, tol, max_sweeps, remainder)
-
-    def _solve_warm(
-        self,
-        state: ChainState,
-        duration: float,
-        step: float,
-        tol: float,
-        max_sweeps: int,
-        remainder: np.ndarray | None,
-    ) -> ChainSolution | None:
-        solution = self._solve(state, duration, step, tol, max_sweeps, remainder)
-        if solution is None and remainder is not None:
-            solution = self._solve(state, duration, step, tol, max_sweeps, None)
+        threads = nullcontext() if self._n > SINGLE_THREAD_MAX_SEGMENTS else single_threaded_blas()
+        with threads:
+            solution = self._solve(state, duration, step, tol, max_sweeps, remainder)
+            if solution is None and remainder is not None:
+                solution = self._solve(state, duration, step, tol, max_sweeps, None)
         return solution
 
     def _solve(
