@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from lumpbeam_lab.bench.bench_result import BenchResult, best_time
-from lumpbeam_lab.bench.diagnose_pairs import diagnose_bag, worst_error
+from lumpbeam_lab.bench.diagnose_pairs import diagnose_bag, found, worst_error
 from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.diagnose.measurement import Record, read_record
 from lumpbeam_ros.diagnose.workflow import diagnose, nominal_form
@@ -126,7 +126,7 @@ def cpu_row(
             'within': cpu <= allowed_s,
             'cost_in_simulations': cpu / simulation,
             'simulations': result.simulations,
-            'found': '+'.join(e.name for e in result.missing_effects) or result.missing_effect,
+            'found': found(result),
             'worst_parameter_error': worst_error(result, hidden),
         },
     )

@@ -80,7 +80,8 @@ def worst_error(result: Diagnosis, hidden: Mapping[str, float]) -> float:
     return max(errors) if errors else float('nan')
 
 
-def _found(result: Diagnosis) -> str:
+def found(result: Diagnosis) -> str:
+    """The named effects joined by ``+`` in the order chosen (or the verdict if none)."""
     return '+'.join(e.name for e in result.missing_effects) or result.missing_effect
 
 
@@ -97,7 +98,7 @@ def _case(hidden: Mapping[str, float], seed: int, duration_s: float) -> BenchRes
         details={
             'case': '+'.join(hidden),
             'allowed_s': ALLOWED_S[len(hidden)],
-            'found': _found(result),
+            'found': found(result),
             'worst_parameter_error': worst_error(result, hidden),
             'confidence': result.confidence,
         },
