@@ -110,12 +110,22 @@ class FitProblem:
         self, record: Record, nominal: BeamParameters, sigma_z: float, sigma_pitch: float
     ):
         self.record = record
-        self.nominal = nominal
+        self._memo: dict[tuple[str, bytes, float], np.ndarray] = {}
+        self._nominal = nominal
         self.sigma_z = sigma_z
         self.sigma_pitch = sigma_pitch
         self.simulations = 0
         self._segments = record.tracked_segments()
-        self._memo: dict[tuple[str, bytes, float], np.ndarray] = {}
+
+    @property
+    def nominal(self) -> BeamParameters:
+        """The nominal beam the models' parameters refer to."""
+        return self._nominal
+
+    @nominal.setter
+    def nominal(self, beam: BeamParameters) -> None:
+        self._nominal = beam
+        self._memo.clear()  # residuals remembered for the old reference are not the new's
 
     def simulate(
         self, beam: BeamParameters, end_s: float = math.inf, warm: WarmStart | None = None
