@@ -14,6 +14,7 @@ SUITES = (
     'tracker',
     'camera-accuracy',
     'ident',
+    'crb',
     'bagio',
     'diagnose',
     'diagnose_pairs',
