@@ -16,6 +16,25 @@ import yaml
 
 from lumpbeam_ros.errors import ConfigError
 
+#: libyaml's loader when PyYAML was built with it: the same safe subset of YAML, parsed ten
+#: times faster than the pure-Python one (a command reads two or three files as it starts).
+_SAFE_LOADER: Any = getattr(yaml, 'CSafeLoader', yaml.SafeLoader)
+
+
+def safe_load(text: str) -> Any:
+    """``yaml.safe_load`` with libyaml when available.
+
+    Args:
+        text: A YAML document.
+
+    Returns:
+        The parsed value.
+
+    Raises:
+        yaml.YAMLError: Not valid YAML.
+    """
+    return yaml.load(text, Loader=_SAFE_LOADER)
+
 
 def flatten(tree: Mapping[str, Any], prefix: str = '') -> dict[str, Any]:
     """Flattens nested mappings into dotted keys, as ROS 2 names nested parameters.
@@ -57,7 +76,7 @@ def read_yaml_document(path: str | Path) -> Any:
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(path, '', f'cannot read: {exc}') from None
     try:
-        return yaml.safe_load(text)
+        return safe_load(text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, 'problem_mark', None)
         where = f' at line {mark.line + 1}' if mark is not None else ''

@@ -149,3 +149,14 @@ def test_get_int_and_get_choice_accept_and_default():
             get_choice({'m': bad}, 'm', 'f', choices)
     with pytest.raises(ConfigError, match='m: missing'):
         get_choice({}, 'm', 'f', choices)
+
+
+def test_safe_load_parses_as_yaml_safe_load_and_refuses_python_objects():
+    import yaml
+
+    from lumpbeam_ros.paramfile import safe_load
+
+    text = 'a: [1, 2.5, -3e-4]\nb: {c: true, d: null, e: "x"}\n'
+    assert safe_load(text) == yaml.safe_load(text)
+    with pytest.raises(yaml.YAMLError):
+        safe_load('!!python/object/apply:os.system ["true"]')

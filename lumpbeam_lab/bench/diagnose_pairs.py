@@ -42,7 +42,7 @@ ALLOWED_S = {1: 10.0, 2: 30.0}
 NOMINAL_SEEDS = 20
 
 
-def _diagnose_bag(
+def diagnose_bag(
     effects: Mapping[str, float], seed: int, duration_s: float, exhaustive: bool = False
 ) -> tuple[float, Diagnosis]:
     """CPU seconds of reading and diagnosing one synthetic bag, and the diagnosis."""
@@ -80,13 +80,14 @@ def worst_error(result: Diagnosis, hidden: Mapping[str, float]) -> float:
     return max(errors) if errors else float('nan')
 
 
-def _found(result: Diagnosis) -> str:
+def found(result: Diagnosis) -> str:
+    """The named effects joined by ``+`` in the order chosen (or the verdict if none)."""
     return '+'.join(e.name for e in result.missing_effects) or result.missing_effect
 
 
 def _case(hidden: Mapping[str, float], seed: int, duration_s: float) -> BenchResult:
-    cpu, result = _diagnose_bag(hidden, seed, duration_s)
-    baseline, _ = _diagnose_bag(hidden, seed, duration_s, exhaustive=True)
+    cpu, result = diagnose_bag(hidden, seed, duration_s)
+    baseline, _ = diagnose_bag(hidden, seed, duration_s, exhaustive=True)
     return BenchResult(
         name=f'diagnose_{"+".join(hidden)}',
         value=cpu,
@@ -97,7 +98,7 @@ def _case(hidden: Mapping[str, float], seed: int, duration_s: float) -> BenchRes
         details={
             'case': '+'.join(hidden),
             'allowed_s': ALLOWED_S[len(hidden)],
-            'found': _found(result),
+            'found': found(result),
             'worst_parameter_error': worst_error(result, hidden),
             'confidence': result.confidence,
         },
@@ -105,8 +106,8 @@ def _case(hidden: Mapping[str, float], seed: int, duration_s: float) -> BenchRes
 
 
 def _nominal(seeds: int, duration_s: float) -> BenchResult:
-    runs = [_diagnose_bag({}, 100 + seed, duration_s) for seed in range(seeds)]
-    baseline, _ = _diagnose_bag({}, 100, duration_s, exhaustive=True)
+    runs = [diagnose_bag({}, 100 + seed, duration_s) for seed in range(seeds)]
+    baseline, _ = diagnose_bag({}, 100, duration_s, exhaustive=True)
     nones = sum(r.missing_effect == 'none' for _, r in runs)
     mean = sum(cpu for cpu, _ in runs) / seeds
     return BenchResult(

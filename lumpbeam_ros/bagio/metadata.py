@@ -16,9 +16,9 @@ from typing import Any, Final
 
 import yaml
 from rosbags.interfaces import Qos
-from rosbags.rosbag2.metadata import dump_qos_v9
 
 from lumpbeam_ros.errors import BagError
+from lumpbeam_ros.paramfile import safe_load
 
 VERSION: Final = 9
 FILENAME = 'metadata.yaml'
@@ -41,6 +41,23 @@ class TopicEntry:
     count: int
     qos: list[dict[str, Any]]
     type_hash: str = ''
+
+
+def dump_qos(profiles: Sequence[Qos]) -> list[dict[str, Any]]:
+    """QoS profiles in rosbag2's version 9 form, as ``metadata.yaml`` lists them.
+
+    rosbags.rosbag2 is imported only here: it brings its own reader, writer and ruamel.yaml,
+    which a command that only reads a bag (``lumpbeam analyze``) does not need at start-up.
+
+    Args:
+        profiles: The profiles.
+
+    Returns:
+        One mapping per profile.
+    """
+    from rosbags.rosbag2.metadata import dump_qos_v9
+
+    return [dict(profile) for profile in dump_qos_v9(list(profiles))]
 
 
 def build(
@@ -76,7 +93,7 @@ def build(
                         'name': name,
                         'type': msgtype,
                         'serialization_format': 'cdr',
-                        'offered_qos_profiles': dump_qos_v9(list(qos)),
+                        'offered_qos_profiles': dump_qos(qos),
                         'type_description_hash': rihs01,
                     },
                     'message_count': n,
@@ -156,7 +173,7 @@ def load(folder: Path) -> BagInfo:
     if not path.is_file():
         raise BagError(f'{folder}: not a rosbag2 bag (no {FILENAME})')
     try:
-        raw = yaml.safe_load(path.read_text(encoding='utf-8'))
+        raw = safe_load(path.read_text(encoding='utf-8'))
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise BagError(f'{path}: unreadable metadata ({first})') from None
@@ -178,7 +195,7 @@ def load(folder: Path) -> BagInfo:
             meta = item['topic_metadata']
             qos = meta.get('offered_qos_profiles') or []
             if isinstance(qos, str):  # version <= 8 stores the profiles as a YAML string
-                qos = yaml.safe_load(qos) or []
+                qos = safe_load(qos) or []
             topics[meta['name']] = TopicEntry(
                 name=str(meta['name']),
                 msgtype=str(meta['type']),

@@ -42,7 +42,6 @@ import yaml
 from mcap.writer import CompressionType
 from mcap.writer import Writer as McapWriter
 from rosbags.interfaces import Qos
-from rosbags.rosbag2.metadata import dump_qos_v9
 
 from lumpbeam_ros import __version__
 from lumpbeam_ros.bagio import convert, metadata
@@ -168,7 +167,7 @@ class BagWriter(ClosedOnExit):
                 lambda: self._mcap.register_schema(msgtype, encoding, msgdef.encode())
             )
             self._schemas[msgtype] = schema_id
-        qos_text = yaml.safe_dump(dump_qos_v9(profiles), default_flow_style=False).strip()
+        qos_text = yaml.safe_dump(metadata.dump_qos(profiles), default_flow_style=False).strip()
         channel_id = self._guard(
             lambda: self._mcap.register_channel(
                 topic, 'cdr', schema_id, {'offered_qos_profiles': qos_text}

@@ -15,6 +15,7 @@ level, so a record tracked throughout is compared as it is.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -23,7 +24,7 @@ from scipy.optimize import least_squares
 
 from lumpbeam_ros.diagnose.measurement import Record
 from lumpbeam_ros.model.parameters import BeamParameters
-from lumpbeam_ros.model.simulate import SimulationDivergedError, simulate_loads
+from lumpbeam_ros.model.simulate import SimulationDivergedError, WarmStart, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
 #: Finite-difference step of the fitted parameters (relative, at least 2e-3 absolute): well
@@ -34,6 +35,10 @@ DIFF_STEP = 2e-3
 #: Residual of every sample when a model cannot be simulated (extreme parameters): far
 #: worse than any fit, so the least squares steps back.
 DIVERGED_RESIDUAL = 1e3
+
+#: Residual vectors remembered by model and parameters: a fit's start is often a point the
+#: screening has just simulated.
+MEMO_SIZE = 32
 
 
 class Fittable(Protocol):
@@ -105,18 +110,33 @@ class FitProblem:
         self, record: Record, nominal: BeamParameters, sigma_z: float, sigma_pitch: float
     ):
         self.record = record
-        self.nominal = nominal
+        self._memo: dict[tuple[str, bytes, float], np.ndarray] = {}
+        self._nominal = nominal
         self.sigma_z = sigma_z
         self.sigma_pitch = sigma_pitch
         self.simulations = 0
         self._segments = record.tracked_segments()
 
-    def simulate(self, beam: BeamParameters, end_s: float = math.inf) -> TipTrajectory:
+    @property
+    def nominal(self) -> BeamParameters:
+        """The nominal beam the models' parameters refer to."""
+        return self._nominal
+
+    @nominal.setter
+    def nominal(self, beam: BeamParameters) -> None:
+        self._nominal = beam
+        self._memo.clear()  # residuals remembered for the old reference are not the new's
+
+    def simulate(
+        self, beam: BeamParameters, end_s: float = math.inf, warm: WarmStart | None = None
+    ) -> TipTrajectory:
         """Simulates a beam at the record's stamps up to ``end_s``.
 
         Args:
             beam: The beam.
             end_s: Last time of interest, s.
+            warm: Where to start the solver's sweeps from, and to leave this simulation's
+                (:class:`~lumpbeam_ros.model.simulate.WarmStart`).
 
         Returns:
             The tip trajectory at the stamps ``t <= end_s``.
@@ -124,11 +144,20 @@ class FitProblem:
         self.simulations += 1
         t = self.record.t[self.record.t <= end_s]
         return simulate_loads(
-            beam, t, self.record.load_events, self.record.initial_load_kg, stiff_fallback=False
+            beam,
+            t,
+            self.record.load_events,
+            self.record.initial_load_kg,
+            stiff_fallback=False,
+            warm=warm,
         )
 
     def model_residuals(
-        self, model: Fittable, x: np.ndarray, end_s: float = math.inf
+        self,
+        model: Fittable,
+        x: np.ndarray,
+        end_s: float = math.inf,
+        warm: WarmStart | None = None,
     ) -> np.ndarray:
         """Residuals of a model at ``x`` on the samples up to ``end_s``.
 
@@ -140,16 +169,24 @@ class FitProblem:
             model: The model.
             x: Its parameters.
             end_s: Last time, s.
+            warm: See :meth:`simulate`.
 
         Returns:
             The stacked residuals (:meth:`residuals`).
         """
+        key = (model.name, np.asarray(x, dtype=float).tobytes(), end_s)
+        if key in self._memo:  # e.g. a screening column at the strength a fit starts from
+            return self._memo[key].copy()
         try:
             with np.errstate(all='ignore'):
-                return self.residuals(self.simulate(model.beam(self.nominal, x), end_s))
+                residuals = self.residuals(self.simulate(model.beam(self.nominal, x), end_s, warm))
         except (SimulationDivergedError, RuntimeError):  # RuntimeError: no static equilibrium
             count = int(np.count_nonzero(self.record.t <= end_s))
-            return np.full(2 * count, DIVERGED_RESIDUAL)
+            residuals = np.full(2 * count, DIVERGED_RESIDUAL)
+        if len(self._memo) >= MEMO_SIZE:
+            self._memo.pop(next(iter(self._memo)))
+        self._memo[key] = residuals
+        return residuals.copy()
 
     def residuals(self, trajectory: TipTrajectory, start_s: float = -math.inf) -> np.ndarray:
         """Noise-normalized residuals (model minus measurement), z then pitch.
@@ -183,6 +220,7 @@ class FitProblem:
         x0: np.ndarray,
         end_s: float = math.inf,
         max_evaluations: int = 60,
+        alternatives: Sequence[np.ndarray] = (),
     ) -> Fit:
         """Fits a candidate by bounded least squares on the samples up to ``end_s``.
 
@@ -191,16 +229,25 @@ class FitProblem:
             x0: Starting parameters (clipped into the bounds).
             end_s: Last fitted time, s.
             max_evaluations: Budget of residual evaluations (each one simulation).
+            alternatives: Other starting points (e.g. a linearized step's prediction):
+                the fit starts from whichever of them and ``x0`` has the lowest chi2.
 
         Returns:
             The fit.
         """
         lo, hi = candidate.bounds()
-        x0 = np.clip(np.asarray(x0, dtype=float), lo + 1e-9, hi - 1e-9)
         start = self.simulations
+        warm = WarmStart()  # each evaluation starts from the previous one's solution
 
         def fun(x: np.ndarray) -> np.ndarray:
-            return self.model_residuals(candidate, x, end_s)
+            return self.model_residuals(candidate, x, end_s, warm)
+
+        starts = [
+            np.clip(np.asarray(x, dtype=float), lo + 1e-9, hi - 1e-9) for x in (x0, *alternatives)
+        ]
+        x0 = (
+            min(starts, key=lambda x: float(np.sum(fun(x) ** 2))) if len(starts) > 1 else starts[0]
+        )
 
         result = least_squares(
             fun,

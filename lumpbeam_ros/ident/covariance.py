@@ -12,7 +12,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import fftconvolve
 
 #: Lags looked ahead when deciding that the residual autocorrelation has died out.
 _LOOKAHEAD = 16
@@ -127,12 +126,34 @@ def sandwich_covariance(jacobian: np.ndarray, residuals: np.ndarray) -> Covarian
         # J^T Sigma J with Sigma the Toeplitz matrix of the tapered autocovariances: Sigma J
         # is a convolution of each Jacobian column with the kernel, O(N log N), not O(N lag).
         kernel = np.concatenate([kernel[:0:-1], kernel])
-        meat = jacobian.T @ fftconvolve(jacobian, kernel[:, None], mode='same', axes=0)
+        meat = jacobian.T @ _convolve_same(jacobian, kernel)
     matrix = bread @ meat @ bread
     # Bartlett-tapered biased autocovariances form a positive semi-definite Toeplitz matrix
     # (a Schur product of two), so the meat, and the result, are too; only rounding remains.
     matrix = 0.5 * (matrix + matrix.T)
     return Covariance(matrix, white, float(np.sqrt(s2)), lag)
+
+
+def _convolve_same(columns: np.ndarray, kernel: np.ndarray) -> np.ndarray:
+    """Each column convolved with an odd-length kernel, centred (``mode='same'``), by FFT.
+
+    numpy's FFT rather than ``scipy.signal.fftconvolve``: importing scipy.signal takes
+    longer than a whole identification (``lumpbeam analyze`` starts in a fraction of it).
+
+    Args:
+        columns: Shape (N, m).
+        kernel: Shape (K,), K odd.
+
+    Returns:
+        Shape (N, m): the full convolution's middle N rows.
+    """
+    n, k = columns.shape[0], kernel.size
+    size = n + k - 1
+    fast = 1 << (size - 1).bit_length()
+    spectrum = np.fft.rfft(columns, fast, axis=0) * np.fft.rfft(kernel, fast)[:, None]
+    full = np.fft.irfft(spectrum, fast, axis=0)
+    start = (k - 1) // 2
+    return np.asarray(full[start : start + n])
 
 
 def mean_with_std(values: np.ndarray) -> tuple[float, float]:

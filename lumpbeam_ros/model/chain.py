@@ -25,6 +25,7 @@ the offsets add to the right-hand side. The clamped beam has no offsets.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -39,11 +40,29 @@ def _difference_matrix(n: int) -> np.ndarray:
     return np.eye(n) - np.eye(n, k=-1)
 
 
+def _frozen(array: np.ndarray) -> np.ndarray:
+    """A cached matrix, read-only: every caller shares it."""
+    array = np.asarray(array)
+    array.setflags(write=False)
+    return array
+
+
+#: ``(cos phi, sin phi)`` of a batch, computed once for several force terms.
+Trig = tuple[np.ndarray, np.ndarray]
+
+
+def trig(phi: np.ndarray) -> Trig:
+    """``(cos phi, sin phi)``: the trigonometry every force of a batch shares."""
+    return np.cos(phi), np.sin(phi)
+
+
 @dataclass(frozen=True)
 class LumpedChain:
     """A planar chain of ``n`` rigid segments carrying point masses.
 
-    Build one with :meth:`from_beam`; the arrays are not to be modified.
+    Build one with :meth:`from_beam`; the arrays are not to be modified. The matrices
+    derived from them (:attr:`inertia_coupling`, :attr:`stiffness_matrix`, ...) are computed
+    once per chain and read-only: a simulation evaluates the forces thousands of times.
 
     Attributes:
         segment_lengths: Length of each segment, m (L_s for a beam).
@@ -124,19 +143,25 @@ class LumpedChain:
         """Number of segments."""
         return int(self.inertia.size)
 
-    @property
+    @cached_property
     def inertia_coupling(self) -> np.ndarray:
         """A_ij = sum_p m_p l_i^p l_j^p."""
-        return np.asarray((self.levers * self.masses[:, None]).T @ self.levers)
+        return _frozen((self.levers * self.masses[:, None]).T @ self.levers)
 
-    @property
+    @cached_property
     def gravity_moment(self) -> np.ndarray:
         """G_i = sum_p m_p l_i^p: first moment of the masses beyond each joint."""
-        return np.asarray(self.masses @ self.levers)
+        return _frozen(self.masses @ self.levers)
 
-    def gravity_forces(self, phi: np.ndarray) -> np.ndarray:
-        """``g G cos(phi + tilt)``: the generalized forces of gravity, any batch shape."""
-        return self.gravity * self.gravity_moment * np.cos(phi + self.tilt)
+    def gravity_forces(self, phi: np.ndarray, cos_phi: np.ndarray | None = None) -> np.ndarray:
+        """``g G cos(phi + tilt)``: the generalized forces of gravity, any batch shape.
+
+        Args:
+            phi: Angles.
+            cos_phi: ``cos(phi)`` if already computed (used when the clamp is level).
+        """
+        level = cos_phi if cos_phi is not None and self.tilt == 0.0 else np.cos(phi + self.tilt)
+        return np.asarray(self.gravity * self.gravity_moment * level)
 
     def gravity_stiffness(self, phi: np.ndarray) -> np.ndarray:
         """``g G sin(phi + tilt)``: minus the derivative of :meth:`gravity_forces`."""
@@ -146,17 +171,17 @@ class LumpedChain:
         """``3 k3 phi_1^2``: the cubic term's contribution to joint 1's tangent stiffness."""
         return 3.0 * self.cubic_stiffness * float(phi[0]) ** 2
 
-    @property
+    @cached_property
     def stiffness_matrix(self) -> np.ndarray:
         """K = D^T diag(k) D."""
         d = _difference_matrix(self.n)
-        return np.asarray(d.T @ (self.stiffness[:, None] * d))
+        return _frozen(d.T @ (self.stiffness[:, None] * d))
 
-    @property
+    @cached_property
     def damping_matrix(self) -> np.ndarray:
         """C = D^T diag(c) D."""
         d = _difference_matrix(self.n)
-        return np.asarray(d.T @ (self.damping[:, None] * d))
+        return _frozen(d.T @ (self.damping[:, None] * d))
 
     def drive_forces(self, offsets: np.ndarray, offset_rates: np.ndarray) -> np.ndarray:
         """``D^T (k o + c o')``: the generalized forces of springs whose clamps are turned.
@@ -198,19 +223,22 @@ class LumpedChain:
             phi[..., -1].copy(),
         )
 
-    def tip_velocity(self, phi: np.ndarray, phi_dot: np.ndarray) -> np.ndarray:
-        """Velocity (vx, vz) of the free end, shape (..., 2)."""
+    def tip_velocity(
+        self, phi: np.ndarray, phi_dot: np.ndarray, cs: Trig | None = None
+    ) -> np.ndarray:
+        """Velocity (vx, vz) of the free end, shape (..., 2); ``cs``: :func:`trig` of phi."""
         ls = self.segment_lengths
+        c, s = trig(phi) if cs is None else cs
         return np.stack(
             [
-                -(ls * np.sin(phi) * phi_dot).sum(axis=-1),
-                -(ls * np.cos(phi) * phi_dot).sum(axis=-1),
+                -(ls * s * phi_dot).sum(axis=-1),
+                -(ls * c * phi_dot).sum(axis=-1),
             ],
             axis=-1,
         )
 
     def effect_forces(
-        self, phi: np.ndarray, phi_dot: np.ndarray, friction: bool = True
+        self, phi: np.ndarray, phi_dot: np.ndarray, friction: bool = True, cs: Trig | None = None
     ) -> np.ndarray:
         """Generalized forces of dry friction and the cubic spring at joint 1, and tip drag.
 
@@ -219,6 +247,7 @@ class LumpedChain:
             phi_dot: Angular velocities, same shape.
             friction: Include the (smoothed) dry friction; a solver that treats its switching
                 exactly leaves it out.
+            cs: :func:`trig` of ``phi`` if already computed.
 
         Returns:
             Q_e, same shape.
@@ -230,15 +259,16 @@ class LumpedChain:
             # Joint 1's angle is phi_1 itself (it turns against the wall).
             q[..., 0] -= self.coulomb_torque * np.tanh(phi_dot[..., 0] / FRICTION_SMOOTHING_RAD_S)
         if self.drag_c_q > 0.0:
-            v = self.tip_velocity(phi, phi_dot)
+            c, s = trig(phi) if cs is None else cs
+            v = self.tip_velocity(phi, phi_dot, (c, s))
             force = -self.drag_c_q * np.linalg.norm(v, axis=-1, keepdims=True) * v
             # The free end moves by L_i (-sin phi_i, -cos phi_i) per unit of phi_i.
             ls = self.segment_lengths
-            q += -ls * (np.sin(phi) * force[..., :1] + np.cos(phi) * force[..., 1:])
+            q += -ls * (s * force[..., :1] + c * force[..., 1:])
         return q
 
     def generalized_forces(
-        self, phi: np.ndarray, phi_dot: np.ndarray, friction: bool = True
+        self, phi: np.ndarray, phi_dot: np.ndarray, friction: bool = True, cs: Trig | None = None
     ) -> np.ndarray:
         """Right-hand side of B.16 for a batch: every force but the inertial ``M phi''``.
 
@@ -250,27 +280,30 @@ class LumpedChain:
             phi: Angles, shape (..., n).
             phi_dot: Angular velocities, same shape.
             friction: Include the dry friction at joint 1 (see :meth:`effect_forces`).
+            cs: :func:`trig` of ``phi`` if already computed.
 
         Returns:
             The generalized forces, same shape.
         """
         a = self.inertia_coupling
-        c, s = np.cos(phi), np.sin(phi)
+        c, s = trig(phi) if cs is None else cs
         w2 = phi_dot**2
         coriolis = s * ((c * w2) @ a) - c * ((s * w2) @ a)
         return np.asarray(
             -coriolis
-            + self.gravity_forces(phi)
+            + self.gravity_forces(phi, c)
             - phi @ self.stiffness_matrix
             - phi_dot @ self.damping_matrix
-            + self.effect_forces(phi, phi_dot, friction)
+            + self.effect_forces(phi, phi_dot, friction, (c, s))
             + (0.0 if self.preload is None else self.preload)
         )
 
-    def inertial_forces(self, phi: np.ndarray, phi_ddot: np.ndarray) -> np.ndarray:
-        """``M(phi) phi''`` for a batch, without forming the matrices."""
+    def inertial_forces(
+        self, phi: np.ndarray, phi_ddot: np.ndarray, cs: Trig | None = None
+    ) -> np.ndarray:
+        """``M(phi) phi''`` for a batch, without forming the matrices (``cs``: :func:`trig`)."""
         a = self.inertia_coupling
-        c, s = np.cos(phi), np.sin(phi)
+        c, s = trig(phi) if cs is None else cs
         return np.asarray(
             c * ((c * phi_ddot) @ a) + s * ((s * phi_ddot) @ a) + self.inertia * phi_ddot
         )

@@ -17,6 +17,7 @@ the reference integrator, ``scipy.integrate.solve_ivp(method='Radau')`` on the s
 
 from __future__ import annotations
 
+from contextlib import nullcontext
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,7 +26,7 @@ from scipy.signal import lfilter
 
 from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.errors import SolverBudgetError
-from lumpbeam_ros.model.chain import LumpedChain
+from lumpbeam_ros.model.chain import LumpedChain, trig
 from lumpbeam_ros.model.modes import LinearModel
 
 #: Dry friction is stepped at first order (see ``_propagate_with_friction``): its grid is
@@ -60,12 +61,15 @@ class ChainSolution:
         phi: Angles, shape (len(t), n).
         phi_dot: Angular velocities, same shape.
         method: ``'modal'`` or ``'radau'``: which integrator produced it.
+        remainder: The modal solver's converged nonlinear remainder ``r`` on the grid,
+            (len(t), n), to start a similar solve from (``None`` for Radau).
     """
 
     t: np.ndarray
     phi: np.ndarray
     phi_dot: np.ndarray
     method: str
+    remainder: np.ndarray | None = None
 
     def final_state(self) -> ChainState:
         """The state at the last time."""
@@ -177,12 +181,18 @@ class ModalSolver:
         step: float,
         tol: float = 1e-11,
         max_sweeps: int = 40,
+        remainder: np.ndarray | None = None,
     ) -> ChainSolution | None:
         """Integrates from ``state`` over ``duration`` on a uniform grid.
 
         For chains up to ``SINGLE_THREAD_MAX_SEGMENTS`` the products are small, so BLAS runs
         single-threaded: handing them to threads costs more than it saves, badly so on a busy
         two-core machine. Longer chains keep the threads.
+
+        The sweeps start from ``remainder`` when given (a nearby beam's converged one, e.g.
+        the previous step of a fit): the fixed point is the same, to ``tol``, and it is
+        reached in fewer sweeps than from zero. A warm start that does not converge is
+        retried from zero, so it can only save sweeps.
 
         Args:
             state: Initial angles and velocities.
@@ -191,18 +201,27 @@ class ModalSolver:
                 ``FRICTION_REFINEMENT`` times finer with dry friction).
             tol: Convergence threshold on the change of the angles between sweeps, rad.
             max_sweeps: Sweeps before giving up.
+            remainder: A starting remainder on the same grid (ignored if its shape differs).
 
         Returns:
             The solution on the grid (starting at 0), or ``None`` when the sweeps did not
             converge and a general integrator is needed.
         """
-        if self._n > SINGLE_THREAD_MAX_SEGMENTS:
-            return self._solve(state, duration, step, tol, max_sweeps)
-        with single_threaded_blas():
-            return self._solve(state, duration, step, tol, max_sweeps)
+        threads = nullcontext() if self._n > SINGLE_THREAD_MAX_SEGMENTS else single_threaded_blas()
+        with threads:
+            solution = self._solve(state, duration, step, tol, max_sweeps, remainder)
+            if solution is None and remainder is not None:
+                solution = self._solve(state, duration, step, tol, max_sweeps, None)
+        return solution
 
     def _solve(
-        self, state: ChainState, duration: float, step: float, tol: float, max_sweeps: int
+        self,
+        state: ChainState,
+        duration: float,
+        step: float,
+        tol: float,
+        max_sweeps: int,
+        remainder: np.ndarray | None,
     ) -> ChainSolution | None:
         if self.chain.coulomb_torque > 0.0:
             step /= FRICTION_REFINEMENT
@@ -212,7 +231,9 @@ class ModalSolver:
         phi_eq = self.linear.phi_eq
         z0 = self.modal_state(state)
         chain = self.chain
-        forcing = np.zeros((t.size, self._n))
+        shape = (t.size, self._n)
+        warm = remainder is not None and remainder.shape == shape
+        forcing = np.array(remainder) if warm else np.zeros(shape)
         previous = None
         for _ in range(max_sweeps):
             # A diverging sweep overflows on its way to the check below, which handles it.
@@ -222,19 +243,22 @@ class ModalSolver:
                 return None
             d, d_dot = x[:, : self._n], x[:, self._n :]
             if previous is not None and np.max(np.abs(d - previous)) < tol:
-                return ChainSolution(t, d + phi_eq, d_dot, 'modal')
+                return ChainSolution(t, d + phi_eq, d_dot, 'modal', forcing)
             previous = d
             d_ddot = forcing @ self._m0_inv.T - d @ self._m0_inv_k.T - d_dot @ self._m0_inv_c.T
             phi = d + phi_eq
+            cs = trig(phi)  # shared by every force term below
             # r: everything B.16 has beyond its linearisation (see the module docstring).
             # The equilibrium's own forces cancel, leaving the linear model's -K_eff d - C d'.
             # A diverging sweep's large but finite angles may overflow here: the next
             # sweep's check refuses them.
             with np.errstate(over='ignore', invalid='ignore'):
-                inertial_excess = chain.inertial_forces(phi, d_ddot) - d_ddot @ self.linear.mass
+                inertial_excess = (
+                    chain.inertial_forces(phi, d_ddot, cs) - d_ddot @ self.linear.mass
+                )
                 linear_force = -d @ self.linear.stiffness - d_dot @ self.linear.damping
                 forcing = (
-                    chain.generalized_forces(phi, d_dot, friction=False)
+                    chain.generalized_forces(phi, d_dot, friction=False, cs=cs)
                     - linear_force
                     - inertial_excess
                 )

@@ -33,6 +33,35 @@ class SimulationDivergedError(LumpbeamError):
     """The modal solver cannot integrate a beam and the stiff fallback is off."""
 
 
+class WarmStart:
+    """The converged nonlinear remainders of a simulation, to start a similar one from.
+
+    A fit simulates the same record's stretches for beams that differ by a step of the
+    least squares: handed the previous simulation's remainder, each stretch's sweeps start
+    next to the fixed point (:meth:`~lumpbeam_ros.model.integrate.ModalSolver.solve`), which
+    they reach in about half the sweeps. The result is the same to the solver's tolerance.
+    Keyed by the stretch's start and load; only a grid of the same shape is used.
+    """
+
+    def __init__(self) -> None:
+        self._remainders: dict[tuple[float, float], np.ndarray] = {}
+
+    def get(self, start_s: float, load_kg: float) -> np.ndarray | None:
+        """The remainder last stored for a stretch (``None``: none yet)."""
+        return self._remainders.get((start_s, load_kg))
+
+    def put(self, start_s: float, load_kg: float, remainder: np.ndarray | None) -> None:
+        """Stores a stretch's converged remainder (``None`` is ignored)."""
+        if remainder is not None:
+            self._remainders[(start_s, load_kg)] = remainder
+
+    def copy(self) -> WarmStart:
+        """An independent copy (the arrays are shared: they are never modified)."""
+        other = WarmStart()
+        other._remainders = dict(self._remainders)
+        return other
+
+
 class BeamSimulation:
     """A beam advanced in time, with the tip load changeable between advances.
 
@@ -45,6 +74,8 @@ class BeamSimulation:
         stiff_fallback: Integrate a stretch the modal solver cannot (extreme parameters) with
             the Radau reference; ``False`` raises :class:`SimulationDivergedError` instead (a fit
             takes such parameters for a bad fit rather than wait minutes for Radau).
+        warm: Remainders to start each stretch's sweeps from, updated with this
+            simulation's (``None``: every stretch starts from zero).
     """
 
     def __init__(
@@ -54,26 +85,36 @@ class BeamSimulation:
         t0: float = 0.0,
         step: float = DEFAULT_STEP_S,
         stiff_fallback: bool = True,
+        warm: WarmStart | None = None,
     ):
         self.beam = beam
         self.stiff_fallback = stiff_fallback
+        self.warm = warm
         self.step = step
         self.time = float(t0)
         self.load_kg = float(load_kg)
+        self._chains: dict[float, LumpedChain] = {}
         self._solvers: dict[float, ModalSolver] = {}
-        chain = self._solver(self.load_kg).chain
+        chain = self._chain(self.load_kg)
         self.state = ChainState(static_equilibrium(chain), np.zeros(beam.n_segments))
         self._rest = (self.state, self.load_kg)
 
+    def _chain(self, load_kg: float) -> LumpedChain:
+        if load_kg not in self._chains:
+            self._chains[load_kg] = LumpedChain.from_beam(self.beam, load_kg)
+        return self._chains[load_kg]
+
     def _solver(self, load_kg: float) -> ModalSolver:
+        # Built only for a load the beam moves under: a drop test never integrates its
+        # loaded rest, so it never pays for that configuration's eigen-decomposition.
         if load_kg not in self._solvers:
-            self._solvers[load_kg] = ModalSolver(LumpedChain.from_beam(self.beam, load_kg))
+            self._solvers[load_kg] = ModalSolver(self._chain(load_kg))
         return self._solvers[load_kg]
 
     @property
     def chain(self) -> LumpedChain:
         """The chain with the current load."""
-        return self._solver(self.load_kg).chain
+        return self._chain(self.load_kg)
 
     def set_load(self, load_kg: float) -> None:
         """Changes the tip load now; the motion carries over.
@@ -112,7 +153,10 @@ class BeamSimulation:
             phi = np.repeat(self.state.phi[None, :], t_out.size, axis=0)
             return phi, np.repeat(self.state.phi_dot[None, :], t_out.size, axis=0)
         solver = self._solver(self.load_kg)
-        solution = solver.solve(self.state, duration, self.step)
+        warm = None if self.warm is None else self.warm.get(self.time, self.load_kg)
+        solution = solver.solve(self.state, duration, self.step, remainder=warm)
+        if self.warm is not None and solution is not None:
+            self.warm.put(self.time, self.load_kg, solution.remainder)
         if solution is None:
             if not self.stiff_fallback:
                 raise SimulationDivergedError(
@@ -140,6 +184,7 @@ def simulate_loads(
     initial_load_kg: float = 0.0,
     step: float = DEFAULT_STEP_S,
     stiff_fallback: bool = True,
+    warm: WarmStart | None = None,
 ) -> TipTrajectory:
     """Simulates the tip under a schedule of load changes, starting at rest.
 
@@ -156,6 +201,7 @@ def simulate_loads(
         initial_load_kg: The load before the first event; the beam starts at rest with it.
         step: Internal grid spacing, s.
         stiff_fallback: See :class:`BeamSimulation`.
+        warm: See :class:`BeamSimulation`.
 
     Returns:
         The tip trajectory at ``t``, with the load at each sample.
@@ -168,7 +214,7 @@ def simulate_loads(
     physical_t = t - latency
     events = sorted((float(te), float(kg)) for te, kg in load_events)
     start = min(float(physical_t[0]), events[0][0] if events else np.inf)
-    simulation = BeamSimulation(beam, initial_load_kg, start, step, stiff_fallback)
+    simulation = BeamSimulation(beam, initial_load_kg, start, step, stiff_fallback, warm)
     n = beam.n_segments
     phi = np.empty((t.size, n))
     loads = np.empty(t.size)

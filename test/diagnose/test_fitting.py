@@ -164,3 +164,30 @@ def test_a_mount_too_soft_to_carry_the_beam_is_a_bad_fit_not_an_error(k_base):
     residuals = problem.model_residuals(Model((candidate,)), x)
     assert residuals.size == 2 * len(problem.record)
     np.testing.assert_array_equal(residuals, DIVERGED_RESIDUAL)
+
+
+def test_a_fit_starts_from_the_better_of_its_starts_and_remembers_what_it_simulated():
+    problem = _problem(_record(_beam(1.04, 1.5), noise=1.0))
+    truth = np.array([math.log(1.04), math.log(1.5)])
+    far = problem.fit(nominal_candidate(), np.zeros(2))
+    problem.simulations = 0
+    near = problem.fit(nominal_candidate(), np.array([0.3, -1.0]), alternatives=[truth + 1e-3])
+    np.testing.assert_allclose(near.x, far.x, atol=1e-4)
+    # Both starts are simulated once; the least squares' own first call is remembered.
+    assert near.evaluations < far.evaluations
+    residuals = problem.model_residuals(nominal_candidate(), near.x)
+    before = problem.simulations
+    again = problem.model_residuals(nominal_candidate(), near.x)
+    assert problem.simulations == before and np.array_equal(again, residuals)
+    again[:] = 0.0  # a caller's copy: the memory keeps its own
+    assert not np.array_equal(problem.model_residuals(nominal_candidate(), near.x), again)
+
+
+def test_a_new_nominal_beam_forgets_the_remembered_residuals():
+    problem = _problem(_record(_beam(1.04, 1.5)))
+    first = problem.model_residuals(nominal_candidate(), np.zeros(2))
+    problem.nominal = _beam(1.04, 1.5)
+    assert problem.simulations == 1
+    second = problem.model_residuals(nominal_candidate(), np.zeros(2))
+    assert problem.simulations == 2
+    assert np.max(np.abs(second)) < 1e-3 < np.max(np.abs(first))

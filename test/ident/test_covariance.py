@@ -50,3 +50,16 @@ def test_mean_of_correlated_series_has_a_wider_error():
 
 def test_propagate():
     assert propagate(np.array([1.0, 2.0]), np.diag([4.0, 1.0])) == pytest.approx(math.sqrt(8.0))
+
+
+def test_the_fft_convolution_is_the_centred_direct_one():
+    from lumpbeam_ros.ident.covariance import _convolve_same
+
+    rng = np.random.default_rng(3)
+    for n, k in ((200, 49), (30, 61), (7, 3)):
+        columns, kernel = rng.normal(size=(n, 2)), rng.normal(size=k)
+        direct = np.column_stack([np.convolve(c, kernel, mode='full') for c in columns.T])
+        start = (k - 1) // 2
+        assert _convolve_same(columns, kernel) == pytest.approx(
+            direct[start : start + n], abs=1e-12
+        )

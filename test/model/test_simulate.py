@@ -103,3 +103,39 @@ def test_a_beam_the_modal_solver_cannot_follow_is_refused_without_the_stiff_fall
     soft = replace(BeamParameters(), k_total_nm_per_rad=100.0)  # sags by tens of degrees
     with pytest.raises(SimulationDivergedError, match='extreme parameters'):
         simulate_loads(soft, np.linspace(0, 2, 361), [(0.5, 0.0)], 4.5, stiff_fallback=False)
+
+
+def test_a_warm_start_reaches_the_same_trajectory_in_fewer_sweeps(monkeypatch):
+    from lumpbeam_ros.model import integrate
+    from lumpbeam_ros.model.simulate import WarmStart
+
+    sweeps: list[int] = []
+    propagate = integrate.ModalSolver._propagate
+
+    def counted(self, *args):
+        sweeps[-1] += 1
+        return propagate(self, *args)
+
+    monkeypatch.setattr(integrate.ModalSolver, '_propagate', counted)
+    t = np.arange(0.0, 5.0, 1.0 / 180.0)
+    nearby = replace(BEAM, k_total_nm_per_rad=BEAM.k_total_nm_per_rad * 1.002)
+
+    def run(beam, warm=None):
+        sweeps.append(0)
+        return simulate_loads(beam, t, [(2.0, 0.0)], 4.5, warm=warm)
+
+    cold = run(nearby)
+    warm = WarmStart()
+    run(BEAM, warm)  # a fit's previous step
+    assert warm.get(2.0, 0.0) is not None and warm.get(2.0, 4.5) is None
+    warmed = run(nearby, warm)
+    # The same fixed point to the solver's tolerance (1e-11 rad between sweeps).
+    assert np.max(np.abs(warmed.q - cold.q)) < 1e-9
+    assert sweeps[2] < sweeps[0]
+    # A remainder of another grid is not used: that run sweeps as a cold one does.
+    shorter = t[t < 4.0]
+    sweeps.append(0)
+    simulate_loads(nearby, shorter, [(2.0, 0.0)], 4.5, warm=warm.copy())
+    sweeps.append(0)
+    simulate_loads(nearby, shorter, [(2.0, 0.0)], 4.5)
+    assert sweeps[-2] == sweeps[-1]

@@ -1,3 +1,5 @@
+import pytest
+
 from lumpbeam_lab.bench import cli
 from lumpbeam_lab.bench.runner import available_suites
 from lumpbeam_ros.cli.main import main
@@ -22,3 +24,13 @@ def test_bench_only_cli_prints_both_rows(capsys):
     table = capsys.readouterr().out
     assert 'cli_start_help ' in table and 'cli_start_analyze_help ' in table
     assert table.count('python -c pass') == 2
+
+
+@pytest.mark.slow
+def test_analyze_row_runs_a_whole_analysis_of_a_bag():
+    result = cli.analyze_time(runs=1, duration_s=4.0)
+    assert result.name == 'cli_start_analyze_4s_bag'
+    assert result.details['command'] == 'lumpbeam analyze BAG (4 s, 180 Hz)'
+    assert result.details['budget_s'] == cli.ANALYZE_BUDGET_S
+    # A whole analysis imports numpy and scipy: it cannot start as fast as a bare interpreter.
+    assert result.value > result.baseline_value and result.ratio < 1.0

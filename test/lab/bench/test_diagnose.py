@@ -22,3 +22,15 @@ def test_quick_run_diagnoses_the_bag_and_compares_with_radau():
     assert result.details['simulations'] > 50
     assert math.isfinite(result.details['radau_ms_per_simulation_nominal'])
     assert 'diagnose' in available_suites()
+
+
+@pytest.mark.slow
+def test_cpu_row_counts_the_diagnosis_in_simulations_of_the_same_bag():
+    row = diagnose.cpu_row({'coulomb_friction': 1.0}, 2.0, 1, 4.0)
+    assert row.name == 'diagnose_cpu_coulomb_friction' and row.unit == 'CPU s'
+    assert row.details['found'] == 'coulomb_friction'
+    assert row.details['worst_parameter_error'] < 0.05
+    # A diagnosis runs hundreds of simulations, each at least as costly as the nominal one.
+    assert row.details['cost_in_simulations'] > row.details['simulations'] / 2
+    assert row.ratio == pytest.approx(row.baseline_value / row.value)
+    assert row.details['within'] == (row.value <= 2.0)
