@@ -29,8 +29,8 @@ class HardeningChain(LumpedChain):
     cubic_nm_per_rad3: float = 0.0
     reference_rad: float = 0.0
 
-    def generalized_forces(self, phi, phi_dot, friction=True):
-        q = super().generalized_forces(phi, phi_dot, friction)
+    def generalized_forces(self, phi, phi_dot, friction=True, cs=None):
+        q = super().generalized_forces(phi, phi_dot, friction, cs)
         q[..., 0] -= self.cubic_nm_per_rad3 * (phi[..., 0] - self.reference_rad) ** 3
         return q
 
