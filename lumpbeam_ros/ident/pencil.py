@@ -86,7 +86,12 @@ class MatrixPencil:
         _, vectors = np.linalg.eigh(gram)
         basis = vectors[:, ::-1][:, : self.order]
         poles = np.linalg.eigvals(np.linalg.pinv(basis[:-1]) @ basis[1:])
-        poles = poles[np.abs(poles) > 1e-9]
+        # A spurious pole that grows beyond floating point over the record (seen on a spoiled
+        # stream) makes the Vandermonde matrix below inf, and LAPACK's least squares on it
+        # never returns (a hung identifier); a decaying mode is never such a pole.
+        with np.errstate(divide='ignore', invalid='ignore'):
+            growth = n * np.log(np.abs(poles))
+        poles = poles[(np.abs(poles) > 1e-9) & (growth < 700.0)]
         s = np.log(poles.astype(complex)) / dt
         # Amplitudes by least squares on the Vandermonde matrix of the poles.
         k = np.arange(n)
