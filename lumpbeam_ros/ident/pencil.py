@@ -64,7 +64,7 @@ class MatrixPencil:
             The modes, also kept as ``self.result_``.
 
         Raises:
-            LumpbeamError: Too few samples for the pencil.
+            LumpbeamError: Too few samples for the pencil, or samples too large to centre.
         """
         t = np.asarray(t, dtype=float)
         y = np.asarray(y, dtype=float)
@@ -78,6 +78,10 @@ class MatrixPencil:
         centre = float(u.mean())
         scale = float(np.max(np.abs(u - centre))) or 1.0
         u = (u - centre) / scale
+        if not np.all(np.isfinite(u)):
+            # Finite samples near the float limit (1e308) overflow the centring; the SVD below
+            # would fail with a bare LinAlgError.
+            raise LumpbeamError('matrix pencil: samples too large to centre (near 1e308)')
         # Contiguous, so the Gram product below runs in BLAS.
         hankel = np.ascontiguousarray(np.lib.stride_tricks.sliding_window_view(u, length + 1))
         # The right singular vectors from the small Gram matrix: an (L+1)^2 eigenproblem

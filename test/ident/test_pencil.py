@@ -65,3 +65,11 @@ def test_a_pole_that_overflows_the_record_is_left_out():
     )
     assert done.returncode == 0, done.stderr
     assert float(done.stdout) == pytest.approx(3.06, abs=0.01)
+
+
+def test_samples_near_the_float_limit_are_a_one_line_error():
+    """Finite but 1e308: the centring overflowed and the SVD failed with a bare LinAlgError."""
+    y = -0.01 + _mode(3.1, 0.01, 0.03)
+    y[100:103] = 1e308
+    with pytest.raises(LumpbeamError, match='too large'):
+        MatrixPencil().fit(T, y)
