@@ -75,9 +75,10 @@ class MatrixPencil:
         if length <= self.order:
             raise LumpbeamError(f'matrix pencil: {t.size} samples are too few')
         # Centring keeps a large static level from dominating the subspace.
-        centre = float(u.mean())
-        scale = float(np.max(np.abs(u - centre))) or 1.0
-        u = (u - centre) / scale
+        with np.errstate(over='ignore', invalid='ignore'):  # checked just below
+            centre = float(u.mean())
+            scale = float(np.max(np.abs(u - centre))) or 1.0
+            u = (u - centre) / scale
         if not np.all(np.isfinite(u)):
             # Finite samples near the float limit (1e308) overflow the centring; the SVD below
             # would fail with a bare LinAlgError.
