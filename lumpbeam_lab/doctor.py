@@ -98,7 +98,8 @@ _SUMMARY_OPCODES = {
     Opcode.METADATA_INDEX,
 }
 _CHUNK_OPCODES = {Opcode.SCHEMA, Opcode.CHANNEL, Opcode.MESSAGE}
-_PARSE_ERRORS = (struct.error, EndOfFile, UnicodeDecodeError, ValueError)
+# OverflowError: a damaged 8-byte length beyond what an index can hold (the fuzz campaign).
+_PARSE_ERRORS = (struct.error, EndOfFile, UnicodeDecodeError, ValueError, OverflowError)
 _DECOMPRESS_ERRORS = (McapError, RuntimeError, ValueError, zstandard.ZstdError)
 
 

@@ -47,7 +47,7 @@ def _lumpbeam(*args: str) -> None:
 def prepare(folder: Path) -> dict[str, list[str]]:
     """Writes the inputs; returns each target's arguments."""
     _lumpbeam('synth', str(folder / 'drop'), '--duration', '12')
-    _lumpbeam('synth', str(folder / 'long'), '--duration', '600')
+    _lumpbeam('synth', str(folder / 'long'), '--duration', '2500')
     _lumpbeam('synth', str(folder / 'filmed'), '--duration', '12', '--images',
               '--image-size', '320x240')  # fmt: skip
     drop, long, filmed = (str(folder / n) for n in ('drop', 'long', 'filmed'))

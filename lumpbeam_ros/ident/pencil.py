@@ -64,7 +64,7 @@ class MatrixPencil:
             The modes, also kept as ``self.result_``.
 
         Raises:
-            LumpbeamError: Too few samples for the pencil.
+            LumpbeamError: Too few samples for the pencil, or samples too large to centre.
         """
         t = np.asarray(t, dtype=float)
         y = np.asarray(y, dtype=float)
@@ -75,9 +75,14 @@ class MatrixPencil:
         if length <= self.order:
             raise LumpbeamError(f'matrix pencil: {t.size} samples are too few')
         # Centring keeps a large static level from dominating the subspace.
-        centre = float(u.mean())
-        scale = float(np.max(np.abs(u - centre))) or 1.0
-        u = (u - centre) / scale
+        with np.errstate(over='ignore', invalid='ignore'):  # checked just below
+            centre = float(u.mean())
+            scale = float(np.max(np.abs(u - centre))) or 1.0
+            u = (u - centre) / scale
+        if not np.all(np.isfinite(u)):
+            # Finite samples near the float limit (1e308) overflow the centring; the SVD below
+            # would fail with a bare LinAlgError.
+            raise LumpbeamError('matrix pencil: samples too large to centre (near 1e308)')
         # Contiguous, so the Gram product below runs in BLAS.
         hankel = np.ascontiguousarray(np.lib.stride_tricks.sliding_window_view(u, length + 1))
         # The right singular vectors from the small Gram matrix: an (L+1)^2 eigenproblem
@@ -86,7 +91,12 @@ class MatrixPencil:
         _, vectors = np.linalg.eigh(gram)
         basis = vectors[:, ::-1][:, : self.order]
         poles = np.linalg.eigvals(np.linalg.pinv(basis[:-1]) @ basis[1:])
-        poles = poles[np.abs(poles) > 1e-9]
+        # A spurious pole that grows beyond floating point over the record (seen on a spoiled
+        # stream) makes the Vandermonde matrix below inf, and LAPACK's least squares on it
+        # never returns (a hung identifier); a decaying mode is never such a pole.
+        with np.errstate(divide='ignore', invalid='ignore'):
+            growth = n * np.log(np.abs(poles))
+        poles = poles[(np.abs(poles) > 1e-9) & (growth < 700.0)]
         s = np.log(poles.astype(complex)) / dt
         # Amplitudes by least squares on the Vandermonde matrix of the poles.
         k = np.arange(n)

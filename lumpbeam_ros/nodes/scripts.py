@@ -12,12 +12,21 @@ from __future__ import annotations
 import importlib
 from collections.abc import Callable
 
+from lumpbeam_ros.interface import (
+    CAMERA_NODE,
+    DIAGNOSIS_NODE,
+    IDENTIFIER_NODE,
+    SHAPER_NODE,
+    SIMULATOR_NODE,
+)
 from lumpbeam_ros.interrupts import run_script
 
 
-def _run(module: str) -> int:
+def _run(node: str) -> int:
+    """Runs ``lumpbeam_ros.nodes.<node>``'s ``main`` (each node's module bears its name)."""
+
     def load() -> Callable[[], int]:
-        main: Callable[[], int] = importlib.import_module(f'lumpbeam_ros.nodes.{module}').main
+        main: Callable[[], int] = importlib.import_module(f'lumpbeam_ros.nodes.{node}').main
         return main
 
     return run_script(load, lambda _signum: 0)
@@ -25,24 +34,24 @@ def _run(module: str) -> int:
 
 def camera_node() -> int:
     """``camera_node`` (:mod:`lumpbeam_ros.nodes.camera_node`)."""
-    return _run('camera_node')
+    return _run(CAMERA_NODE)
 
 
 def identifier_node() -> int:
     """``identifier_node`` (:mod:`lumpbeam_ros.nodes.identifier_node`)."""
-    return _run('identifier_node')
+    return _run(IDENTIFIER_NODE)
 
 
 def simulator_node() -> int:
     """``simulator_node`` (:mod:`lumpbeam_ros.nodes.simulator_node`)."""
-    return _run('simulator_node')
+    return _run(SIMULATOR_NODE)
 
 
 def diagnosis_node() -> int:
     """``diagnosis_node`` (:mod:`lumpbeam_ros.nodes.diagnosis_node`)."""
-    return _run('diagnosis_node')
+    return _run(DIAGNOSIS_NODE)
 
 
 def shaper_node() -> int:
     """``shaper_node`` (:mod:`lumpbeam_ros.nodes.shaper_node`)."""
-    return _run('shaper_node')
+    return _run(SHAPER_NODE)

@@ -269,13 +269,13 @@ def _diagnose_stream(bag: Path, beam, seed: int) -> None:
 
 @pytest.fixture(scope='module')
 def filmed(tmp_path_factory):
-    """A short filmed drop test (320 x 240, 40 frames a second), and its clean tracking."""
+    """A short filmed drop test (320 x 240, 25 frames a second), and its clean tracking."""
     from lumpbeam_ros.synthetic.images import ImageOptions
     from lumpbeam_ros.vision.config import load_camera_config
 
     folder = tmp_path_factory.mktemp('filmed')
     beam, drop = load_beam_config()
-    options = SynthOptions(duration_s=2.5, rate_hz=40.0, markers_rate_hz=0.0)
+    options = SynthOptions(duration_s=2.4, rate_hz=25.0, markers_rate_hz=0.0)
     write_drop_test_bag(folder / 'bag', beam, drop, options, images=ImageOptions(320, 240))
     config = load_camera_config().with_resolution(320, 240)
     clean_poses = _tracked(folder / 'bag', folder / 'clean_out', config)

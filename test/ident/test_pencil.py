@@ -1,4 +1,7 @@
 import math
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -39,3 +42,34 @@ def test_too_few_samples_and_bad_settings():
         MatrixPencil().fit(T[:15], T[:15])
     with pytest.raises(ValueError):
         MatrixPencil(order=10, pencil_length=5)
+
+
+#: The fuzz campaign's identifier case 860 (a drop test's window after a small stamp jump):
+#: one spurious pole grows by more than 1e308 over the 537 samples.
+GROWING_POLE = Path(__file__).resolve().parents[1] / 'data' / 'pencil_growing_pole.npz'
+
+FIT_GROWING_POLE = f"""
+import numpy as np
+from lumpbeam_ros.ident.pencil import MatrixPencil
+
+record = np.load({str(GROWING_POLE)!r})
+modes = MatrixPencil(7, 40, 1).fit(record['t'], record['y']).modes
+print(min(modes, key=lambda m: abs(m.natural_frequency_hz - 3.06)).natural_frequency_hz)
+"""
+
+
+def test_a_pole_that_overflows_the_record_is_left_out():
+    """LAPACK's least squares on the inf Vandermonde matrix never returned: a hung node."""
+    done = subprocess.run(
+        [sys.executable, '-c', FIT_GROWING_POLE], capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 0, done.stderr
+    assert float(done.stdout) == pytest.approx(3.06, abs=0.01)
+
+
+def test_samples_near_the_float_limit_are_a_one_line_error():
+    """Finite but 1e308: the centring overflowed and the SVD failed with a bare LinAlgError."""
+    y = -0.01 + _mode(3.1, 0.01, 0.03)
+    y[100:103] = 1e308
+    with pytest.raises(LumpbeamError, match='too large'):
+        MatrixPencil().fit(T, y)

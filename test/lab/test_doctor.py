@@ -387,3 +387,10 @@ def test_an_empty_folder_is_not_a_bag(tmp_path: Path) -> None:
     (tmp_path / 'empty').mkdir()
     with pytest.raises(BagError, match='not a bag folder'):
         examine_bag(tmp_path / 'empty')
+
+
+def test_a_chunk_length_beyond_an_index_is_an_unreadable_record():
+    """A damaged chunk whose data length is about 1.2e19 raised OverflowError (fuzz case)."""
+    body = struct.pack('<QQQI', 0, 0, 0, 0) + struct.pack('<I', 0) + struct.pack('<Q', 2**63 + 5)
+    with pytest.raises(doctor._UnreadableError):
+        doctor._parse(doctor.Opcode.CHUNK, body, 'offset 8')

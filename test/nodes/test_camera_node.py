@@ -230,8 +230,10 @@ def test_main_reads_a_bag_with_a_params_file_and_rejects_a_missing_bag(
         env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
     try:
-        # The node is up (its diagnostics come) before /tip_pose has a subscriber.
+        # The node is up (its diagnostics come), and has had time for the six frames,
+        # before /tip_pose has a subscriber.
         assert ros_graph.spin_until(lambda: len(statuses) > 0, 30.0)
+        ros_graph.spin_for(2.0)
         poses = ros_graph.collect('/tip_pose', PoseStamped, QoSProfile(depth=100))
         stdout, stderr = process.communicate(timeout=30)
     finally:
