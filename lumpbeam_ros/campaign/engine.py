@@ -97,15 +97,25 @@ def start_client(
             '(dask, distributed, pyarrow)'
         ) from None
     if scheduler is None:
-        cluster = stack.enter_context(
-            LocalCluster(
+        from distributed.deploy.spec import SpecCluster
+
+        registered = set(SpecCluster._instances)
+        try:
+            cluster = LocalCluster(
                 n_workers=workers,
                 threads_per_worker=1,
                 processes=True,
                 dashboard_address=None,
                 silence_logs=50,
             )
-        )
+        except BaseException:
+            # A cluster registers itself for distributed's exit-time cleanup before its
+            # workers start; one whose start a signal cut short fails an assertion there (a
+            # traceback after "interrupted"). Its worker processes are multiprocessing
+            # children, which the interpreter ends at exit anyway.
+            SpecCluster._instances.difference_update(set(SpecCluster._instances) - registered)
+            raise
+        stack.enter_context(cluster)
         return stack.enter_context(Client(cluster))
     try:
         client = Client(scheduler, timeout=timeout_s)

@@ -108,3 +108,39 @@ def test_cli_campaign_writes_table_and_report(campaign_bags, tmp_path):
         assert (tmp_path / 'out' / name).is_file()
     html = (tmp_path / 'out' / 'report.html').read_text()
     assert 'data:image/png;base64,' in html and 'EI, N m^2' in html
+
+
+#: A process that starts a local cluster once it has said so (its imports done), and exits
+#: 130 when interrupted, as the lumpbeam command does.
+_INTERRUPTED_START = """
+import contextlib, sys
+from lumpbeam_ros.campaign.engine import start_client
+import distributed
+print('starting', flush=True)
+try:
+    with contextlib.ExitStack() as stack:
+        start_client(None, 2, stack)
+        print('started', flush=True)
+except KeyboardInterrupt:
+    sys.exit(130)
+"""
+
+
+def test_a_signal_while_the_cluster_starts_leaves_no_traceback():
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    child = subprocess.Popen(
+        [sys.executable, '-c', _INTERRUPTED_START],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert child.stdout.readline().strip() == 'starting'
+    time.sleep(0.2)  # inside the cluster's start: spawning two workers takes longer
+    child.send_signal(signal.SIGINT)
+    out, err = child.communicate(timeout=60)
+    assert 'started' not in out, 'the signal came after the start: no test'
+    assert child.returncode == 130 and 'Traceback' not in err, err
