@@ -586,7 +586,10 @@ class ArmMode:
 def _carries(beam: BeamParameters, load_kg: float) -> bool:
     """Whether the beam has a static equilibrium under ``load_kg`` at its tip."""
     try:
-        static_tip_deflection(beam, load_kg)
+        # A load the floats cannot carry either (1e308 kg) overflows in the solver: that is
+        # a "no", not a numpy warning in the node's log.
+        with np.errstate(over='raise', invalid='raise'):
+            static_tip_deflection(beam, load_kg)
     except (RuntimeError, ValueError, ArithmeticError):
         return False
     return True
