@@ -39,13 +39,16 @@ from lumpbeam_ros.model.modes import LinearModel
 
 #: A new linearization when a joint angle has moved this far from the reference's, rad: 0.1
 #: takes more eigen-decompositions than it saves sweeps on the bench's arm, 0.4 more sweeps.
-RELINEARIZE_RAD = 0.2
+RELINEARIZE_RAD = 0.4
 
 #: A mode's ``e^{lambda t}`` below this is gone for the scan (double rounding).
 _NEGLIGIBLE = 1e-17
 
 #: How far the first guess of a window carries the deflections' starting rate, s.
 GUESS_HORIZON_S = 0.02
+
+#: Largest deflection whose cosine and sine are taken by their series, rad.
+SERIES_RAD = 0.15
 
 #: Relaxation sweeps a window may take before the solver gives up on it.
 MAX_SWEEPS = 40
@@ -92,9 +95,6 @@ class _Frame:
         v_t = (vectors[:, keep] * np.where(lam.imag > 0.0, 2.0, 1.0)).T
         self.v_inv = v_inv[keep]
         b_t = (self.v_inv[:, n:] @ m0_inv).T
-        # Real products (a real input, a real state): half the work of complex ones.
-        self.b_re, self.b_im = np.ascontiguousarray(b_t.real), np.ascontiguousarray(b_t.imag)
-        self.v_re, self.v_im = np.ascontiguousarray(v_t.real), np.ascontiguousarray(-v_t.imag)
         self.e, h_phi1, h_phi2 = hold_weights(lam, h)
         # The first step: a first-order hold; the others: the parabola through the samples
         # before, at and after the step (O(h^3) globally instead of O(h^2)).
@@ -104,6 +104,16 @@ class _Frame:
         self.q_before = h_phi3 - 0.5 * h_phi2
         self.q_at = h_phi1 - 2.0 * h_phi3
         self.q_after = h_phi3 + 0.5 * h_phi2
+        # A real input times a complex matrix as one real product whose result, read as
+        # complex, is the modal input: the columns interleave real and imaginary parts. The
+        # hold's weights are folded in, so a sweep's three weighted inputs are one product.
+        self.b = _interleaved(b_t)
+        self.b_weighted = np.hstack(
+            [_interleaved(b_t * w) for w in (self.q_before, self.q_at, self.q_after)]
+        )
+        # And back: Re(z v) = [Re z, Im z] interleaved times the rows of Re v and -Im v.
+        self.v = np.empty((2 * lam.size, 2 * n))
+        self.v[0::2], self.v[1::2] = v_t.real, -v_t.imag
         self.h = h
 
 
@@ -116,13 +126,42 @@ def _h_phi3(lam: np.ndarray, h: float) -> np.ndarray:
     return np.asarray(h * np.where(small, series, (np.expm1(z) - z - 0.5 * z * z) / safe**3))
 
 
-def _scan(g: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """``z_k = e z_{k-1} + g_k`` (``z_0 = g_0``) for every column, by doubling.
+def _turned(trig: tuple[np.ndarray, np.ndarray], d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``cos(r + d)`` and ``sin(r + d)`` from ``cos r``, ``sin r`` and a small ``d``.
 
-    The columns are ordered by decreasing ``|e|``; a pass leaves out those whose ``e^step``
-    has fallen below the rounding of what it adds to (a mode that has died out).
+    The trigonometric functions of a sweep's angles cost more than the rest of its forcing;
+    the rigid angles' are taken once a window and the deflections' by their Taylor series,
+    which for ``|d| <=`` :data:`SERIES_RAD` ends below ``2e-15`` after the ``d^9`` term.
     """
-    z = g.copy()
+    cos_r, sin_r = trig
+    if np.max(np.abs(d)) > SERIES_RAD:
+        cos_d, sin_d = np.cos(d), np.sin(d)
+    else:
+        d2 = d * d
+        cos_d = 1.0 + d2 * (-1.0 / 2.0 + d2 * (1.0 / 24.0 + d2 * (-1.0 / 720.0 + d2 / 40320.0)))
+        sin_d = d * (
+            1.0 + d2 * (-1.0 / 6.0 + d2 * (1.0 / 120.0 + d2 * (-1.0 / 5040.0 + d2 / 362880.0)))
+        )
+    return cos_r * cos_d - sin_r * sin_d, sin_r * cos_d + cos_r * sin_d
+
+
+def _interleaved(b: np.ndarray) -> np.ndarray:
+    """A complex (n, m) matrix as a real (n, 2m) one, each column's real then imaginary part.
+
+    A real row vector times it is, read as complex (``.view(complex)``), the row times ``b``.
+    """
+    out = np.empty((b.shape[0], 2 * b.shape[1]))
+    out[:, 0::2], out[:, 1::2] = b.real, b.imag
+    return out
+
+
+def _scan(z: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """``z_k = e z_{k-1} + g_k`` (``z_0 = g_0``) for every column, by doubling, in place.
+
+    ``z`` holds ``g`` on entry. The columns are ordered by decreasing ``|e|``; a pass leaves
+    out those whose ``e^step`` has fallen below the rounding of what it adds to (a mode that
+    has died out).
+    """
     power = e.copy()
     step = 1
     while step < z.shape[0]:
@@ -150,7 +189,7 @@ class DeflectionSolver:
         self,
         chain: LumpedChain,
         joint_angles: Callable[[np.ndarray], np.ndarray],
-        tol: float = 1e-9,
+        tol: float = 1e-8,
     ):
         self.chain = chain
         self.joint_angles = joint_angles
@@ -164,14 +203,22 @@ class DeflectionSolver:
         self.sweeps = 0
         self._frame: _Frame | None = None
 
-    def _frame_for(self, phi: np.ndarray, h: float) -> _Frame:
+    def _frame_for(self, joints: np.ndarray, phi_ahead: np.ndarray, h: float) -> _Frame:
+        """The linearization for a window whose joint angles are ``joints``.
+
+        The last one serves while the window stays within about half :data:`RELINEARIZE_RAD`
+        of it (a window spans less than that, and the deflections move on a little); a new one
+        is taken at ``phi_ahead``, the window's end, so it serves this window and the next one
+        from the middle (the relaxation converges as fast as the joints stay near the
+        linearization's).
+        """
         frame = self._frame
         if (
             frame is None
             or frame.h != h
-            or np.max(np.abs(self.joint_angles(phi) - frame.joints)) > RELINEARIZE_RAD
+            or np.max(np.abs(joints - frame.joints)) > 0.6 * RELINEARIZE_RAD
         ):
-            frame = self._frame = _Frame(self, phi, h)
+            frame = self._frame = _Frame(self, phi_ahead, h)
             self.frames += 1
         return frame
 
@@ -179,25 +226,28 @@ class DeflectionSolver:
         self,
         frame: _Frame,
         rigid: RigidMotion,
+        trig: tuple[np.ndarray, np.ndarray],
         d: np.ndarray,
         d_dot: np.ndarray,
         d_ddot: np.ndarray,
     ) -> np.ndarray:
-        """``u`` of the module docstring on a window, (T, n)."""
-        phi = rigid.r + d
-        c, s = np.cos(phi), np.sin(phi)
+        """``u`` of the module docstring on a window, (T, n); ``trig``: cos and sin of ``r``."""
+        c, s = _turned(trig, d)
         acc = rigid.r_ddot + d_ddot
         w2 = (rigid.r_dot + d_dot) ** 2
-        # M(phi) x = c (A (c x)) + s (A (s x)) + I x and S(phi) w = s (A (c w)) - c (A (s w))
-        # (four products: stacked into one they ran several times slower).
+        # M(phi) x = c (A (c x)) + s (A (s x)) + I x and S(phi) w = s (A (c w)) - c (A (s w)):
+        # the products by A taken two at a time (stacked into one they ran several times
+        # slower).
         a = self.a
+        cos_part = (c * acc - s * w2) @ a
+        sin_part = (s * acc + c * w2) @ a
         return np.asarray(
             self.weight * c
             + frame.gravity_stiffness * d
             + d_ddot @ frame.mass
             - self.chain.inertia * acc
-            - c * ((c * acc) @ a - (s * w2) @ a)
-            - s * ((s * acc) @ a + (c * w2) @ a)
+            - c * cos_part
+            - s * sin_part
         )
 
     def solve(
@@ -229,7 +279,9 @@ class DeflectionSolver:
             drift = np.max(np.abs(joints[start + 1 : start + window + 1] - joints[start]), axis=1)
             beyond = np.flatnonzero(drift > 0.5 * RELINEARIZE_RAD)
             stop = start + 1 + max(1, int(beyond[0]) if beyond.size else drift.size)
-            frame = self._frame_for(rigid.r[start] + d[start], h)
+            # The window's joint angles, the deflections' part taken as at its start.
+            bent = joints[start:stop] + self.joint_angles(d[start])
+            frame = self._frame_for(bent, rigid.r[stop - 1] + d[start], h)
             part = RigidMotion(
                 rigid.r[start:stop], rigid.r_dot[start:stop], rigid.r_ddot[start:stop]
             )
@@ -267,35 +319,36 @@ class DeflectionSolver:
         """
         n = d0.size
         z0 = frame.v_inv @ np.concatenate([d0, d0_dot])
-        modal_before = None if before is None else before @ frame.b_re + 1j * (before @ frame.b_im)
+        modal_before = None if before is None else (before @ frame.b).view(complex)
         # First guess: the deflections go on at their starting rate for a short while
         # (over a long window of free vibration, held where they start).
-        elapsed = np.minimum(frame.h * np.arange(part.r.shape[0]), GUESS_HORIZON_S)
+        steps = part.r.shape[0]
+        elapsed = np.minimum(frame.h * np.arange(steps), GUESS_HORIZON_S)
         guess = d0 + elapsed[:, None] * d0_dot
-        u = self._forcing(frame, part, guess, np.broadcast_to(d0_dot, guess.shape), 0.0 * guess)
+        trig = (np.cos(part.r), np.sin(part.r))
+        u = self._forcing(
+            frame, part, trig, guess, np.broadcast_to(d0_dot, guess.shape), 0.0 * guess
+        )
         previous = guess
-        g = np.empty((part.r.shape[0], z0.size), dtype=complex)
+        g = np.empty((steps, z0.size), dtype=complex)
+        m = z0.size
         for _ in range(MAX_SWEEPS):
             self.sweeps += 1
-            modal_u = (u @ frame.b_re) + 1j * (u @ frame.b_im)
+            # The modal inputs times the hold's weights before, at and after each step.
+            weighted = (u @ frame.b_weighted).view(complex)
+            w_before, w_at, w_after = weighted[:, :m], weighted[:, m : 2 * m], weighted[:, 2 * m :]
             g[0] = z0
             if modal_before is None:
-                g[1] = frame.w0 * modal_u[0] + frame.w1 * modal_u[1]
+                modal = (u[:2] @ frame.b).view(complex)
+                g[1] = frame.w0 * modal[0] + frame.w1 * modal[1]
             else:
-                g[1] = (
-                    frame.q_before * modal_before
-                    + frame.q_at * modal_u[0]
-                    + frame.q_after * modal_u[1]
-                )
-            g[2:] = (
-                frame.q_before * modal_u[:-2]
-                + frame.q_at * modal_u[1:-1]
-                + frame.q_after * modal_u[2:]
-            )
+                g[1] = frame.q_before * modal_before + w_at[0] + w_after[1]
+            np.add(w_before[:-2], w_at[1:-1], out=g[2:])
+            g[2:] += w_after[2:]
             # A diverging window overflows on its way to this check, which refuses it.
             with np.errstate(over='ignore', invalid='ignore'):
                 z = _scan(g, frame.e)
-                x = z.real @ frame.v_re + z.imag @ frame.v_im
+                x = z.view(float) @ frame.v
                 change = np.max(np.abs(x[:, :n] - previous))
             if not np.isfinite(change):
                 return None
@@ -305,7 +358,7 @@ class DeflectionSolver:
             previous = d
             with np.errstate(over='ignore', invalid='ignore'):
                 d_ddot = u @ frame.m0_inv_t - x @ frame.decay_t
-                u = self._forcing(frame, part, d, d_dot, d_ddot)
+                u = self._forcing(frame, part, trig, d, d_dot, d_ddot)
         return None
 
 
