@@ -95,26 +95,83 @@ class _Frame:
         v_t = (vectors[:, keep] * np.where(lam.imag > 0.0, 2.0, 1.0)).T
         self.v_inv = v_inv[keep]
         b_t = (self.v_inv[:, n:] @ m0_inv).T
+        # The overdamped modes apart, in real arithmetic: half the work of complex numbers.
+        real = lam.imag == 0.0
+        self.oscillating = _Modes(lam[~real], b_t[:, ~real], v_t[~real], h)
+        self.overdamped = _Modes(lam[real].real, b_t[:, real].real, v_t[real].real, h)
+        self.split = real
+        self.h = h
+
+
+class _Modes:
+    """Modes of a frame (all complex or all real) and their hold weights.
+
+    Args:
+        lam: Eigenvalues, slowest decay first (the scan drops the modes that have died out).
+        b_t: Input matrix: a forcing row times it is the modes' input, (n, m).
+        v_t: Output matrix: the modes times it are the state ``[d, d']``, (m, 2n).
+        h: Step, s.
+    """
+
+    def __init__(self, lam: np.ndarray, b_t: np.ndarray, v_t: np.ndarray, h: float):
+        self.is_complex = bool(np.iscomplexobj(lam))
+        self.m = lam.size
         self.e, h_phi1, h_phi2 = hold_weights(lam, h)
+        h_phi3 = _h_phi3(lam, h)
+        if not self.is_complex:
+            self.e, h_phi1, h_phi2, h_phi3 = (w.real for w in (self.e, h_phi1, h_phi2, h_phi3))
         # The first step: a first-order hold; the others: the parabola through the samples
         # before, at and after the step (O(h^3) globally instead of O(h^2)).
         self.w0 = h_phi1 - h_phi2
         self.w1 = h_phi2
-        h_phi3 = _h_phi3(lam, h)
         self.q_before = h_phi3 - 0.5 * h_phi2
-        self.q_at = h_phi1 - 2.0 * h_phi3
-        self.q_after = h_phi3 + 0.5 * h_phi2
+        q_at = h_phi1 - 2.0 * h_phi3
+        q_after = h_phi3 + 0.5 * h_phi2
         # A real input times a complex matrix as one real product whose result, read as
         # complex, is the modal input: the columns interleave real and imaginary parts. The
         # hold's weights are folded in, so a sweep's three weighted inputs are one product.
-        self.b = _interleaved(b_t)
-        self.b_weighted = np.hstack(
-            [_interleaved(b_t * w) for w in (self.q_before, self.q_at, self.q_after)]
-        )
+        self.b = _interleaved(b_t) if self.is_complex else b_t
+        self.b_weighted = np.hstack([self._real(b_t * w) for w in (self.q_before, q_at, q_after)])
         # And back: Re(z v) = [Re z, Im z] interleaved times the rows of Re v and -Im v.
-        self.v = np.empty((2 * lam.size, 2 * n))
-        self.v[0::2], self.v[1::2] = v_t.real, -v_t.imag
-        self.h = h
+        self.v = np.empty((2 * self.m, v_t.shape[1])) if self.is_complex else v_t
+        if self.is_complex:
+            self.v[0::2], self.v[1::2] = v_t.real, -v_t.imag
+
+    def _real(self, b: np.ndarray) -> np.ndarray:
+        return _interleaved(b) if self.is_complex else b
+
+    def product(self, u: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """``u @ b`` read as the modes' numbers."""
+        out = u @ b
+        return out.view(complex) if self.is_complex else out
+
+    def state(
+        self, u: np.ndarray, z0: np.ndarray, before: np.ndarray | None, g: np.ndarray
+    ) -> np.ndarray:
+        """These modes' part of ``[d, d']`` on a window under the forcing ``u``.
+
+        Args:
+            u: The forcing, (T, n).
+            z0: The modes at the window's start.
+            before: The forcing one step before the start, or ``None`` (a first-order hold
+                on the first step).
+            g: Room for the modes, (T, m).
+        """
+        m = self.m
+        if m == 0:
+            return np.zeros((u.shape[0], self.v.shape[1]))
+        weighted = self.product(u, self.b_weighted)
+        w_before, w_at, w_after = weighted[:, :m], weighted[:, m : 2 * m], weighted[:, 2 * m :]
+        g[0] = z0
+        if before is None:
+            modal = self.product(u[:2], self.b)
+            g[1] = self.w0 * modal[0] + self.w1 * modal[1]
+        else:
+            g[1] = self.q_before * self.product(before, self.b) + w_at[0] + w_after[1]
+        np.add(w_before[:-2], w_at[1:-1], out=g[2:])
+        g[2:] += w_after[2:]
+        z = _scan(g, self.e)
+        return np.asarray((z.view(float) if self.is_complex else z) @ self.v)
 
 
 def _h_phi3(lam: np.ndarray, h: float) -> np.ndarray:
@@ -319,7 +376,8 @@ class DeflectionSolver:
         """
         n = d0.size
         z0 = frame.v_inv @ np.concatenate([d0, d0_dot])
-        modal_before = None if before is None else (before @ frame.b).view(complex)
+        z0_overdamped = z0[frame.split].real
+        z0 = z0[~frame.split]
         # First guess: the deflections go on at their starting rate for a short while
         # (over a long window of free vibration, held where they start).
         steps = part.r.shape[0]
@@ -331,24 +389,13 @@ class DeflectionSolver:
         )
         previous = guess
         g = np.empty((steps, z0.size), dtype=complex)
-        m = z0.size
+        g_overdamped = np.empty((steps, z0_overdamped.size))
         for _ in range(MAX_SWEEPS):
             self.sweeps += 1
-            # The modal inputs times the hold's weights before, at and after each step.
-            weighted = (u @ frame.b_weighted).view(complex)
-            w_before, w_at, w_after = weighted[:, :m], weighted[:, m : 2 * m], weighted[:, 2 * m :]
-            g[0] = z0
-            if modal_before is None:
-                modal = (u[:2] @ frame.b).view(complex)
-                g[1] = frame.w0 * modal[0] + frame.w1 * modal[1]
-            else:
-                g[1] = frame.q_before * modal_before + w_at[0] + w_after[1]
-            np.add(w_before[:-2], w_at[1:-1], out=g[2:])
-            g[2:] += w_after[2:]
             # A diverging window overflows on its way to this check, which refuses it.
             with np.errstate(over='ignore', invalid='ignore'):
-                z = _scan(g, frame.e)
-                x = z.view(float) @ frame.v
+                x = frame.oscillating.state(u, z0, before, g)
+                x += frame.overdamped.state(u, z0_overdamped, before, g_overdamped)
                 change = np.max(np.abs(x[:, :n] - previous))
             if not np.isfinite(change):
                 return None
