@@ -195,11 +195,26 @@ def _turned(trig: tuple[np.ndarray, np.ndarray], d: np.ndarray) -> tuple[np.ndar
         cos_d, sin_d = np.cos(d), np.sin(d)
     else:
         d2 = d * d
-        cos_d = 1.0 + d2 * (-1.0 / 2.0 + d2 * (1.0 / 24.0 + d2 * (-1.0 / 720.0 + d2 / 40320.0)))
-        sin_d = d * (
-            1.0 + d2 * (-1.0 / 6.0 + d2 * (1.0 / 120.0 + d2 * (-1.0 / 5040.0 + d2 / 362880.0)))
-        )
-    return cos_r * cos_d - sin_r * sin_d, sin_r * cos_d + cos_r * sin_d
+        cos_d = _horner(d2, (1.0 / 40320.0, -1.0 / 720.0, 1.0 / 24.0, -0.5, 1.0))
+        sin_d = _horner(d2, (1.0 / 362880.0, -1.0 / 5040.0, 1.0 / 120.0, -1.0 / 6.0, 1.0))
+        sin_d *= d
+    c = cos_r * cos_d
+    s = sin_r * cos_d
+    product = sin_r * sin_d
+    c -= product
+    np.multiply(cos_r, sin_d, out=product)
+    s += product
+    return c, s
+
+
+def _horner(x: np.ndarray, coefficients: tuple[float, ...]) -> np.ndarray:
+    """The polynomial in ``x`` with ``coefficients`` (highest power first), in place."""
+    out = coefficients[0] * x
+    for coefficient in coefficients[1:-1]:
+        out += coefficient
+        out *= x
+    out += coefficients[-1]
+    return out
 
 
 def _interleaved(b: np.ndarray) -> np.ndarray:
@@ -291,21 +306,25 @@ class DeflectionSolver:
         """``u`` of the module docstring on a window, (T, n); ``trig``: cos and sin of ``r``."""
         c, s = _turned(trig, d)
         acc = rigid.r_ddot + d_ddot
-        w2 = (rigid.r_dot + d_dot) ** 2
+        w2 = rigid.r_dot + d_dot
+        w2 *= w2
         # M(phi) x = c (A (c x)) + s (A (s x)) + I x and S(phi) w = s (A (c w)) - c (A (s w)):
         # the products by A taken two at a time (stacked into one they ran several times
-        # slower).
-        a = self.a
-        cos_part = (c * acc - s * w2) @ a
-        sin_part = (s * acc + c * w2) @ a
-        return np.asarray(
-            self.weight * c
-            + frame.gravity_stiffness * d
-            + d_ddot @ frame.mass
-            - self.chain.inertia * acc
-            - c * cos_part
-            - s * sin_part
-        )
+        # slower), in place where the arrays are the window's size.
+        cos_part = c * acc
+        cos_part -= s * w2
+        sin_part = s * acc
+        sin_part += c * w2
+        u = self.weight - cos_part @ self.a
+        u *= c
+        sin_part = sin_part @ self.a
+        sin_part *= s
+        u -= sin_part
+        u += frame.gravity_stiffness * d
+        u += d_ddot @ frame.mass
+        acc *= self.chain.inertia
+        u -= acc
+        return u
 
     def solve(
         self, d0: np.ndarray, d0_dot: np.ndarray, rigid: RigidMotion, h: float, window: int
