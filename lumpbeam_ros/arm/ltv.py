@@ -409,7 +409,8 @@ class DeflectionSolver:
         previous = guess
         g = np.empty((steps, z0.size), dtype=complex)
         g_overdamped = np.empty((steps, z0_overdamped.size))
-        for _ in range(MAX_SWEEPS):
+        last_change = 0.0
+        for sweep in range(MAX_SWEEPS):
             self.sweeps += 1
             # A diverging window overflows on its way to this check, which refuses it.
             with np.errstate(over='ignore', invalid='ignore'):
@@ -419,8 +420,12 @@ class DeflectionSolver:
             if not np.isfinite(change):
                 return None
             d, d_dot = x[:, :n], x[:, n:]
-            if change < self.tol:
+            # Each sweep shrinks the error by about the ratio of its change to the last one's
+            # (the first change, from the guess, says nothing of that ratio), so this sweep's
+            # deflections are off by about that ratio times its change.
+            if change < self.tol or change * change < self.tol * last_change:
                 return d, d_dot, u
+            last_change = change if sweep else 0.0
             previous = d
             with np.errstate(over='ignore', invalid='ignore'):
                 d_ddot = u @ frame.m0_inv_t - x @ frame.decay_t
