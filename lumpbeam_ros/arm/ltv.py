@@ -14,16 +14,20 @@ and after each step (a first-order hold, as
 :class:`~lumpbeam_ros.model.integrate.ModalSolver` does about an equilibrium, on a piece's
 first step), so the stiff springs cost nothing; ``u`` is smooth and small, and is found by
 waveform relaxation window by window: propagate with the last ``u``, evaluate ``u`` on the
-whole window at once, repeat until the deflections stop changing. A window's relaxation
-converges as fast as ``M(phi)`` stays near ``M0`` (its mass term feeds back instantly,
-whatever the window's length), so a window ends before the joints turn by half
-:data:`RELINEARIZE_RAD`, and once a joint has moved that far from the reference the next
-window takes a new linearization (an eigen-decomposition of the ``2n`` state matrix, the
-expensive step). While the joints are held, one linearization serves
-the whole ring-down.
+whole window at once, repeat until the deflections' error, estimated from how fast the
+sweeps contract, is below the tolerance. A window's relaxation converges as fast as
+``M(phi)`` stays near ``M0`` (its mass term feeds back instantly, whatever the window's
+length), so a window ends before the joints turn by half :data:`RELINEARIZE_RAD`, and a new
+linearization (an eigen-decomposition of the ``2n`` state matrix, the expensive step) is
+taken at the end of the window that would stray further from the last one, so it serves
+that window and the next from the middle. While the joints are held, one linearization
+serves the whole ring-down.
 
 The modal recurrences ``z_k = e^{lambda h} z_{k-1} + g_k`` of a window are summed by doubling
-(``log2`` of the window's length in array operations), not by a Python loop.
+(``log2`` of the window's length in array operations), not by a Python loop; the oscillating
+modes in complex numbers, the overdamped ones in real. A sweep's cost is array arithmetic
+over the window, so the rigid angles' cosines and sines are taken once a window and the
+deflections' by their series.
 """
 
 from __future__ import annotations
@@ -37,9 +41,14 @@ from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.integrate import hold_weights
 from lumpbeam_ros.model.modes import LinearModel
 
-#: A new linearization when a joint angle has moved this far from the reference's, rad: 0.1
-#: takes more eigen-decompositions than it saves sweeps on the bench's arm, 0.4 more sweeps.
+#: Joint travel a linearization serves (half of it on either side), rad. On the bench's arm
+#: 0.4 took the fewest sweeps and was the most accurate; 0.2, 0.3 and 0.6 were up to three
+#: times less accurate (0.06 to 0.09 um RMS: the hold samples the forcing, which carries
+#: ``(M(phi) - M0) d''``, differently) and 0.8 took more sweeps.
 RELINEARIZE_RAD = 0.4
+
+#: A jump of the rates at a piece's start at least this large is a kick (a knot), rad/s.
+KICK_RAD_S = 1e-6
 
 #: A mode's ``e^{lambda t}`` below this is gone for the scan (double rounding).
 _NEGLIGIBLE = 1e-17
@@ -142,7 +151,7 @@ class _Modes:
 
     def product(self, u: np.ndarray, b: np.ndarray) -> np.ndarray:
         """``u @ b`` read as the modes' numbers."""
-        out = u @ b
+        out = np.asarray(u @ b)
         return out.view(complex) if self.is_complex else out
 
     def state(
@@ -254,7 +263,8 @@ class DeflectionSolver:
         joint_angles: ``phi (..., n) ->`` the angles ``M(phi)`` and gravity depend on (the
             joints': the first segment's and each link's against the one before), to decide
             where windows end and when to re-linearize.
-        tol: Convergence threshold on the change of the deflections between sweeps, rad.
+        tol: Convergence threshold on the deflections' estimated error (a sweep's change
+            times its ratio to the last one's), or on their change between sweeps, rad.
     """
 
     def __init__(
@@ -324,7 +334,7 @@ class DeflectionSolver:
         u += d_ddot @ frame.mass
         acc *= self.chain.inertia
         u -= acc
-        return u
+        return np.asarray(u)
 
     def solve(
         self, d0: np.ndarray, d0_dot: np.ndarray, rigid: RigidMotion, h: float, window: int
@@ -357,7 +367,12 @@ class DeflectionSolver:
             stop = start + 1 + max(1, int(beyond[0]) if beyond.size else drift.size)
             # The window's joint angles, the deflections' part taken as at its start.
             bent = joints[start:stop] + self.joint_angles(d[start])
-            frame = self._frame_for(bent, rigid.r[stop - 1] + d[start], h)
+            # A new linearization is taken at the window's end, so that it serves from the
+            # middle, except on a piece's first window when the rates jump there (a kick):
+            # the kick's fast accelerations, times the mass matrix's change from the
+            # linearization's, would then fill the forcing that the hold samples.
+            ahead = stop - 1 if start or np.max(np.abs(d0_dot)) < KICK_RAD_S else 0
+            frame = self._frame_for(bent, rigid.r[ahead] + d[start], h)
             part = RigidMotion(
                 rigid.r[start:stop], rigid.r_dot[start:stop], rigid.r_ddot[start:stop]
             )
