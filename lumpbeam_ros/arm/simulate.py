@@ -284,8 +284,27 @@ def _simulate_modal(
     t = np.concatenate(grid_t)
     if t.size < 2:
         return np.vstack(grid_phi), np.vstack(grid_rate)
-    spline = CubicHermiteSpline(t, np.vstack(grid_phi), np.vstack(grid_rate), axis=0)
-    return spline(t_eval), spline(t_eval, 1)
+    return _hermite(t, np.vstack(grid_phi), np.vstack(grid_rate), t_eval)
+
+
+def _hermite(
+    t: np.ndarray, y: np.ndarray, y_dot: np.ndarray, at: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The cubic Hermite interpolation of ``(y, y')`` on ``t`` and its derivative at ``at``.
+
+    Only the intervals asked for are evaluated: building a spline object on the whole grid
+    cost more than the solver's ring-down sweeps.
+    """
+    i = np.clip(np.searchsorted(t, at, side='right') - 1, 0, t.size - 2)
+    step = (t[i + 1] - t[i])[:, None]
+    s = (at - t[i])[:, None] / step
+    y0, y1, m0, m1 = y[i], y[i + 1], y_dot[i] * step, y_dot[i + 1] * step
+    s2 = s * s
+    s3 = s2 * s
+    value = (2 * s3 - 3 * s2 + 1) * y0 + (s3 - 2 * s2 + s) * m0 + (3 * s2 - 2 * s3) * y1
+    value += (s3 - s2) * m1
+    rate = (6 * s2 - 6 * s) * (y0 - y1) + (3 * s2 - 4 * s + 1) * m0 + (3 * s2 - 2 * s) * m1
+    return value, rate / step
 
 
 def _simulate_lsoda(

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from arm.arm_cases import small_arm
-from lumpbeam_ros.arm.ltv import DeflectionSolver, RigidMotion, _scan
+from lumpbeam_ros.arm.ltv import SERIES_RAD, DeflectionSolver, RigidMotion, _scan, _turned
 from lumpbeam_ros.arm.model import ArmModel
 from lumpbeam_ros.arm.statics import arm_equilibrium
 
@@ -24,6 +24,17 @@ def test_the_doubling_scan_is_the_recurrence():
     for k in range(1, 37):
         z[k] = e * z[k - 1] + g[k]
     assert _scan(g, e) == pytest.approx(z, abs=1e-13)
+
+
+@pytest.mark.parametrize('largest', [SERIES_RAD, 3.0])
+def test_the_turned_angles_cosine_and_sine_are_the_functions_own(largest):
+    """By the series up to SERIES_RAD, by numpy's beyond (both to the rounding of r + d)."""
+    rng = np.random.default_rng(5)
+    r = rng.uniform(-4.0, 4.0, size=(50, 6))
+    d = rng.uniform(-largest, largest, size=(50, 6))
+    c, s = _turned((np.cos(r), np.sin(r)), d)
+    assert c == pytest.approx(np.cos(r + d), abs=4e-15)
+    assert s == pytest.approx(np.sin(r + d), abs=4e-15)
 
 
 def test_an_arm_held_at_rest_stays_there():
