@@ -6,18 +6,18 @@ The arm starts at rest in its static equilibrium at the motion's first angles an
 
 (:class:`~lumpbeam_ros.model.chain.LumpedChain`, :mod:`lumpbeam_ros.arm.model`).
 
-Two integrators. The default (``method='modal'``) follows the small deflections about the
-rigid motion the joints prescribe (:mod:`lumpbeam_ros.arm.ltv`): the springs' linear part
-exactly in modal coordinates, linearized afresh as the joints turn, the rest by waveform
-relaxation on a 2 ms grid while the joints move and a 5 ms grid once they stop; it is about
-a hundred times faster than integrating B.16 step by step and agrees with a tight reference to
-a few hundredths of a micrometre (doc/arm.md, ``lumpbeam bench --only arm``). The other
-(``method='lsoda'``, the reference, and the fallback when the deflections are too large for
-the first) integrates B.16 in the angles and a momentum-like variable (:class:`_MomentumForm`)
-so that the joint rates, which jump at every sample of a trajectory file, drop out of the
-right-hand side, with ``scipy.integrate.solve_ivp(method='LSODA')`` and the Jacobian of the
-forces (springs, gravity, dampers, the velocity terms; the change of ``M`` with ``phi`` in
-``phi'`` left out, which only slows its Newton iterations).
+Two integrators. The default (``method='modal'``) follows the small deflections about the rigid
+motion the joints prescribe (:mod:`lumpbeam_ros.arm.ltv`): the springs' linear part exactly in
+modal coordinates, linearized afresh as the joints turn, the rest by waveform relaxation on a 2 ms
+grid while the joints move and a 5 ms grid once they stop; it is many times faster than integrating
+B.16 step by step (the bench's ``lsoda_s`` beside its time) and agrees with a tight reference to a
+few hundredths of a micrometre (doc/arm.md, ``lumpbeam bench --only arm``). The other
+(``method='lsoda'``, the reference, and the fallback when the deflections are too large for the
+first) integrates B.16 in the angles and a momentum-like variable (:class:`_MomentumForm`) so that
+the joint rates, which jump at every sample of a trajectory file, drop out of the right-hand side,
+with ``scipy.integrate.solve_ivp(method='LSODA')`` and the Jacobian of the forces (springs,
+gravity, dampers, the velocity terms; the change of ``M`` with ``phi`` in ``phi'`` left out, which
+only slows its Newton iterations).
 
 Either way, a trajectory of few samples (a few-row file's corners) is integrated sample to
 sample, so no step straddles a corner; a dense one (smooth motion sampled at 1 kHz) is
