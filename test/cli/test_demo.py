@@ -26,10 +26,16 @@ def test_demo_runs_the_graph_end_to_end(demo_results, mcap_doctor):
     # the /tip_load delivery delay: a Float64 has no stamp) and leaves a few times the noise.
     assert abs(summary['prediction_lag_s']) < 0.1 and summary['prediction_rms_m'] > 1e-3
     live = summary['live_diagnosis']
-    if live.get('prediction_after_rms_m') is not None:
-        assert live['prediction_after_rms_m'] < 40e-6 < 1e-3 < live['prediction_before_rms_m']
-    else:
+    after = live.get('prediction_after_rms_m')
+    # The node dates the release on /tip_load's arrival: a reading delivered late hides as
+    # much of the latency (the live-latency test below), and the rest stays in the gap.
+    late_s = live['window_s'][0] + 1.0 - 2.0  # pre_release_s before the 2 s release
+    if after is None:
         assert summary['prediction_rms_aligned_m'] < 100e-6
+    elif abs(late_s) <= 0.002:
+        assert after < 40e-6 < 1e-3 < live['prediction_before_rms_m']
+    else:
+        assert after < live['prediction_before_rms_m']
     samples = DURATION_S * 180 + 1
     assert summary['measured_samples'] == samples  # nothing lost by the recorder
     assert summary['predicted_samples'] > (DURATION_S - 1) * 180
