@@ -151,6 +151,18 @@ class RosGraph:
         """Spins for a fixed time (to let discovery or a publisher settle)."""
         self.spin_until(lambda: False, seconds)
 
+    def set_clock(self, nodes: list[Node], seconds: float, timeout: float = 5.0) -> None:
+        """Publishes ``/clock`` and spins until every node (under ``use_sim_time``) reads it."""
+        from rosgraph_msgs.msg import Clock
+
+        msg = Clock()
+        target = round(seconds * 1e9)
+        msg.clock.sec, msg.clock.nanosec = divmod(target, 1_000_000_000)
+        self.publish('/clock', msg)
+        assert self.spin_until(
+            lambda: all(n.get_clock().now().nanoseconds == target for n in nodes), timeout
+        )
+
     def shutdown(self) -> None:
         """Destroys the nodes and the context."""
         self.executor.shutdown()

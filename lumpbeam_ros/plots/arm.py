@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.plots.beam import DEFAULT_SNAPSHOTS, snapshot_indices
+from lumpbeam_ros.plots.beam import DEFAULT_SNAPSHOTS, finish_snapshot_axis, snapshot_indices
 from lumpbeam_ros.plots.files import save_figure
 from lumpbeam_ros.viz.marker_messages import read_marker_arrays
 from lumpbeam_ros.viz.markers import NS_JOINTS, NS_LINK, NS_MEASURED, Action, MarkerSpec
@@ -87,13 +87,8 @@ def plot_arm_snapshots(
         tips = [(t, m.position[2]) for t, ms in arrays for m in ms if m.namespace == NS_MEASURED]
         tip = np.array(tips, dtype=float).reshape(-1, 2)
         time_axis.plot(tip[:, 0], tip[:, 1], lw=0.8, color='tab:red', label='measured tip z')
-        for color, index in zip(colors, chosen, strict=True):
-            time_axis.axvline(stamps[index], color=color, lw=0.8, ls=':')
-        if move_end_s is not None:
-            time_axis.axvline(move_end_s, color='gray', lw=1.0, ls='--', label='end of the move')
-        time_axis.set_xlabel('time (s, header stamp)')
+        finish_snapshot_axis(time_axis, stamps[chosen], colors, (move_end_s, 'end of the move'))
         time_axis.set_ylabel('tip z (m)')
-        time_axis.grid(alpha=0.3)
         time_axis.legend(fontsize=8, loc='best')
         figure.suptitle(title)
         figure.tight_layout()

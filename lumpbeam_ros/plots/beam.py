@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -55,6 +56,29 @@ def snapshot_indices(stamps: np.ndarray, times: Sequence[float] | None, count: i
     """
     wanted = np.linspace(stamps[0], stamps[-1], count) if times is None else times
     return sorted({int(np.argmin(np.abs(stamps - t))) for t in wanted})
+
+
+def finish_snapshot_axis(
+    axis: Any, times: np.ndarray, colors: Any, event: tuple[float | None, str]
+) -> None:
+    """The time axis under a snapshot figure: a line at each snapshot and at the event.
+
+    Each snapshot is dotted in its colour; the event (the release, the end of a move) is
+    dashed, when its time is known.
+
+    Args:
+        axis: The matplotlib axes.
+        times: The snapshots' stamps, s.
+        colors: Their colours, in order.
+        event: ``(time_s or None, label)``.
+    """
+    for color, t in zip(colors, times, strict=True):
+        axis.axvline(t, color=color, lw=0.8, ls=':')
+    event_s, label = event
+    if event_s is not None:
+        axis.axvline(event_s, color='gray', lw=1.0, ls='--', label=label)
+    axis.set_xlabel('time (s, header stamp)')
+    axis.grid(alpha=0.3)
 
 
 def plot_beam_snapshots(
@@ -126,13 +150,8 @@ def plot_beam_snapshots(
             tip_t, tip_z = _tip_series(arrays, namespace)
             if tip_t.size:
                 time_axis.plot(tip_t, tip_z * 1e3, lw=0.8, label=label)
-        for color, index in zip(colors, chosen, strict=True):
-            time_axis.axvline(stamps[index], color=color, lw=0.8, ls=':')
-        if release_time_s is not None:
-            time_axis.axvline(release_time_s, color='gray', lw=1.0, ls='--', label='release')
-        time_axis.set_xlabel('time (s, header stamp)')
+        finish_snapshot_axis(time_axis, stamps[chosen], colors, (release_time_s, 'release'))
         time_axis.set_ylabel('tip z (mm)')
-        time_axis.grid(alpha=0.3)
         time_axis.legend(fontsize=8, loc='lower right')
         figure.suptitle(title)
         figure.tight_layout()

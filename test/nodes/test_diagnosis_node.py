@@ -9,7 +9,6 @@ from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
 
 from lumpbeam_ros.bagio.convert import pitch_to_quaternion
@@ -105,25 +104,15 @@ def _feed(ros_graph, nodes, t, z, pitch, loads, offset, chunk=18):
         clock_s = offset + t[end - 1]
         while pending and offset + pending[0][0] <= clock_s:
             when, kg = pending.pop(0)
-            _set_clock(ros_graph, nodes, offset + when)
+            ros_graph.set_clock(nodes, offset + when, 30.0)
             ros_graph.publish('/tip_load', Float64(data=kg), LATCHED)
             assert ros_graph.spin_until(
                 lambda kg=kg: bool(diag.buffer.loads) and diag.buffer.loads[-1][1] == kg, 30.0
             )
-        _set_clock(ros_graph, nodes, clock_s)
+        ros_graph.set_clock(nodes, clock_s, 30.0)
         for i in range(start, end):
             ros_graph.publish('/tip_pose', _pose(offset + t[i], z[i], pitch[i]), 200)
         assert ros_graph.spin_until(lambda end=end: diag.buffer.measured_count >= end - 1, 30.0)
-
-
-def _set_clock(ros_graph, nodes, seconds):
-    msg = Clock()
-    msg.clock.sec, msg.clock.nanosec = divmod(round(seconds * 1e9), 1_000_000_000)
-    ros_graph.publish('/clock', msg)
-    target = round(seconds * 1e9)
-    assert ros_graph.spin_until(
-        lambda: all(n.get_clock().now().nanoseconds == target for n in nodes), 30.0
-    )
 
 
 def test_a_live_ring_down_names_the_hidden_latency_and_the_simulator_adopts_it(ros_graph):

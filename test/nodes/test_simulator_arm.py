@@ -6,7 +6,6 @@ import yaml
 from builtin_interfaces.msg import Duration
 from geometry_msgs.msg import PoseStamped
 from rclpy.parameter import Parameter
-from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
 from trajectory_msgs.msg import JointTrajectoryPoint
@@ -58,14 +57,6 @@ def _start(ros_graph, arm_file, **overrides):
     return node
 
 
-def _set_clock(ros_graph, node, seconds):
-    msg = Clock()
-    msg.clock.sec, msg.clock.nanosec = divmod(round(seconds * 1e9), 1_000_000_000)
-    ros_graph.publish('/clock', msg)
-    target = round(seconds * 1e9)
-    assert ros_graph.spin_until(lambda: node.get_clock().now().nanoseconds == target, 5.0)
-
-
 def _move(duration=0.3, step=0.005):
     t = np.arange(0.0, duration + 1e-9, step)
     s = t / duration
@@ -100,7 +91,7 @@ def test_follows_a_command_as_the_offline_simulation_under_sim_time(ros_graph, a
     joints = ros_graph.collect('/joint_states', JointState, 400)
     markers = ros_graph.collect('/beam_markers', MarkerArray, 50)
     node = _start(ros_graph, arm_file, arm_commands='/joint_trajectory_shaped')
-    _set_clock(ros_graph, node, START_S)
+    ros_graph.set_clock([node], START_S)
     t, q = _move()
     # Named in another order than the arm's: the node reorders by name. The first send may
     # be lost before discovery; the second must then start where the first would have.
@@ -109,7 +100,7 @@ def test_follows_a_command_as_the_offline_simulation_under_sim_time(ros_graph, a
     assert ros_graph.spin_until(lambda: node.arm.accepted >= 1, 10.0)
     assert node.arm.stream.anchor_s == START_S
     for step in range(1, 61):  # 0.6 s of /clock at 100 Hz
-        _set_clock(ros_graph, node, START_S + step / RATE_HZ)
+        ros_graph.set_clock([node], START_S + step / RATE_HZ)
     assert ros_graph.spin_until(lambda: len(poses) >= 61 and len(joints) >= 61, 10.0)
     ros_graph.spin_for(0.3)
     stamps = _stamps(poses)
@@ -143,10 +134,10 @@ def test_follows_a_command_as_the_offline_simulation_under_sim_time(ros_graph, a
     # A replayed bag that loops: the clock goes back and the arm restarts at rest, at the
     # angles the joints had then (before the command: its first point).
     before = len(poses)
-    _set_clock(ros_graph, node, 50.0)
+    ros_graph.set_clock([node], 50.0)
     assert ros_graph.spin_until(lambda: len(poses) > before, 10.0)
     for step in range(1, 6):
-        _set_clock(ros_graph, node, 50.0 + step / RATE_HZ)
+        ros_graph.set_clock([node], 50.0 + step / RATE_HZ)
     assert ros_graph.spin_until(lambda: len(poses) >= before + 6, 10.0)
     again = poses[before:]
     np.testing.assert_allclose(_stamps(again)[:6], 50.0 + np.arange(6) / RATE_HZ, atol=1e-6)

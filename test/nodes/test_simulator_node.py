@@ -7,7 +7,6 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile
-from rosgraph_msgs.msg import Clock
 from scipy.optimize import curve_fit
 from std_msgs.msg import Float64
 
@@ -37,14 +36,6 @@ def _columns(poses):
     q = [p.pose.orientation for p in poses]
     pitch = np.array([quaternion_to_pitch(o.x, o.y, o.z, o.w) for o in q])
     return t, z, pitch
-
-
-def _set_clock(ros_graph, node, seconds):
-    msg = Clock()
-    msg.clock.sec, msg.clock.nanosec = divmod(round(seconds * 1e9), 1_000_000_000)
-    ros_graph.publish('/clock', msg)
-    target = round(seconds * 1e9)
-    assert ros_graph.spin_until(lambda: node.get_clock().now().nanoseconds == target, 5.0)
 
 
 def test_publishes_at_the_rate_from_the_loaded_equilibrium(ros_graph):
@@ -118,10 +109,10 @@ def test_follows_clock_under_sim_time_and_matches_the_batch_simulation(ros_graph
     ros_graph.publish('/tip_load', Float64(data=4.5), LATCHED)  # hanging all along
     ros_graph.spin_for(0.3)
     assert got == [] and node.stream is None  # no /clock yet: time stands at zero
-    _set_clock(ros_graph, node, 100.0)
+    ros_graph.set_clock([node], 100.0)
     assert ros_graph.spin_until(lambda: node.stream is not None)
     for step in range(1, 91):  # 0.5 s of /clock at 180 Hz
-        _set_clock(ros_graph, node, 100.0 + step / 180)
+        ros_graph.set_clock([node], 100.0 + step / 180)
         if step == 45:
             ros_graph.publish('/tip_load', Float64(data=0.0), LATCHED)
             assert ros_graph.spin_until(lambda: node.stream.load_kg == 0.0)
@@ -134,9 +125,9 @@ def test_follows_clock_under_sim_time_and_matches_the_batch_simulation(ros_graph
     np.testing.assert_allclose(z, ref.z, atol=1e-6)
     assert z[-1] - z[0] > 0.01  # it moved up after the drop
     # A bag looping: the clock goes back, the beam restarts at rest under the current load.
-    _set_clock(ros_graph, node, 10.0)
+    ros_graph.set_clock([node], 10.0)
     assert ros_graph.spin_until(lambda: node.stream.time == 10.0)  # the next tick resets
-    _set_clock(ros_graph, node, 10.1)
+    ros_graph.set_clock([node], 10.1)
     assert ros_graph.spin_until(lambda: len(got) >= 91 + 18, 3.0)
     t2, z2, _ = _columns(got[91:])
     assert t2[0] == pytest.approx(10.0, abs=1e-9)
