@@ -242,7 +242,6 @@ class _Scan:
     level, a sample noise (from first differences: var = 2 sigma^2) and a spread; where the
     spread is within ``_QUIET_RATIO`` noise sigmas the tip was static, and the first of
     ``_PERSIST`` samples more than ``_DEPARTURE_SIGMAS`` off the level starts a step.
-    Rolling sums keep it linear in the window length.
     """
 
     def __init__(self, window: PoseWindow, config: IdentifierConfig):
@@ -260,14 +259,16 @@ class _Scan:
             self.quiet = np.zeros(n, dtype=bool)
             return
         z = self.z - np.median(self.z)
-        s1 = np.concatenate([[0.0], np.cumsum(z)])
-        s2 = np.concatenate([[0.0], np.cumsum(z * z)])
-        d2 = np.concatenate([[0.0], np.cumsum(np.diff(z) ** 2)])
+        # Each sample's preceding q samples, and their q - 1 differences. Rolling sums would
+        # be linear in n, but over a long window their differences cancel: beside a
+        # centimetre swing, a static level's nanometre spread (a noise-free camera) is lost to
+        # rounding and no stretch looks quiet.
+        before = np.lib.stride_tricks.sliding_window_view(z, q)[: n - q]
+        steps = np.lib.stride_tricks.sliding_window_view(np.diff(z), q - 1)[: n - q]
         i = np.arange(q, n)
-        mean = (s1[i] - s1[i - q]) / q
-        spread = np.sqrt(np.maximum((s2[i] - s2[i - q]) / q - mean**2, 0.0))
-        # The differences inside samples i-q .. i-1: d[i-q] .. d[i-2].
-        noise = np.sqrt((d2[i - 1] - d2[i - q]) / (2.0 * (q - 1)))
+        mean = before.mean(axis=1)
+        spread = before.std(axis=1)
+        noise = np.sqrt(np.einsum('ij,ij->i', steps, steps) / (2.0 * (q - 1)))
         noise = np.maximum(noise, 1e-12)
         quiet = spread <= _QUIET_RATIO * noise
         self.quiet = np.concatenate([np.zeros(q, dtype=bool), quiet])
