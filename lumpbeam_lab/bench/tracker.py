@@ -201,14 +201,11 @@ def end_to_end(
         One result per transport.
     """
     results = []
+    frames = camera_stream.drop_test_frames(width, height, rate_hz, duration_s)
     transports = ((True, 'shm32mb'), (False, 'default'))
     for large, label in transports if default_transport else transports[:1]:
-        node = camera_stream.measure(
-            camera_stream.camera_node_command(), width, height, rate_hz, duration_s, large
-        )
-        echo = camera_stream.measure(
-            camera_stream.echo_command(), width, height, rate_hz, duration_s, large
-        )
+        node = camera_stream.measure(camera_stream.camera_node_command(), frames, rate_hz, large)
+        echo = camera_stream.measure(camera_stream.echo_command(), frames, rate_hz, large)
         value = node.received / node.duration_s
         baseline = echo.received / echo.duration_s
         details = {

@@ -3,8 +3,9 @@
 A bag keeps each topic's offered QoS so that a player can offer the same again. The project's
 defaults, used for synthetic bags and by the player when a bag has none:
 
-- images and camera info: best effort, volatile, keep last 5 (the sensor-data profile): a
-  late frame is worth less than the next one and must never stall a 180 fps stream;
+- images and camera info: best effort, volatile, keep last :data:`SENSOR_DEPTH`: a late
+  frame is worth less than the next one and must never stall a 180 fps stream, but a
+  reader's history must cover the moments its process is off the CPU;
 - ``/tip_load``: reliable, transient local, keep last 1. It changes rarely (a drop), so a
   node that starts after the last change still needs the current load; a transient-local
   publisher also serves volatile subscribers, so nobody is excluded;
@@ -41,8 +42,12 @@ ZERO = QosTime(0, 0)
 #: player publishes ``/clock`` beside every message, doubling the rate). A PoseStamped is
 #: about 100 bytes, so a history costs some 40 kB per endpoint.
 STREAM_DEPTH = 400
-#: History of the sensor-data profile (images, camera info).
-SENSOR_DEPTH = 5
+#: History of the sensor-data profile (images, camera info): a third of a second at 180 fps.
+#: ROS's sensor-data profile keeps 5, 28 ms at 180 fps: with two busy loops on two cores
+#: the camera node, off the CPU for longer than that, lost up to a fifth of the frames
+#: (doc/validation.md, 'Speed'). A reader's history holds frames only while it is behind;
+#: full, it is 60 MB of 1024 x 1024 mono8 frames.
+SENSOR_DEPTH = 60
 
 SENSOR_TYPES = (IMAGE_TYPE, CAMERA_INFO_TYPE)
 LATCHED_TOPICS = (TIP_LOAD,)

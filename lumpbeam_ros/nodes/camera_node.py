@@ -50,6 +50,7 @@ import numpy as np
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
+from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
 from sensor_msgs.msg import CameraInfo as CameraInfoMsg
 from sensor_msgs.msg import Image
@@ -68,7 +69,7 @@ from lumpbeam_ros.interface import (
     TIP_POSE_COVARIANCE,
 )
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
-from lumpbeam_ros.nodes.lifecycle import run_node
+from lumpbeam_ros.nodes.lifecycle import run_node, spin_events
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
 from lumpbeam_ros.vision.bag_frames import bag_frames
@@ -128,8 +129,8 @@ class CameraNode(SchemaNode):
         self.stamps_back = 0
         self._last_stamp_ns: int | None = None
 
-        # /tip_pose: reliable, more than a second of poses; images and camera info: the
-        # sensor-data profile (best effort, keep last 5); lumpbeam_ros.bagio.qos.
+        # /tip_pose: reliable, more than a second of poses; images and camera info: best
+        # effort, a third of a second of frames (lumpbeam_ros.bagio.qos).
         self.pose_publisher = publisher(self, PoseStamped, TIP_POSE)
         self.covariance_publisher = publisher(self, PoseWithCovarianceStamped, TIP_POSE_COVARIANCE)
         self.diagnostics_publisher = publisher(self, DiagnosticArray, DIAGNOSTICS)
@@ -141,7 +142,10 @@ class CameraNode(SchemaNode):
             subscription(self, Image, IMAGE, self.on_image, raw=True)
             subscription(self, CameraInfoMsg, CAMERA_INFO, self.on_camera_info, raw=True)
         period = float(self._param('diagnostics_period_s'))
-        self.create_timer(period if period > 0 else 1.0, self.publish_diagnostics)
+        # Steady: the period's counts are timed with time.monotonic, and a live node spins on
+        # the events executor, whose timers do not follow a simulated clock.
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self.create_timer(period if period > 0 else 1.0, self.publish_diagnostics, clock=steady)
 
     # -- parameters -------------------------------------------------------------------------
 
@@ -428,7 +432,7 @@ def main(args: Sequence[str] | None = None) -> int:
 def _run(node: CameraNode) -> None:
     """Spins a live node; a node given a bag or footage reads it through, then says so."""
     if not node.in_process:
-        rclpy.spin(node)
+        spin_events(node)
         return
 
     def should_stop() -> bool:

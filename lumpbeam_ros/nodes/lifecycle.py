@@ -10,6 +10,8 @@ One place for what each node's ``main`` did alike (:func:`run_node`):
 * what the node published is written for the demo's per-topic counts
   (:mod:`lumpbeam_ros.nodes.counts`) however it stopped.
 
+A node fed at camera rate spins with :func:`spin_events` instead of ``rclpy.spin``.
+
 The commands that run a node in their own loop (``lumpbeam play``, ``lumpbeam record``) take
 their namespace from :func:`checked_namespace`, their topic names from :func:`checked_topics`
 and their rclpy session and stop request from :func:`stoppable_session`.
@@ -96,6 +98,37 @@ def run_node(
         rclpy.try_shutdown()
         restore_handlers(previous)
     return 0
+
+
+#: Longest time :func:`spin_events` stays in the executor before it looks at the context and
+#: lets Python run its signal handlers, s.
+EVENTS_POLL_S = 0.1
+
+
+def spin_events(node: Node) -> None:
+    """Spins a node on rclpy's events executor until its context shuts down.
+
+    ``rclpy.spin``'s executor rebuilds its wait set from every entity of the node (a dozen
+    with the parameter services) in Python on each wake; at 180 frames a second that was a
+    third of the camera node's CPU (doc/validation.md, 'Speed'). The events executor
+    dispatches each event from C++. It is rclpy's experimental executor: its timers do not
+    follow a simulated clock, so only a node whose timers all run on the steady clock may
+    spin here. Its own ``spin`` only returns when the context's Python shutdown runs, which
+    rclpy's signal handler does not call: the loop returns to Python every
+    :data:`EVENTS_POLL_S` to see the context shut down and to run the signal handlers.
+
+    Args:
+        node: The node; its context is the one watched.
+    """
+    from rclpy.experimental import EventsExecutor
+
+    executor = EventsExecutor(context=node.context)
+    executor.add_node(node)
+    try:
+        while node.context.ok():
+            executor.spin_once(timeout_sec=EVENTS_POLL_S)
+    finally:
+        executor.shutdown()
 
 
 def checked_namespace(namespace: str | None) -> str:

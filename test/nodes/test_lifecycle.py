@@ -17,7 +17,13 @@ from rclpy.node import Node
 from std_msgs.msg import Float64
 
 from lumpbeam_ros.errors import ConfigError, LumpbeamError
-from lumpbeam_ros.interface import BEAM_PARAMS, MODEL_DISCREPANCY, TIP_POSE, TIP_POSE_PREDICTED
+from lumpbeam_ros.interface import (
+    BEAM_PARAMS,
+    DIAGNOSTICS,
+    MODEL_DISCREPANCY,
+    TIP_POSE,
+    TIP_POSE_PREDICTED,
+)
 from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.nodes.counts import COUNTS_DIR_ENV, read_counts
 from lumpbeam_ros.nodes.lifecycle import CONFIG_ERROR, run_node
@@ -165,9 +171,11 @@ def filmed_bag(tmp_path_factory):
 
 
 #: Each node, what it is given to work on, what it publishes while it works and whether it
-#: needs /tip_pose for that.
+#: needs /tip_pose for that. A live camera node (no bag) spins on the events executor
+#: (lifecycle.spin_events) and shows it spins by its diagnostics.
 NODES = {
     'camera': (['-p', 'bag_path:={bag}'], TIP_POSE, PoseStamped, False),
+    'camera live': (['-p', 'diagnostics_period_s:=0.1'], DIAGNOSTICS, DiagnosticArray, False),
     'identifier': (['-p', 'publish_rate_hz:=20.0'], BEAM_PARAMS, DiagnosticArray, True),
     'simulator': ([], TIP_POSE_PREDICTED, PoseStamped, False),
     'diagnosis': (['-p', 'status_period_s:=0.2'], MODEL_DISCREPANCY, DiagnosticArray, True),
@@ -193,7 +201,8 @@ def test_a_node_stops_within_the_bound_while_it_works(ros_graph, filmed_bag, nod
     env = ros_env(ros_graph.domain_id)
     env['PYTHONPATH'] = str(ROOT)
     argv = [a.format(bag=filmed_bag) for a in extra]
-    process = start_process(env, f'lumpbeam_ros.nodes.{node}_node', '--ros-args', *argv)
+    module = f'lumpbeam_ros.nodes.{node.split()[0]}_node'
+    process = start_process(env, module, '--ros-args', *argv)
     try:
         worked = ros_graph.spin_until(working, 60.0)
     finally:

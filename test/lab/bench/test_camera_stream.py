@@ -2,9 +2,10 @@
 
 import math
 
+import numpy as np
 import pytest
 
-from lumpbeam_lab.bench.camera_stream import ParamsAges
+from lumpbeam_lab.bench.camera_stream import BEFORE_RELEASE_S, ParamsAges, drop_test_frames
 
 
 def _ages(messages):
@@ -32,3 +33,13 @@ def test_a_message_without_a_window_is_ignored(window_end_s):
     ages = _ages([(1.0, window_end_s), (1.2, 1.19)])
     assert ages.latencies_ms == pytest.approx([10.0])
     assert ages.repeated == 0
+
+
+def test_the_stream_is_the_drop_test_from_before_the_release():
+    frames = drop_test_frames(160, 120, 180.0, 1.5)
+    assert frames.shape == (270, 120, 160) and frames.dtype == np.uint8
+    # At rest for the second before the release (a noise-free render: identical frames),
+    # then moving.
+    still = round(BEFORE_RELEASE_S * 180.0)
+    assert np.array_equal(frames[0], frames[still - 1])
+    assert not np.array_equal(frames[still - 1], frames[still + 20])

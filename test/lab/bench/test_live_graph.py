@@ -2,7 +2,7 @@ import math
 
 import pytest
 
-from lumpbeam_lab.bench.live_graph import run
+from lumpbeam_lab.bench.live_graph import MAX_P99_MS, run
 from lumpbeam_lab.bench.runner import available_suites, format_table
 
 
@@ -10,18 +10,23 @@ from lumpbeam_lab.bench.runner import available_suites, format_table
 # worker keeps busy.
 @pytest.mark.slow
 @pytest.mark.ros
-def test_quick_run_reports_the_demo_latency_against_the_camera_hop():
+def test_quick_run_reports_the_params_latency_against_the_camera_hop_and_the_echo():
     assert 'live_graph' in available_suites()
     (row,) = run(quick=True)
-    assert row.name == 'demo_e2e_latency_320x240' and row.unit == 'ms (p50)'
+    assert row.name == 'live_graph_320x240_idle' and row.unit == 'ms (/beam_params p99)'
     details = row.details
+    assert details['busy_loops'] == 0
     assert details['frames_published'] == 3 * 180
-    assert details['poses_received'] > 0 and details['beam_params_received'] > 0
+    assert details['poses_pct'] == pytest.approx(100 * details['poses_received'] / (3 * 180))
+    assert details['beam_params_timed'] > 0 and details['echo_poses_pct'] > 0
     # Updates that repeat a window (as after the stream's end) are counted, not timed.
-    assert 0 < details['beam_params_timed'] <= details['beam_params_received']
-    # Both latencies measured, p50 <= p99.
-    assert 0 < details['tip_pose_latency_p50_ms'] <= details['tip_pose_latency_p99_ms']
-    assert 0 < row.value <= details['beam_params_latency_p99_ms']
-    assert row.baseline_value == details['tip_pose_latency_p50_ms']
+    assert details['beam_params_timed'] <= details['beam_params_received']
+    # Every latency measured, p50 <= p99.
+    for prefix in ('tip_pose_latency', 'echo_latency', 'beam_params_latency'):
+        assert 0 < details[f'{prefix}_p50_ms'] <= details[f'{prefix}_p99_ms']
+    assert row.value == details['beam_params_latency_p99_ms']
+    assert row.baseline_value == details['tip_pose_latency_p99_ms']
     assert math.isclose(row.ratio, row.baseline_value / row.value)
-    assert 'demo_e2e_latency_320x240' in format_table([row])
+    passed = row.value < MAX_P99_MS
+    assert (f'{"pass" if passed else "FAIL"} /beam_params p99') in details['target']
+    assert 'live_graph_320x240_idle' in format_table([row])
