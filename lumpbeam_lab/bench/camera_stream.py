@@ -125,9 +125,7 @@ def drop_test_frames(width: int, height: int, rate_hz: float, duration_s: float)
     start = load_beam_config()[1].release_time_s - BEFORE_RELEASE_S
     trajectory = drop_test_trajectory(rate_hz).between(start, start + duration_s - 0.5 / rate_hz)
     config = load_camera_config().with_resolution(width, height)
-    clean = replace(
-        config.synthetic, noise_sigma_dn=0.0, supersample=1, max_motion_samples=1
-    )
+    clean = replace(config.synthetic, noise_sigma_dn=0.0, supersample=1, max_motion_samples=1)
     frames = render_frames(replace(config, synthetic=clean), trajectory)
     return np.stack([f.image for f in frames])
 
