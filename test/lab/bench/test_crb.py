@@ -55,7 +55,7 @@ def test_quick_rows_compare_the_identifier_and_a_peer_with_the_bounds():
     # No estimator beats the bound by much over two trials; the identifier's damping is
     # close to it and its reported sds hold.
     assert d['zeta_rms_over_bound'] > 0.1 and d['zeta_rms_in_reported_std'] < 3.0
-    assert d['f_rms_in_reported_std'] < 3.0
+    assert d['f_rms_in_reported_std'] < 3.0 and d['f_within_3_std'] == 1.0
     # The linear fit (fit.nonlinear never) and the peer land near the linear bound, biased
     # by the amplitude-averaged frequency shift (a few ppm, positive).
     for prefix in ('linear_', 'ssi_cov_'):
