@@ -52,7 +52,7 @@ _STEP = 1e-5
 #: A parameter whose direction in the weighted Jacobian is this small (relative to the
 #: largest singular value) is not determined by the data.
 _RANK_TOLERANCE = 1e-6
-#: A stiffness whose relative std exceeds this is reported as uncertain.
+#: A stiffness or damping whose relative std exceeds this is reported as uncertain.
 UNCERTAIN_ABOVE = 0.05
 #: The weighted residual of a mode the model no longer has.
 _FAR = 1e6
@@ -187,9 +187,12 @@ class LinkFit:
         return arm_modes(ArmModel.from_config(self.arm), q)
 
     def warnings(self) -> list[str]:
-        """One line per link whose stiffness is uncertain by more than :data:`UNCERTAIN_ABOVE`.
+        """One line per stiffness or damping uncertain by more than :data:`UNCERTAIN_ABOVE`.
 
-        The fit is kept: its standard deviation says how uncertain it is.
+        Each line says what data would pin it down. The fit is kept: its standard deviation
+        says how uncertain it is. A link's damping comes from the damping ratios of the modes
+        that bend it, which a smooth move leaves too weak to measure for the higher modes
+        (doc/arm.md).
         """
         lines = []
         for i, link in enumerate(self.links, start=1):
@@ -198,6 +201,14 @@ class LinkFit:
                 lines.append(
                     f"link {i}'s stiffness is uncertain by {100 * relative:.0f} %: add bags "
                     'that show more modes, or whose moves end in other configurations'
+                )
+            relative = link.damping_beta_std / link.damping_beta
+            if relative > UNCERTAIN_ABOVE:
+                lines.append(
+                    f"link {i}'s damping is uncertain by {100 * relative:.0f} %: end each move "
+                    'with a short quick step of the outer joint (about 0.03 rad in 0.15 s) so '
+                    'that every mode rings, and add bags whose moves end in other '
+                    'configurations'
                 )
         return lines
 
