@@ -211,11 +211,33 @@ class BagTrials:
         trials: The fits scored as :class:`Trials`.
         modes: Modes identified per campaign (all bags).
         reduced_chi2: Each campaign's chi-square over its degrees of freedom.
+        mode_errors: For each mode number (1-based) the fit matched a measured mode to, rows
+            of (frequency error, its reported std, damping-ratio error, its reported std),
+            relative to the truth's mode at the bag's final angles.
+        bags: Bags per campaign.
     """
 
     trials: Trials
     modes: np.ndarray
     reduced_chi2: np.ndarray
+    mode_errors: dict[int, np.ndarray]
+    bags: int
+
+    def mode_rows(self) -> list[str]:
+        """One line per mode: how well the ring-downs measured it, in % of the truth."""
+        lines = []
+        campaigns = self.modes.size
+        for k, rows in sorted(self.mode_errors.items()):
+            err = rows * 100
+            inside = [int(np.sum(np.abs(err[:, i]) <= 3 * err[:, i + 1])) for i in (0, 2)]
+            lines.append(
+                f'  mode {k} in {len(rows)}/{self.bags * campaigns} bags: frequency error % '
+                f'RMS {_rms(err[:, 0]):.4f} mean std % {err[:, 1].mean():.4f} within 3 std '
+                f'{inside[0]}; damping ratio error % RMS {_rms(err[:, 2]):.2f} bias '
+                f'{err[:, 2].mean():+.2f} mean std % {err[:, 3].mean():.2f} within 3 std '
+                f'{inside[1]}'
+            )
+        return lines
 
 
 def run_bag_trials(case: ArmCase, folder: Path, trials: int, seed: int = 0) -> BagTrials:
@@ -231,6 +253,8 @@ def run_bag_trials(case: ArmCase, folder: Path, trials: int, seed: int = 0) -> B
     rng = np.random.default_rng(seed)
     moves = [campaign_move(case, np.asarray(q, dtype=float)) for q in case.finals]
     values, stds, modes, chi2 = [], [], [], []
+    errors: dict[int, list[list[float]]] = {}
+    truth_model = ArmModel.from_config(truth)
     for trial in range(trials):
         bags = []
         for k, move in enumerate(moves):
@@ -247,10 +271,24 @@ def run_bag_trials(case: ArmCase, folder: Path, trials: int, seed: int = 0) -> B
         stds.append(s)
         modes.append(sum(len(o.modes) for o in obs))
         chi2.append(fit.chi2 / fit.dof if fit.dof > 0 else math.nan)
+        for o, match in zip(obs, fit.matches, strict=True):
+            want = arm_modes(truth_model, o.joint_angles_rad)
+            for m, j in zip(o.sorted_modes(), match, strict=True):
+                f, zeta = want.natural_frequency_hz[j], want.damping_ratio[j]
+                errors.setdefault(j + 1, []).append(
+                    [
+                        m.natural_frequency_hz / f - 1,
+                        m.natural_frequency_hz_std / f,
+                        m.damping_ratio / zeta - 1,
+                        m.damping_ratio_std / zeta,
+                    ]
+                )
     return BagTrials(
         Trials(truth_table(truth), np.array(values), np.array(stds)),
         np.array(modes),
         np.array(chi2),
+        {k: np.array(rows) for k, rows in errors.items()},
+        len(moves),
     )
 
 
@@ -262,6 +300,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--only', choices=[c.name for c in CASES], help='one arm')
+    parser.add_argument(
+        '--smooth',
+        action='store_true',
+        help='campaign moves without the finishing step (what it is for)',
+    )
     parser.add_argument(
         '--bags',
         type=int,
@@ -281,6 +324,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             )
             print('\n'.join(result.rows()))
         if args.bags > 0:
+            if args.smooth:
+                case = replace(case, finish=())
             with tempfile.TemporaryDirectory() as folder:
                 bag_result = run_bag_trials(case, Path(folder), args.bags, args.seed)
             step = f', ending with a {FINISH_S:g} s step of {list(case.finish)} rad' * bool(
@@ -294,6 +339,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 f'{np.median(bag_result.reduced_chi2):.3g} max {bag_result.reduced_chi2.max():.3g}'
             )
             print('\n'.join(bag_result.trials.rows()))
+            print('\n'.join(bag_result.mode_rows()))
     return 0
 
 

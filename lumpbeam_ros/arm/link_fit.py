@@ -7,7 +7,8 @@ pin down each link's total stiffness k_tE (B.12, B.13) and its damping ``beta = 
 (B.23), which one configuration can only when it shows at least one mode per link: the
 model's modes (statics, then B.16 linearized about the rest at the final joint angles q) are
 fitted to the measured ones by weighted nonlinear least squares, each residual over the
-measurement's standard deviation.
+measurement's standard deviation (a frequency's with :data:`FREQUENCY_FLOOR` of the model's
+own added).
 
 The unknowns are log factors on the nominal arm's values, one for each link's stiffness and
 one for its damping, so both stay positive and the solver sees relative changes. A link given
@@ -52,6 +53,13 @@ _STEP = 1e-5
 #: A parameter whose direction in the weighted Jacobian is this small (relative to the
 #: largest singular value) is not determined by the data.
 _RANK_TOLERANCE = 1e-6
+#: How closely, relative, the linearized model about the rest can match a measured frequency:
+#: added in quadrature to each measured frequency's std. A ring-down's first mode is often
+#: measured finer than this, while its frequency departs from the small-amplitude model's by
+#: about 6e-6 (the three-link arm after the lab's campaign moves, ``python -m
+#: lumpbeam_lab.arm_links --bags``); weighted at its own std it would claim the first link's
+#: stiffness tighter than it is.
+FREQUENCY_FLOOR = 1e-5
 #: A stiffness or damping whose relative std exceeds this is reported as uncertain.
 UNCERTAIN_ABOVE = 0.05
 #: The weighted residual of a mode the model no longer has.
@@ -505,9 +513,11 @@ class LinkParameterFit:
                     # The mode turned overdamped or vanished: as far off as it can be.
                     parts += [_FAR, _FAR]
                     continue
-                df = modes.natural_frequency_hz[j] - mode.natural_frequency_hz
+                f = mode.natural_frequency_hz
+                df = modes.natural_frequency_hz[j] - f
                 dz = modes.damping_ratio[j] - mode.damping_ratio
-                parts += [df / mode.natural_frequency_hz_std, dz / mode.damping_ratio_std]
+                f_std = math.hypot(mode.natural_frequency_hz_std, FREQUENCY_FLOOR * f)
+                parts += [df / f_std, dz / mode.damping_ratio_std]
         return np.asarray(parts, dtype=float)
 
     def _solve(self, theta: np.ndarray, data: _Data, matches: list[tuple[int, ...]]) -> np.ndarray:

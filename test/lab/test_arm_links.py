@@ -66,8 +66,12 @@ def test_each_campaign_move_ends_with_the_cases_quick_step():
     assert plain.time_s[-1] == pytest.approx(MOVE_S) and plain.angles_rad[-1] == pytest.approx(q)
 
 
+@pytest.mark.slow
 def test_a_campaign_from_bags_recovers_the_rotary_link(tmp_path):
     result = run_bag_trials(ROTARY, tmp_path, trials=1, seed=2)
     err = np.abs(result.trials.values[0] / result.trials.truth - 1)
     assert np.all(err < 0.01) and np.all(err <= 3 * result.trials.stds[0] / result.trials.truth)
     assert result.modes.tolist() == [len(ROTARY.finals)] and list(tmp_path.iterdir()) == []
+    (rows,) = result.mode_errors.values()
+    assert rows.shape == (2, 4) and np.all(np.abs(rows[:, 2]) <= 3 * rows[:, 3])
+    assert result.mode_rows()[0].startswith('  mode 1 in 2/2 bags: frequency error %')
