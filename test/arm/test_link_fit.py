@@ -13,6 +13,7 @@ from arm.arm_cases import small_arm
 from lumpbeam_lab.mujoco_arm import MujocoArm
 from lumpbeam_ros.arm.config import arm_from_mapping
 from lumpbeam_ros.arm.link_fit import (
+    FREQUENCY_FLOOR,
     LinkParameterFit,
     MeasuredMode,
     ModeObservation,
@@ -244,3 +245,18 @@ def test_a_mode_from_the_json_of_analyze():
         MeasuredMode.from_json({**entry, 'damping_ratio_std': None}, 'bag: mode 2')
     with pytest.raises(LumpbeamError, match='natural_frequency_hz is None'):
         MeasuredMode.from_json({}, 'bag')
+
+
+def test_a_frequency_measured_finer_than_the_model_matches_is_held_to_the_floor():
+    # A first mode reported to 1e-9 claims no stiffness tighter than the linearized model's
+    # own 1e-5: the std stays at the floor's size, and an error of a few floors is covered.
+    one = small_arm(1)
+    (obs,) = observe(one, [[0.4]], 2)
+    fine = [replace(m, natural_frequency_hz_std=1e-9 * m.natural_frequency_hz) for m in obs.modes]
+    off = replace(fine[0], natural_frequency_hz=fine[0].natural_frequency_hz * (1 + 2e-5))
+    fit = LinkParameterFit(nominal_of(one)).fit([replace(obs, modes=(off, fine[1]))])
+    (link,) = fit.links
+    truth = link_stiffness_total(one.links[0])
+    relative = link.k_total_nm_per_rad_std / link.k_total_nm_per_rad
+    assert FREQUENCY_FLOOR < relative < 5 * FREQUENCY_FLOOR
+    assert abs(link.k_total_nm_per_rad - truth) < 3 * link.k_total_nm_per_rad_std
