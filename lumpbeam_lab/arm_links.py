@@ -301,6 +301,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--only', choices=[c.name for c in CASES], help='one arm')
     parser.add_argument(
+        '--repeat',
+        type=int,
+        default=1,
+        metavar='N',
+        help='the trials measure each configuration N times (1): how much data a looser '
+        'identification needs',
+    )
+    parser.add_argument(
         '--smooth',
         action='store_true',
         help='campaign moves without the finishing step (what it is for)',
@@ -313,13 +321,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         help='also N seeded campaigns of the whole path from synthetic bags (0: none)',
     )
     args = parser.parse_args(argv)
+    if args.repeat < 1:
+        parser.error(f'--repeat {args.repeat}: at least 1')
     for case in CASES:
         if args.only and case.name != args.only:
             continue
         if args.trials > 0:
-            result = run_trials(case, args.trials, args.seed)
+            repeated = replace(case, finals=case.finals * args.repeat)
+            result = run_trials(repeated, args.trials, args.seed)
             print(
-                f'{case.name}: {len(case.finals)} configurations x {case.n_modes} modes, '
+                f'{case.name}: {len(case.finals)} configurations x {case.n_modes} modes'
+                f'{f", each in {args.repeat} bags" if args.repeat > 1 else ""}, '
                 f'nominal {NOMINAL_ERROR:.0%} off, {args.trials} trials'
             )
             print('\n'.join(result.rows()))

@@ -75,3 +75,12 @@ def test_a_campaign_from_bags_recovers_the_rotary_link(tmp_path):
     (rows,) = result.mode_errors.values()
     assert rows.shape == (2, 4) and np.all(np.abs(rows[:, 2]) <= 3 * rows[:, 3])
     assert result.mode_rows()[0].startswith('  mode 1 in 2/2 bags: frequency error %')
+
+
+def test_repeated_configurations_are_trials_on_more_bags(capsys):
+    assert main(['--trials', '1', '--only', 'rotary', '--repeat', '2']) == 0
+    assert '2 configurations x 2 modes, each in 2 bags' in capsys.readouterr().out
+    with pytest.raises(SystemExit) as exit_info:
+        main(['--repeat', '0'])
+    assert exit_info.value.code == 2
+    assert '--repeat 0: at least 1' in capsys.readouterr().err
