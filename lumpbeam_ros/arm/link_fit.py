@@ -7,7 +7,8 @@ pin down each link's total stiffness k_tE (B.12, B.13) and its damping ``beta = 
 (B.23), which one configuration can only when it shows at least one mode per link: the
 model's modes (statics, then B.16 linearized about the rest at the final joint angles q) are
 fitted to the measured ones by weighted nonlinear least squares, each residual over the
-measurement's standard deviation.
+measurement's standard deviation (a frequency's with :data:`FREQUENCY_FLOOR` of the model's
+own added).
 
 The unknowns are log factors on the nominal arm's values, one for each link's stiffness and
 one for its damping, so both stay positive and the solver sees relative changes. A link given
@@ -52,7 +53,14 @@ _STEP = 1e-5
 #: A parameter whose direction in the weighted Jacobian is this small (relative to the
 #: largest singular value) is not determined by the data.
 _RANK_TOLERANCE = 1e-6
-#: A stiffness whose relative std exceeds this is reported as uncertain.
+#: How closely, relative, the linearized model about the rest can match a measured frequency:
+#: added in quadrature to each measured frequency's std. A ring-down's first mode is often
+#: measured finer than this, while its frequency departs from the small-amplitude model's by
+#: about 6e-6 (the three-link arm after the lab's campaign moves, ``python -m
+#: lumpbeam_lab.arm_links --bags``); weighted at its own std it would claim the first link's
+#: stiffness tighter than it is.
+FREQUENCY_FLOOR = 1e-5
+#: A stiffness or damping whose relative std exceeds this is reported as uncertain.
 UNCERTAIN_ABOVE = 0.05
 #: The weighted residual of a mode the model no longer has.
 _FAR = 1e6
@@ -187,9 +195,12 @@ class LinkFit:
         return arm_modes(ArmModel.from_config(self.arm), q)
 
     def warnings(self) -> list[str]:
-        """One line per link whose stiffness is uncertain by more than :data:`UNCERTAIN_ABOVE`.
+        """One line per stiffness or damping uncertain by more than :data:`UNCERTAIN_ABOVE`.
 
-        The fit is kept: its standard deviation says how uncertain it is.
+        Each line says what data would pin it down. The fit is kept: its standard deviation
+        says how uncertain it is. A link's damping comes from the damping ratios of the modes
+        that bend it, which a smooth move leaves too weak to measure for the higher modes
+        (doc/arm.md).
         """
         lines = []
         for i, link in enumerate(self.links, start=1):
@@ -198,6 +209,14 @@ class LinkFit:
                 lines.append(
                     f"link {i}'s stiffness is uncertain by {100 * relative:.0f} %: add bags "
                     'that show more modes, or whose moves end in other configurations'
+                )
+            relative = link.damping_beta_std / link.damping_beta
+            if relative > UNCERTAIN_ABOVE:
+                lines.append(
+                    f"link {i}'s damping is uncertain by {100 * relative:.0f} %: end each move "
+                    'with a short quick step of the outer joint (about 0.03 rad in 0.15 s) so '
+                    'that every mode rings, and add bags whose moves end in other '
+                    'configurations'
                 )
         return lines
 
@@ -494,9 +513,11 @@ class LinkParameterFit:
                     # The mode turned overdamped or vanished: as far off as it can be.
                     parts += [_FAR, _FAR]
                     continue
-                df = modes.natural_frequency_hz[j] - mode.natural_frequency_hz
+                f = mode.natural_frequency_hz
+                df = modes.natural_frequency_hz[j] - f
                 dz = modes.damping_ratio[j] - mode.damping_ratio
-                parts += [df / mode.natural_frequency_hz_std, dz / mode.damping_ratio_std]
+                f_std = math.hypot(mode.natural_frequency_hz_std, FREQUENCY_FLOOR * f)
+                parts += [df / f_std, dz / mode.damping_ratio_std]
         return np.asarray(parts, dtype=float)
 
     def _solve(self, theta: np.ndarray, data: _Data, matches: list[tuple[int, ...]]) -> np.ndarray:

@@ -302,7 +302,8 @@ def add_analyze(parser: argparse.ArgumentParser) -> None:
         '--fit-links',
         action='store_true',
         help="fit each link's k_total_nm_per_rad and damping_beta to the modes measured after "
-        'the last move of each BAG (moves ending in different configurations); with --arm',
+        'the last move of each BAG (moves ending in different configurations, each with a '
+        'short quick step of the outer joint so that every mode rings); with --arm',
     )
 
 

@@ -4,6 +4,8 @@ The measured modes come from a truth arm (the test arms, and MuJoCo's own linear
 it), the fit starts from a nominal arm whose stiffnesses are 20 % off.
 """
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -11,6 +13,7 @@ from arm.arm_cases import small_arm
 from lumpbeam_lab.mujoco_arm import MujocoArm
 from lumpbeam_ros.arm.config import arm_from_mapping
 from lumpbeam_ros.arm.link_fit import (
+    FREQUENCY_FLOOR,
     LinkParameterFit,
     MeasuredMode,
     ModeObservation,
@@ -154,7 +157,24 @@ def test_a_link_the_data_hardly_see_is_reported_uncertain():
     fit = LinkParameterFit(nominal_of(TRUTH)).fit(observe(TRUTH, FINALS, 1))
     warnings = fit.warnings()
     assert any(line.startswith("link 3's stiffness is uncertain by") for line in warnings)
-    assert LinkParameterFit(nominal_of(TRUTH)).fit(observe(TRUTH, FINALS[:3], 3)).warnings() == []
+    three = LinkParameterFit(nominal_of(TRUTH)).fit(observe(TRUTH, FINALS[:3], 3)).warnings()
+    assert not any('stiffness' in line for line in three)
+
+
+def test_damping_ratios_measured_too_loosely_are_reported_with_what_to_record(exact_fit):
+    # At 5 % x k of each damping ratio, three configurations leave the outer links' damping
+    # uncertain by more than 5 %; ring-downs ten times as precise pin it down.
+    loose = exact_fit.warnings()
+    assert any(line.startswith("link 2's damping is uncertain by") for line in loose)
+    assert all('short quick step of the outer joint' in line for line in loose)
+    precise = [
+        ModeObservation(
+            o.joint_angles_rad,
+            tuple(replace(m, damping_ratio_std=m.damping_ratio_std / 10) for m in o.modes),
+        )
+        for o in observe(TRUTH, FINALS[:3], 3)
+    ]
+    assert LinkParameterFit(nominal_of(TRUTH)).fit(precise).warnings() == []
 
 
 def test_too_few_modes_for_the_links_is_refused_in_one_line():
@@ -225,3 +245,18 @@ def test_a_mode_from_the_json_of_analyze():
         MeasuredMode.from_json({**entry, 'damping_ratio_std': None}, 'bag: mode 2')
     with pytest.raises(LumpbeamError, match='natural_frequency_hz is None'):
         MeasuredMode.from_json({}, 'bag')
+
+
+def test_a_frequency_measured_finer_than_the_model_matches_is_held_to_the_floor():
+    # A first mode reported to 1e-9 claims no stiffness tighter than the linearized model's
+    # own 1e-5: the std stays at the floor's size, and an error of a few floors is covered.
+    one = small_arm(1)
+    (obs,) = observe(one, [[0.4]], 2)
+    fine = [replace(m, natural_frequency_hz_std=1e-9 * m.natural_frequency_hz) for m in obs.modes]
+    off = replace(fine[0], natural_frequency_hz=fine[0].natural_frequency_hz * (1 + 2e-5))
+    fit = LinkParameterFit(nominal_of(one)).fit([replace(obs, modes=(off, fine[1]))])
+    (link,) = fit.links
+    truth = link_stiffness_total(one.links[0])
+    relative = link.k_total_nm_per_rad_std / link.k_total_nm_per_rad
+    assert FREQUENCY_FLOOR < relative < 5 * FREQUENCY_FLOOR
+    assert abs(link.k_total_nm_per_rad - truth) < 3 * link.k_total_nm_per_rad_std
