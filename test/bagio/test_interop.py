@@ -6,6 +6,8 @@ from mcap_ros2.decoder import DecoderFactory
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import Stores, get_typestore
 
+from lumpbeam_ros.bagio.qos import SENSOR_DEPTH
+
 from .helpers import T0, write_drop_bag
 
 
@@ -63,5 +65,5 @@ def test_metadata_has_what_ros2_bag_info_expects(drop):
     assert (image_qos['reliability'], image_qos['history'], image_qos['depth']) == (
         'best_effort',
         'keep_last',
-        5,
+        SENSOR_DEPTH,
     )
