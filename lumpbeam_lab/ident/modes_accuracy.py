@@ -148,7 +148,9 @@ def scenarios() -> list[Callable[[], Record]]:
     return [
         lambda: drop_record('drop_paper_beam', 2.5, 4.5, 1),
         lambda: drop_record('drop_light_tip', 0.5, 4.5, 2),
-        lambda: arm_record('rotary', 'arm_rotary.yaml', minimum_jerk([0.0], [0.5], 0.4), 12.4, 2),
+        # 0.1 rad: a half radian in 0.4 s rings far enough into the link's nonlinearity to
+        # bias the first mode's damping against the linear truth (doc/validation.md).
+        lambda: arm_record('rotary', 'arm_rotary.yaml', minimum_jerk([0.0], [0.1], 0.4), 12.4, 2),
         lambda: arm_record(
             'three_link',
             'arm_3link.yaml',
