@@ -25,8 +25,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: Nielsen's starting damping, relative to the largest scaled diagonal of J^T J.
-_INITIAL_DAMPING = 1e-3
+#: Nielsen's starting damping, relative to the largest scaled diagonal of J^T J. Small, for
+#: a start near the solution (Madsen, Nielsen and Tingleff suggest 1e-6): the identifier
+#: starts from spectral peaks or a previous fit, and MINPACK's first step, bounded by
+#: ``100 ||D x0||``, is the Gauss-Newton step there too.
+_INITIAL_DAMPING = 1e-6
 #: The golden section's smaller fraction, (3 - sqrt 5) / 2.
 _GOLDEN = 0.5 * (3.0 - math.sqrt(5.0))
 #: sqrt of the double precision unit roundoff, Brent's relative resolution of x.

@@ -58,7 +58,10 @@ def test_levenberg_marquardt_reaches_scipys_solution_far_below_the_std(name, noi
         theirs = least_squares(residuals, x0, jac=decay.jacobian, method='lm', x_scale='jac')
     assert ours.converged and theirs.success
     std = np.sqrt(np.diag(sandwich_covariance(decay.jacobian(ours.x), ours.residuals).matrix))
-    assert np.max(np.abs(ours.x - theirs.x) / std) < 1e-3
+    # Both stop once the sum of squares (N sigma^2) falls by less than ftol = 1e-8 of itself,
+    # which leaves x free by up to sqrt(ftol N) standard deviations (4e-3 here); on every
+    # problem but one flat one they agree a thousand times closer.
+    assert np.max(np.abs(ours.x - theirs.x) / std) < math.sqrt(1e-8 * TAU.size)
     rss, scipy_rss = ours.residuals @ ours.residuals, 2 * theirs.cost
     assert rss <= scipy_rss * (1 + 1e-9)
     assert ours.n_evaluations <= 2 * theirs.nfev + 5
