@@ -28,7 +28,12 @@ PROBLEMS = {
     'one mode': (1, False, False, [-0.05, *_mode(3.1, 0.01, 0.04, 0.3)]),
     'one mode, drift': (1, True, False, [-0.05, 2e-5, *_mode(3.1, 0.01, 0.04, 0.3)]),
     'one mode, nonlinear': (1, False, True, [-0.05, *_mode(3.1, 0.01, 0.04, 0.3), 8e-6, 0.1]),
-    'two modes': (2, False, False, [-0.05, *_mode(3.1, 0.01, 0.04, 0.3), *_mode(21, 0.02, 1e-3, 1)]),
+    'two modes': (
+        2,
+        False,
+        False,
+        [-0.05, *_mode(3.1, 0.01, 0.04, 0.3), *_mode(21, 0.02, 1e-3, 1)],
+    ),
     'two modes, nonlinear': (
         2,
         False,
