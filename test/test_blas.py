@@ -67,5 +67,5 @@ def test_a_blas_loaded_after_the_first_limit_is_limited_too():
     assert result.returncode == 0, result.stderr
     pools = ast.literal_eval(result.stdout)
     if len(pools) < 2:
-        pytest.skip('scipy shares numpy\'s BLAS here')
+        pytest.skip("scipy shares numpy's BLAS here")
     assert {threads for _, threads in pools} == {1}
