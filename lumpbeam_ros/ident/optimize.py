@@ -113,13 +113,14 @@ def levenberg_marquardt(
     rss = _sum_of_squares(r)
     if not math.isfinite(rss):
         raise ValueError('the residuals at the starting point are not finite')
-    scale = np.zeros(x.size)
+    scale = np.empty(0)
     damping = math.nan
     nu = 2.0
     while True:
         jac = np.asarray(jacobian(x), dtype=float)
         norms = np.linalg.norm(jac, axis=0)
-        scale = np.maximum(scale, np.where(norms > 0.0, norms, 1.0))
+        # MINPACK's diag: the first norms (1 for a zero column), then their running maximum.
+        scale = np.maximum(scale, norms) if scale.size else np.where(norms > 0.0, norms, 1.0)
         if rss == 0.0 or _gradient_cosine(jac, r, norms, rss) <= gtol:
             return LeastSquaresSolution(x, r, evaluations, 'gtol')
         q, upper = np.linalg.qr(jac)
@@ -147,7 +148,8 @@ def levenberg_marquardt(
                 damping *= max(1.0 / 3.0, 1.0 - (2.0 * gain - 1.0) ** 3)
                 nu = 2.0
             else:
-                damping *= nu
+                # After some 600 good steps in a row the damping underflows to 0.
+                damping = damping * nu if damping > 0.0 else _INITIAL_DAMPING
                 nu *= 2.0
             if abs(actual) <= ftol * previous_rss and predicted <= ftol * previous_rss:
                 if gain <= 2.0:
