@@ -174,7 +174,7 @@ class FitProblem:
         Returns:
             The stacked residuals (:meth:`residuals`).
         """
-        key = (model.name, np.asarray(x, dtype=float).tobytes(), end_s)
+        key = self._key(model, x, end_s)
         if key in self._memo:  # e.g. a screening column at the strength a fit starts from
             return self._memo[key].copy()
         try:
@@ -183,10 +183,39 @@ class FitProblem:
         except (SimulationDivergedError, RuntimeError):  # RuntimeError: no static equilibrium
             count = int(np.count_nonzero(self.record.t <= end_s))
             residuals = np.full(2 * count, DIVERGED_RESIDUAL)
+        self._remember(key, residuals)
+        return residuals.copy()
+
+    def trajectory(self, model: Fittable, x: np.ndarray, end_s: float = math.inf) -> TipTrajectory:
+        """Simulates a model at ``x`` up to ``end_s``, remembering its residuals.
+
+        A fit that then starts at ``x`` (:meth:`fit`) finds them instead of simulating again.
+
+        Args:
+            model: The model.
+            x: Its parameters.
+            end_s: Last time, s.
+
+        Returns:
+            The tip trajectory.
+
+        Raises:
+            SimulationDivergedError: The modal solver cannot simulate the beam.
+            RuntimeError: The beam has no static equilibrium.
+        """
+        with np.errstate(all='ignore'):
+            trajectory = self.simulate(model.beam(self.nominal, x), end_s)
+        self._remember(self._key(model, x, end_s), self.residuals(trajectory))
+        return trajectory
+
+    @staticmethod
+    def _key(model: Fittable, x: np.ndarray, end_s: float) -> tuple[str, bytes, float]:
+        return model.name, np.asarray(x, dtype=float).tobytes(), end_s
+
+    def _remember(self, key: tuple[str, bytes, float], residuals: np.ndarray) -> None:
         if len(self._memo) >= MEMO_SIZE:
             self._memo.pop(next(iter(self._memo)))
         self._memo[key] = residuals
-        return residuals.copy()
 
     def residuals(self, trajectory: TipTrajectory, start_s: float = -math.inf) -> np.ndarray:
         """Noise-normalized residuals (model minus measurement), z then pitch.

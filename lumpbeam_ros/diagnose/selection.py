@@ -339,6 +339,7 @@ def select(
     max_effects: int = MAX_EFFECTS,
     start_strength: Callable[[Candidate], float | None] = lambda c: None,
     exhaustive: bool = False,
+    informed_start: Callable[[Evaluated, Candidate], np.ndarray | None] = lambda b, c: None,
 ) -> Selection:
     """Forward selection of effects (see the module docstring).
 
@@ -352,11 +353,16 @@ def select(
         exhaustive: The baseline ``lumpbeam bench`` measures against: every combination of
             up to ``max_effects`` effects fitted from scratch (from the nominal fit), and
             each round choosing among those fits instead of screening.
+        informed_start: Where a fit of a candidate added to a fitted model starts instead
+            of the generic starts (``None``: those), e.g. dry friction's from the decay
+            envelopes. The generic starts are compared by chi2; a start informed by the
+            effect's own signature is taken as it is, since one inside the right valley may
+            still score worse than one beside it.
 
     Returns:
         The selection.
     """
-    base, fitted = _first_round(selector, nominal, candidates, start_strength)
+    base, fitted = _first_round(selector, nominal, candidates, start_strength, informed_start)
     combinations = (
         _every_combination(selector, nominal, candidates, max_effects) if exhaustive else None
     )
@@ -387,7 +393,7 @@ def select(
             ]
             screened = {}
             continue
-        fitted, screened, stop = _screened_round(selector, base, remaining)
+        fitted, screened, stop = _screened_round(selector, base, remaining, informed_start)
         if stop is not None:
             rounds.append(stop)
             break
@@ -402,6 +408,7 @@ def _first_round(
     nominal: Fit,
     candidates: Sequence[Candidate],
     start_strength: Callable[[Candidate], float | None],
+    informed_start: Callable[[Evaluated, Candidate], np.ndarray | None],
 ) -> tuple[Evaluated, list[Evaluated]]:
     """Round 1: the nominal model and every single effect, fitted and scored.
 
@@ -426,14 +433,19 @@ def _first_round(
     # from 0.1 to 1 N m takes a dozen), and one the linearization misjudges starts from the
     # candidate's own start as before, whichever fits better.
     predictions = selector.screen(base, candidates)
-    singles = [
-        selector.fit(
-            Model((c,)),
-            c.start_x(nominal.x, start_strength(c)),
-            [_plausible_x(c, predictions[c.name][2])],
+    singles = []
+    for c in candidates:
+        informed = informed_start(base, c)
+        if informed is not None:
+            singles.append(selector.fit(Model((c,)), _plausible_x(c, informed)))
+            continue
+        singles.append(
+            selector.fit(
+                Model((c,)),
+                c.start_x(nominal.x, start_strength(c)),
+                [_plausible_x(c, predictions[c.name][2])],
+            )
         )
-        for c in candidates
-    ]
     best_train = min([base, *singles], key=lambda e: e.fit.chi2)
     selector.phi = inflation(best_train.residuals[selector._both(selector.train)])
     return selector.rescore(base), [selector.rescore(e) for e in singles]
@@ -470,7 +482,10 @@ def _every_combination(
 
 
 def _screened_round(
-    selector: Selector, base: Evaluated, remaining: Sequence[Candidate]
+    selector: Selector,
+    base: Evaluated,
+    remaining: Sequence[Candidate],
+    informed_start: Callable[[Evaluated, Candidate], np.ndarray | None] = lambda b, c: None,
 ) -> tuple[list[Evaluated], dict[str, float], Round | None]:
     """A round after the first: screen every remaining effect, fit the promising ones.
 
@@ -494,8 +509,13 @@ def _screened_round(
     fitted = []
     for name in promising:
         c = next(c for c in remaining if c.name == name)
-        strength = _plausible(c, predictions[name][1]) or c.start / c.scale
-        fitted.append(selector.fit(base.model.plus(c), np.r_[base.fit.x, strength]))
+        informed = informed_start(base, c)
+        if informed is None:
+            strength = _plausible(c, predictions[name][1]) or c.start / c.scale
+            x0 = np.r_[base.fit.x, strength]
+        else:
+            x0 = _plausible_x(c, informed)
+        fitted.append(selector.fit(base.model.plus(c), x0))
     if fitted:
         return fitted, screened, None
     stop = RoundDecision(

@@ -22,6 +22,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -50,9 +51,15 @@ from lumpbeam_ros.diagnose.selection import (
     Selector,
     select,
 )
-from lumpbeam_ros.diagnose.signatures import Signatures, signatures
+from lumpbeam_ros.diagnose.signatures import (
+    Signatures,
+    decay_peaks,
+    envelope_rates,
+    signatures,
+)
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.parameters import BeamParameters
+from lumpbeam_ros.model.simulate import SimulationDivergedError
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
 #: Share of the time after the load event that the candidates are fitted on.
@@ -234,6 +241,62 @@ def measurement_error(record: Record) -> tuple[float, float]:
     return sigmas[0], sigmas[1]
 
 
+def _envelope(t: np.ndarray, z: np.ndarray, event_s: float) -> tuple[float, float]:
+    """Viscous and dry decay terms of a record's free decay (NaN if unmeasurable)."""
+    try:
+        level = decay_fit(t, z, event_s).offset
+    except LumpbeamError:
+        return float('nan'), float('nan')
+    return envelope_rates(*decay_peaks(t, z, event_s, level))
+
+
+def dry_friction_start(
+    problem: FitProblem, base: Model, base_x: np.ndarray, candidate: Candidate, end_s: float
+) -> np.ndarray | None:
+    """Where a fit of dry friction added to a fitted model should start, from the envelopes.
+
+    A model without friction mimics a linear decay envelope with extra viscous damping, and
+    a fit from there crawls along the valley where the two trade off (a dozen iterations from
+    0.1 to 1 N m). The envelopes separate them (:func:`~lumpbeam_ros.diagnose.signatures.
+    envelope_rates`): the viscous term scales with beta, the dry term with the torque. So
+    beta is scaled by the measured viscous term over the model's, and the torque is the
+    candidate's starting torque scaled by the measured dry term over the one that torque
+    adds to the model (a probe simulation at the fit's own starting point, remembered for
+    the fit).
+
+    Args:
+        problem: The record and the nominal beam.
+        base: The fitted model that friction would join.
+        base_x: Its parameters.
+        candidate: The dry friction candidate.
+        end_s: Last fitted time, s.
+
+    Returns:
+        The start ``x`` of ``base.plus(candidate)``, or ``None`` when an envelope cannot be
+        measured or does not show the dry term.
+    """
+    record = problem.record
+    event = record.event_time_s
+    keep = record.t <= end_s
+    probe_x = np.r_[base_x, candidate.start / candidate.scale]
+    try:
+        base_run = problem.trajectory(base, base_x, end_s)
+        probe = problem.trajectory(base.plus(candidate), probe_x, end_s)
+    except (SimulationDivergedError, RuntimeError):
+        return None
+    a_data, b_data = _envelope(record.t[keep], record.z[keep], event)
+    a_base, b_base = _envelope(base_run.t, base_run.z, event)
+    _, b_probe = _envelope(probe.t, probe.z, event)
+    per_probe = b_probe - b_base
+    values = (a_data, b_data, a_base, b_base, b_probe)
+    if not all(np.isfinite(values)) or min(a_data, a_base, per_probe) <= 0.0:
+        return None
+    x = probe_x.copy()
+    x[1] += math.log(a_data / a_base)
+    x[-1] *= max(b_data - b_base, 0.0) / per_probe
+    return x
+
+
 def _static_seed(model: TipTrajectory, record: Record, problem: FitProblem) -> BeamParameters:
     """Scales k_tE so the model's static drop at the event matches the data (B.12)."""
     beam = problem.nominal
@@ -304,6 +367,11 @@ def _diagnose(
             return sig.time_shift_s  # the delay seen at the load event
         return None
 
+    def informed_start(base: Evaluated, candidate: Candidate) -> np.ndarray | None:
+        if candidate.name != 'coulomb_friction':
+            return None
+        return dry_friction_start(problem, base.model, base.fit.x, candidate, train_end)
+
     max_effects, limit = _effects_allowed(record)
     selector = Selector(problem, train, train_end)
     selection = select(
@@ -313,6 +381,7 @@ def _diagnose(
         max_effects,
         start_strength,
         exhaustive,
+        informed_start,
     )
     decision = _decision(selection, limit)
 
