@@ -432,18 +432,25 @@ def friction_steps(
     free_response = _free_response(drive, e)
     free_angle = (free_response @ angle_row).real
     powers, sums, angle_powers, angle_sums = _stretch_tables(e, gamma, angle_row, count)
+    # A step decided alone: joint 1's angles by scalar arithmetic (Re(row . gamma f) is
+    # compliance * f), the state by three vector operations: the Python loop runs over every
+    # sticking step, so its cost per step is most of the solver's with friction.
+    drive_angle = (drive @ angle_row).real.tolist()
+    row_e = angle_row * e
     z = np.empty_like(drive)
     z[0] = current = drive[0]
     angle = float((angle_row @ current).real)
     k, window = 0, 32
     while k < count - 1:
-        free = e * current + drive[k + 1]
-        rotation = float((angle_row @ free).real) - angle
-        f = _friction_torque(rotation, compliance, torque)
-        current = free + gamma * f
         k += 1
+        loose = float((row_e @ current).real) + drive_angle[k]  # joint 1 if frictionless
+        rotation = loose - angle
+        f = -rotation / compliance
+        if abs(f) > torque:
+            f = -torque if rotation > 0.0 else torque
+        current = e * current + drive[k] + gamma * f
         z[k] = current
-        angle = float((angle_row @ current).real)
+        angle = loose + compliance * f
         if abs(f) < torque:
             continue  # sticking: the next step is decided alone too
         delta = current - free_response[k]
