@@ -30,7 +30,8 @@ from lumpbeam_ros.model.chain import LumpedChain, trig
 from lumpbeam_ros.model.modes import LinearModel
 
 #: Dry friction is stepped at first order (see ``_propagate_with_friction``): its grid is
-#: this many times finer than the smooth dynamics need.
+#: this many times finer than the smooth dynamics need (the remainder ``r`` stays on the
+#: coarse grid).
 FRICTION_REFINEMENT = 4
 
 #: Longest chain solved with single-threaded BLAS (see :meth:`ModalSolver.solve`).
@@ -158,21 +159,37 @@ class ModalSolver:
         Returns:
             Modal coordinates at the grid points, (T, 2n).
         """
-        e, h_phi1, h_phi2 = self._coefficients(h)
         u = forcing @ self._b.T
-        drive = np.empty_like(u)
-        drive[0] = z0
-        drive[1:] = (h_phi1 - h_phi2) * u[:-1] + h_phi2 * u[1:]
         if self.chain.coulomb_torque > 0.0:
-            return self._propagate_with_friction(drive, e, h_phi1)
-        return _free_response(drive, e)
+            return self._propagate_with_friction(z0, u, h)
+        e, h_phi1, h_phi2 = self._coefficients(h)
+        return _free_response(_hold_drive(z0, u, h_phi1, h_phi2), e)
 
-    def _propagate_with_friction(
-        self, drive: np.ndarray, e: np.ndarray, h_phi1: np.ndarray
-    ) -> np.ndarray:
-        """Steps the modal recurrence with dry friction at joint 1 (:func:`friction_steps`)."""
+    def _propagate_with_friction(self, z0: np.ndarray, u: np.ndarray, h: float) -> np.ndarray:
+        """Steps the modal recurrence with dry friction at joint 1 (:func:`friction_steps`).
+
+        On a grid ``FRICTION_REFINEMENT`` times finer than ``h``, the modal forcing ``u``
+        interpolated linearly between the coarse points: that is the first-order hold the
+        coarse grid assumes, so the finer grid only serves the friction's decisions, and the
+        remainder (most of a sweep's work) is evaluated on the coarse grid alone.
+
+        Args:
+            z0: Initial modal coordinates.
+            u: Modal forcing at the coarse grid points, (T, m).
+            h: Coarse grid spacing, s.
+
+        Returns:
+            Modal coordinates at the coarse grid points, (T, m).
+        """
+        fine = FRICTION_REFINEMENT
+        share = np.arange(fine)[:, None, None] / fine
+        between = u[:-1] + share * (u[1:] - u[:-1])  # (fine, T - 1, m)
+        u_fine = np.concatenate([between.transpose(1, 0, 2).reshape(-1, u.shape[1]), u[-1:]])
+        e, h_phi1, h_phi2 = self._coefficients(h / fine)
+        drive = _hold_drive(z0, u_fine, h_phi1, h_phi2)
         gamma = h_phi1 * self._b[:, 0]
-        return friction_steps(drive, e, gamma, self._v[0], self.chain.coulomb_torque)
+        z = friction_steps(drive, e, gamma, self._v[0], self.chain.coulomb_torque)
+        return z[::fine]
 
     def solve(
         self,
@@ -198,7 +215,7 @@ class ModalSolver:
             state: Initial angles and velocities.
             duration: Time span, s.
             step: Largest grid spacing, s (the grid is uniform, ending exactly at duration;
-                ``FRICTION_REFINEMENT`` times finer with dry friction).
+                dry friction is decided on one ``FRICTION_REFINEMENT`` times finer).
             tol: Convergence threshold on the change of the angles between sweeps, rad.
             max_sweeps: Sweeps before giving up.
             remainder: A starting remainder on the same grid (ignored if its shape differs).
@@ -223,8 +240,6 @@ class ModalSolver:
         max_sweeps: int,
         remainder: np.ndarray | None,
     ) -> ChainSolution | None:
-        if self.chain.coulomb_torque > 0.0:
-            step /= FRICTION_REFINEMENT
         steps = max(1, int(np.ceil(duration / step - 1e-9)))
         h = duration / steps
         t = np.linspace(0.0, duration, steps + 1)
@@ -329,6 +344,16 @@ def solve_reference(
 
 class _OverBudgetError(Exception):
     """Raised from inside ``solve_ivp`` when the evaluations run out; carries the time."""
+
+
+def _hold_drive(
+    z0: np.ndarray, u: np.ndarray, h_phi1: np.ndarray, h_phi2: np.ndarray
+) -> np.ndarray:
+    """The first-order-hold increments of a modal forcing ``u``, with ``z0`` in row 0."""
+    drive = np.empty_like(u)
+    drive[0] = z0
+    drive[1:] = (h_phi1 - h_phi2) * u[:-1] + h_phi2 * u[1:]
+    return drive
 
 
 def _free_response(drive: np.ndarray, e: np.ndarray) -> np.ndarray:
