@@ -429,9 +429,11 @@ def _first_round(
     )
     base = selector.evaluate(base_fit)
     # The linearized step of each effect (as in later rounds) is a second starting point:
-    # a fit that starts where the data put it saves most of its iterations (dry friction's
-    # from 0.1 to 1 N m takes a dozen), and one the linearization misjudges starts from the
-    # candidate's own start as before, whichever fits better.
+    # a fit that starts where the data put it saves most of its iterations, and one the
+    # linearization misjudges starts from the candidate's own start as before, whichever
+    # fits better. An effect without a sign has a third, the nominal fit itself (the effect
+    # off, on its bound): one the data do not hold then starts at its minimum instead of
+    # crawling back to the bound from a start that only the linearization preferred.
     predictions = selector.screen(base, candidates)
     singles = []
     for c in candidates:
@@ -443,12 +445,20 @@ def _first_round(
             selector.fit(
                 Model((c,)),
                 c.start_x(nominal.x, start_strength(c)),
-                [_plausible_x(c, predictions[c.name][2])],
+                [_plausible_x(c, predictions[c.name][2]), *_off(c, nominal.x)],
             )
         )
     best_train = min([base, *singles], key=lambda e: e.fit.chi2)
     selector.phi = inflation(best_train.residuals[selector._both(selector.train)])
     return selector.rescore(base), [selector.rescore(e) for e in singles]
+
+
+def _off(candidate: Candidate, x: np.ndarray) -> list[np.ndarray]:
+    """A fitted model's ``x`` with an unsigned candidate added at strength 0 (its bound).
+
+    A start for the candidate's fit (none for a signed one, whose minimum is seldom at 0).
+    """
+    return [] if candidate.signed else [np.r_[x, 0.0]]
 
 
 def _plausible(candidate: Candidate, strength: float) -> float:
@@ -512,10 +522,10 @@ def _screened_round(
         informed = informed_start(base, c)
         if informed is None:
             strength = _plausible(c, predictions[name][1]) or c.start / c.scale
-            x0 = np.r_[base.fit.x, strength]
+            x0, others = np.r_[base.fit.x, strength], _off(c, base.fit.x)
         else:
-            x0 = _plausible_x(c, informed)
-        fitted.append(selector.fit(base.model.plus(c), x0))
+            x0, others = _plausible_x(c, informed), []
+        fitted.append(selector.fit(base.model.plus(c), x0, others))
     if fitted:
         return fitted, screened, None
     stop = RoundDecision(
