@@ -74,6 +74,8 @@ class Fit:
         n_residuals: Number of residuals (samples times two channels).
         evaluations: Simulations the fit took.
         physical: Whether the fitted values are inside their plausible ranges.
+        jacobian: The residuals' Jacobian at ``x`` (forward differences, the last one the
+            least squares took), or ``None``.
     """
 
     candidate: Fittable
@@ -83,6 +85,7 @@ class Fit:
     n_residuals: int
     evaluations: int
     physical: bool
+    jacobian: np.ndarray | None = None
 
     @property
     def name(self) -> str:
@@ -296,4 +299,5 @@ class FitProblem:
             n_residuals=int(result.fun.size),
             evaluations=self.simulations - start,
             physical=candidate.physical(result.x),
+            jacobian=np.asarray(result.jac),
         )

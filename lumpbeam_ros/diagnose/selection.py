@@ -277,15 +277,29 @@ class Selector:
         """The BIC a fit of ``chi2`` would score."""
         return information_criteria(chi2, self.n_train, n_parameters, self.phi)[0]
 
+    def _jacobian(self, model: Model, x: np.ndarray, r0: np.ndarray) -> np.ndarray:
+        """Forward-difference Jacobian of a model's training residuals ``r0`` at ``x``."""
+        lo, hi = model.bounds()
+        columns = []
+        for i in range(x.size):
+            step = DIFF_STEP * max(1.0, abs(float(x[i])))
+            step = step if x[i] + step <= hi[i] else -step
+            shifted = x.copy()
+            shifted[i] += step
+            columns.append(
+                (self.problem.model_residuals(model, shifted, self.train_end) - r0) / step
+            )
+        return np.column_stack(columns)
+
     def screen(
         self, base: Evaluated, candidates: Sequence[Candidate]
     ) -> dict[str, tuple[float, float, np.ndarray]]:
         """One linearized Gauss-Newton step per candidate added to ``base``.
 
-        The base model's Jacobian on the training part (forward differences) and one column
-        per candidate (its residual change at its starting strength) give the least-squares
-        step of the base parameters and the new strength; an effect without a sign whose
-        step is negative predicts no gain.
+        The base model's Jacobian on the training part (forward differences: the one its fit
+        ended with, or new ones) and one column per candidate (its residual change at its
+        starting strength) give the least-squares step of the base parameters and the new
+        strength; an effect without a sign whose step is negative predicts no gain.
 
         Args:
             base: The current model, fitted.
@@ -298,15 +312,9 @@ class Selector:
         model, x = base.model, base.fit.x
         end = self.train_end
         r0 = self.problem.model_residuals(model, x, end)
-        lo, hi = model.bounds()
-        columns = []
-        for i in range(x.size):
-            step = DIFF_STEP * max(1.0, abs(float(x[i])))
-            step = step if x[i] + step <= hi[i] else -step
-            shifted = x.copy()
-            shifted[i] += step
-            columns.append((self.problem.model_residuals(model, shifted, end) - r0) / step)
-        jacobian = np.column_stack(columns)
+        jacobian = base.fit.jacobian
+        if jacobian is None or jacobian.shape != (r0.size, x.size):
+            jacobian = self._jacobian(model, x, r0)
         out = {}
         for c in candidates:
             wider = model.plus(c)
@@ -426,6 +434,7 @@ def _first_round(
         nominal.n_residuals,
         nominal.evaluations,
         nominal.physical,
+        nominal.jacobian,
     )
     base = selector.evaluate(base_fit)
     # The linearized step of each effect (as in later rounds) is a second starting point:
