@@ -15,7 +15,7 @@ level, so a record tracked throughout is compared as it is.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -31,6 +31,10 @@ from lumpbeam_ros.model.trajectory import TipTrajectory
 #: above the simulator's round-off and its dry-friction switching, well below any
 #: parameter's uncertainty.
 DIFF_STEP = 2e-3
+
+#: Tolerances of the fits' least squares on the change of chi2 and of the parameters.
+FIT_FTOL = 1e-4
+FIT_XTOL = 1e-4
 
 #: Residual of every sample when a model cannot be simulated (extreme parameters): far
 #: worse than any fit, so the least squares steps back.
@@ -76,6 +80,8 @@ class Fit:
         physical: Whether the fitted values are inside their plausible ranges.
         jacobian: The residuals' Jacobian at ``x`` (forward differences, the last one the
             least squares took), or ``None``.
+        warm: The solver's remainders of the fit's last simulation, to start a nearby
+            model's from (:class:`~lumpbeam_ros.model.simulate.WarmStart`), or ``None``.
     """
 
     candidate: Fittable
@@ -86,6 +92,7 @@ class Fit:
     evaluations: int
     physical: bool
     jacobian: np.ndarray | None = None
+    warm: WarmStart | None = None
 
     @property
     def name(self) -> str:
@@ -253,6 +260,7 @@ class FitProblem:
         end_s: float = math.inf,
         max_evaluations: int = 60,
         alternatives: Sequence[np.ndarray] = (),
+        warm: WarmStart | None = None,
     ) -> Fit:
         """Fits a candidate by bounded least squares on the samples up to ``end_s``.
 
@@ -263,16 +271,21 @@ class FitProblem:
             max_evaluations: Budget of residual evaluations (each one simulation).
             alternatives: Other starting points (e.g. a linearized step's prediction):
                 the fit starts from whichever of them and ``x0`` has the lowest chi2.
+            warm: Where the first simulation's sweeps start (a copy is taken; e.g. the
+                fit of the model this one extends): same result, fewer sweeps.
 
         Returns:
             The fit.
         """
         lo, hi = candidate.bounds()
         start = self.simulations
-        warm = WarmStart()  # each evaluation starts from the previous one's solution
+        # Each evaluation starts from the previous one's solution.
+        warm = WarmStart() if warm is None else warm.copy()
 
         def fun(x: np.ndarray) -> np.ndarray:
             return self.model_residuals(candidate, x, end_s, warm)
+
+        jacobian = _FinalJacobian(fun, lo, hi)
 
         starts = [
             np.clip(np.asarray(x, dtype=float), lo + 1e-9, hi - 1e-9) for x in (x0, *alternatives)
@@ -285,11 +298,11 @@ class FitProblem:
             fun,
             x0,
             bounds=(lo, hi),
-            diff_step=DIFF_STEP,
+            jac=jacobian,
             x_scale=1.0,
             max_nfev=max_evaluations,
-            xtol=1e-4,
-            ftol=1e-4,
+            xtol=FIT_XTOL,
+            ftol=FIT_FTOL,
         )
         return Fit(
             candidate=candidate,
@@ -299,5 +312,91 @@ class FitProblem:
             n_residuals=int(result.fun.size),
             evaluations=self.simulations - start,
             physical=candidate.physical(result.x),
-            jacobian=np.asarray(result.jac),
+            jacobian=jacobian.at(result.x),
+            warm=warm,
         )
+
+
+#: Step of a finite difference at a parameter of 0, where a relative step is none (scipy's
+#: for forward differences: the square root of the machine epsilon).
+ZERO_STEP = float(np.sqrt(np.finfo(float).eps))
+
+
+def forward_jacobian(
+    fun: Callable[[np.ndarray], np.ndarray],
+    x: np.ndarray,
+    f0: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+) -> np.ndarray:
+    """Forward-difference Jacobian, with the steps of scipy's ``'2-point'`` scheme.
+
+    The step is ``DIFF_STEP`` relative (``ZERO_STEP`` at 0), towards larger magnitudes,
+    turned back when it would leave the bounds, shortened when neither direction fits.
+
+    Args:
+        fun: The residuals.
+        x: Where.
+        f0: ``fun(x)``.
+        lo: Lower bounds.
+        hi: Upper bounds.
+
+    Returns:
+        The Jacobian, (f0.size, x.size).
+    """
+    sign = np.where(x >= 0.0, 1.0, -1.0)
+    h = DIFF_STEP * sign * np.abs(x)
+    h = np.where((x + h) - x == 0.0, ZERO_STEP * sign * np.maximum(1.0, np.abs(x)), h)
+    below, above = x - lo, hi - x
+    outside = (x + h < lo) | (x + h > hi)
+    fits = np.abs(h) <= np.maximum(below, above)
+    h = np.where(outside & fits, -h, h)
+    h = np.where(~fits & (above >= below), above, h)
+    h = np.where(~fits & (above < below), -below, h)
+    columns = []
+    for i in range(x.size):
+        shifted = x.copy()
+        shifted[i] += h[i]
+        columns.append((fun(shifted) - f0) / (shifted[i] - x[i]))
+    return np.column_stack(columns)
+
+
+class _FinalJacobian:
+    """The fits' Jacobian, skipping the one least squares computes only to stop.
+
+    scipy's trust-region loop computes the Jacobian after every accepted step, even one
+    that meets the tolerances and ends the fit: ``n`` simulations for nothing. A step that
+    meets them (by the test scipy applies, given a good agreement with its model, which a
+    converging fit has) gets the previous Jacobian back instead. Should the loop go on after
+    all, it steps once with that Jacobian (a quasi-Newton step) and then with fresh ones.
+    """
+
+    def __init__(self, fun: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray):
+        self._fun = fun
+        self._lo, self._hi = lo, hi
+        self._x: np.ndarray | None = None
+        self._cost = math.inf
+        self._jacobian: np.ndarray | None = None
+        self._fresh_at: np.ndarray | None = None
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        f0 = self._fun(x)  # just evaluated by the least squares: remembered, not simulated
+        cost = 0.5 * float(f0 @ f0)
+        if self._jacobian is not None and self._x is not None and self._stops(x, cost):
+            self._x, self._cost = x.copy(), cost
+            return self._jacobian
+        self._jacobian = forward_jacobian(self._fun, x, f0, self._lo, self._hi)
+        self._x, self._cost, self._fresh_at = x.copy(), cost, x.copy()
+        return self._jacobian
+
+    def _stops(self, x: np.ndarray, cost: float) -> bool:
+        assert self._x is not None
+        reduction = self._cost - cost
+        small = 0.0 < reduction < FIT_FTOL * self._cost
+        step = float(np.linalg.norm(x - self._x))
+        return small or step < FIT_XTOL * (FIT_XTOL + float(np.linalg.norm(self._x)))
+
+    def at(self, x: np.ndarray) -> np.ndarray | None:
+        """The Jacobian computed at ``x`` (``None`` if the last one was not)."""
+        fresh = self._fresh_at is not None and np.array_equal(self._fresh_at, x)
+        return self._jacobian if fresh else None

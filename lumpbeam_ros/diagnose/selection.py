@@ -260,7 +260,11 @@ class Selector:
         )
 
     def fit(
-        self, model: Model, x0: np.ndarray, alternatives: Sequence[np.ndarray] = ()
+        self,
+        model: Model,
+        x0: np.ndarray,
+        alternatives: Sequence[np.ndarray] = (),
+        base: Evaluated | None = None,
     ) -> Evaluated:
         """Fits a model on the training part and evaluates it.
 
@@ -268,9 +272,12 @@ class Selector:
             model: The model.
             x0: Its starting parameters.
             alternatives: Other starting points (:meth:`FitProblem.fit`).
+            base: The fitted model this one extends: its solver remainders start the
+                simulations' sweeps.
         """
+        warm = None if base is None else base.fit.warm
         return self.evaluate(
-            self.problem.fit(model, x0, self.train_end, alternatives=alternatives)
+            self.problem.fit(model, x0, self.train_end, alternatives=alternatives, warm=warm)
         )
 
     def predicted_bic(self, chi2: float, n_parameters: int) -> float:
@@ -319,7 +326,9 @@ class Selector:
         for c in candidates:
             wider = model.plus(c)
             start = c.start / c.scale
-            column = (self.problem.model_residuals(wider, np.r_[x, start], end) - r0) / start
+            warm = None if base.fit.warm is None else base.fit.warm.copy()
+            residuals = self.problem.model_residuals(wider, np.r_[x, start], end, warm)
+            column = (residuals - r0) / start
             full = np.column_stack([jacobian, column])
             step, *_ = np.linalg.lstsq(full, -r0, rcond=None)
             strength = float(step[-1])
@@ -435,6 +444,7 @@ def _first_round(
         nominal.evaluations,
         nominal.physical,
         nominal.jacobian,
+        nominal.warm,
     )
     base = selector.evaluate(base_fit)
     # The linearized step of each effect (as in later rounds) is a second starting point:
@@ -448,13 +458,14 @@ def _first_round(
     for c in candidates:
         informed = informed_start(base, c)
         if informed is not None:
-            singles.append(selector.fit(Model((c,)), _plausible_x(c, informed)))
+            singles.append(selector.fit(Model((c,)), _plausible_x(c, informed), base=base))
             continue
         singles.append(
             selector.fit(
                 Model((c,)),
                 c.start_x(nominal.x, start_strength(c)),
                 [_plausible_x(c, predictions[c.name][2]), *_off(c, nominal.x)],
+                base,
             )
         )
     best_train = min([base, *singles], key=lambda e: e.fit.chi2)
@@ -534,7 +545,7 @@ def _screened_round(
             x0, others = np.r_[base.fit.x, strength], _off(c, base.fit.x)
         else:
             x0, others = _plausible_x(c, informed), []
-        fitted.append(selector.fit(base.model.plus(c), x0, others))
+        fitted.append(selector.fit(base.model.plus(c), x0, others, base))
     if fitted:
         return fitted, screened, None
     stop = RoundDecision(

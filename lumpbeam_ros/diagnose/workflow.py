@@ -291,7 +291,7 @@ def dry_friction_start(
     values = (a_data, b_data, a_base, b_base, b_probe)
     if not all(np.isfinite(values)) or min(a_data, a_base, per_probe) <= 0.0:
         return None
-    x = probe_x.copy()
+    x: np.ndarray = np.array(probe_x, dtype=float)
     x[1] += math.log(a_data / a_base)
     x[-1] *= max(b_data - b_base, 0.0) / per_probe
     return x

@@ -407,18 +407,23 @@ def friction_steps_loop(
 
 _TABLES: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
 
+#: Rows of the stretch tables built first (:func:`_stretch_tables`): longer than most
+#: stretches of a swing on the friction grid; a longer one extends them.
+STRETCH_TABLE_ROWS = 512
+
 
 def _stretch_tables(
     e: np.ndarray, gamma: np.ndarray, angle_row: np.ndarray, count: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``e^m``, ``sum_{i<m} e^i`` and their joint-1 angles for ``m < count`` (cached).
+    """``e^m``, ``sum_{i<m} e^i`` and their joint-1 angles for ``m < count`` at least (cached).
 
     A fit simulates the same grid for the same chain in every sweep, so the tables are kept
-    for the last few recurrences (keyed by their exact bytes).
+    for the last few recurrences (keyed by their exact bytes). They are built only as long
+    as asked: a stretch lasts about half a swing, far less than the grid.
     """
-    key = e.tobytes() + gamma.tobytes() + angle_row.tobytes() + count.to_bytes(8, 'little')
+    key = e.tobytes() + gamma.tobytes() + angle_row.tobytes()
     tables = _TABLES.get(key)
-    if tables is None:
+    if tables is None or tables[0].shape[0] < count:
         powers = np.exp(np.log(e)[None, :] * np.arange(count)[:, None])
         sums = np.cumsum(np.vstack([np.zeros_like(e), powers[:-1]]), axis=0)
         tables = (powers, sums, powers * angle_row, (sums @ (angle_row * gamma)).real)
@@ -456,7 +461,7 @@ def friction_steps(
     compliance = float((angle_row @ gamma).real)
     free_response = _free_response(drive, e)
     free_angle = (free_response @ angle_row).real
-    powers, sums, angle_powers, angle_sums = _stretch_tables(e, gamma, angle_row, count)
+    tables = _stretch_tables(e, gamma, angle_row, min(count, STRETCH_TABLE_ROWS))
     # A step decided alone: joint 1's angles by scalar arithmetic (Re(row . gamma f) is
     # compliance * f), the state by three vector operations: the Python loop runs over every
     # sticking step, so its cost per step is most of the solver's with friction.
@@ -481,6 +486,9 @@ def friction_steps(
         delta = current - free_response[k]
         while True:
             end = min(count - 1, k + window)
+            if end - k >= tables[0].shape[0]:
+                tables = _stretch_tables(e, gamma, angle_row, min(count, 2 * (end - k) + 1))
+            powers, sums, angle_powers, angle_sums = tables
             m = np.arange(1, end - k + 1)
             angles = (angle_powers[m] @ delta).real + free_angle[k + 1 : end + 1]
             angles += f * angle_sums[m]
