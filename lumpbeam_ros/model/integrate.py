@@ -182,11 +182,15 @@ class ModalSolver:
             Modal coordinates at the coarse grid points, (T, m).
         """
         fine = FRICTION_REFINEMENT
-        share = np.arange(fine)[:, None, None] / fine
-        between = u[:-1] + share * (u[1:] - u[:-1])  # (fine, T - 1, m)
-        u_fine = np.concatenate([between.transpose(1, 0, 2).reshape(-1, u.shape[1]), u[-1:]])
         e, h_phi1, h_phi2 = self._coefficients(h / fine)
-        drive = _hold_drive(z0, u_fine, h_phi1, h_phi2)
+        # Fine step j of coarse step k holds u_k + (j + s) / fine (u_{k+1} - u_k), s in [0, 1].
+        j = np.arange(fine)[:, None]
+        on_change = ((h_phi1 - h_phi2) * j + h_phi2 * (j + 1)) / fine  # (fine, m)
+        change = u[1:] - u[:-1]
+        steps = h_phi1 * u[:-1, None, :] + on_change * change[:, None, :]  # (T - 1, fine, m)
+        drive = np.empty(((u.shape[0] - 1) * fine + 1, u.shape[1]), dtype=complex)
+        drive[0] = z0
+        drive[1:] = steps.reshape(-1, u.shape[1])
         gamma = h_phi1 * self._b[:, 0]
         z = friction_steps(drive, e, gamma, self._v[0], self.chain.coulomb_torque)
         return z[::fine]
@@ -489,22 +493,22 @@ def friction_steps(
             if end - k >= tables[0].shape[0]:
                 tables = _stretch_tables(e, gamma, angle_row, min(count, 2 * (end - k) + 1))
             powers, sums, angle_powers, angle_sums = tables
-            m = np.arange(1, end - k + 1)
-            angles = (angle_powers[m] @ delta).real + free_angle[k + 1 : end + 1]
-            angles += f * angle_sums[m]
-            rotations = angles - np.concatenate([[angle], angles[:-1]]) - compliance * f
-            slides = (np.abs(rotations / compliance) > torque) & (
-                -torque * np.sign(rotations) == f
-            )
-            bad = np.flatnonzero(~slides)
+            length = end - k  # steps m = 1 .. length ahead
+            angles = (angle_powers[1 : length + 1] @ delta).real + free_angle[k + 1 : end + 1]
+            angles += f * angle_sums[1 : length + 1]
+            rotations = np.diff(angles, prepend=angle) - compliance * f
+            # Sliding on: a rotation beyond what the torque can hold, against the torque,
+            # -f * rotation > torque * torque * compliance (|f| = torque, compliance > 0).
+            bad = np.flatnonzero(-f * rotations <= torque * torque * compliance)
             if bad.size or end == count - 1:
                 break
             window *= 2
-        steps = int(bad[0]) if bad.size else m.size
+        steps = int(bad[0]) if bad.size else length
         if steps:
-            m = m[:steps]
             z[k + 1 : k + 1 + steps] = (
-                powers[m] * delta + free_response[k + 1 : k + 1 + steps] + f * gamma * sums[m]
+                powers[1 : steps + 1] * delta
+                + free_response[k + 1 : k + 1 + steps]
+                + f * gamma * sums[1 : steps + 1]
             )
             window = max(32, 2 * steps)
             k += steps
