@@ -496,7 +496,9 @@ def friction_steps(
             length = end - k  # steps m = 1 .. length ahead
             angles = (angle_powers[1 : length + 1] @ delta).real + free_angle[k + 1 : end + 1]
             angles += f * angle_sums[1 : length + 1]
-            rotations = np.diff(angles, prepend=angle) - compliance * f
+            rotations = angles - compliance * f
+            rotations[1:] -= angles[:-1]
+            rotations[0] -= angle
             # Sliding on: a rotation beyond what the torque can hold, against the torque,
             # -f * rotation > torque * torque * compliance (|f| = torque, compliance > 0).
             bad = np.flatnonzero(-f * rotations <= torque * torque * compliance)
