@@ -78,8 +78,8 @@ class Fit:
         n_residuals: Number of residuals (samples times two channels).
         evaluations: Simulations the fit took.
         physical: Whether the fitted values are inside their plausible ranges.
-        jacobian: The residuals' Jacobian at ``x`` (forward differences, the last one the
-            least squares took), or ``None``.
+        jacobian: The last Jacobian of the residuals the least squares computed (forward
+            differences at ``x`` or at the iterate before it, which met the tolerances).
         warm: The solver's remainders of the fit's last simulation, to start a nearby
             model's from (:class:`~lumpbeam_ros.model.simulate.WarmStart`), or ``None``.
     """
@@ -312,7 +312,7 @@ class FitProblem:
             n_residuals=int(result.fun.size),
             evaluations=self.simulations - start,
             physical=candidate.physical(result.x),
-            jacobian=jacobian.at(result.x),
+            jacobian=jacobian.last,
             warm=warm,
         )
 
@@ -377,7 +377,6 @@ class _FinalJacobian:
         self._x: np.ndarray | None = None
         self._cost = math.inf
         self._jacobian: np.ndarray | None = None
-        self._fresh_at: np.ndarray | None = None
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         f0 = self._fun(x)  # just evaluated by the least squares: remembered, not simulated
@@ -386,7 +385,7 @@ class _FinalJacobian:
             self._x, self._cost = x.copy(), cost
             return self._jacobian
         self._jacobian = forward_jacobian(self._fun, x, f0, self._lo, self._hi)
-        self._x, self._cost, self._fresh_at = x.copy(), cost, x.copy()
+        self._x, self._cost = x.copy(), cost
         return self._jacobian
 
     def _stops(self, x: np.ndarray, cost: float) -> bool:
@@ -396,7 +395,7 @@ class _FinalJacobian:
         step = float(np.linalg.norm(x - self._x))
         return small or step < FIT_XTOL * (FIT_XTOL + float(np.linalg.norm(self._x)))
 
-    def at(self, x: np.ndarray) -> np.ndarray | None:
-        """The Jacobian computed at ``x`` (``None`` if the last one was not)."""
-        fresh = self._fresh_at is not None and np.array_equal(self._fresh_at, x)
-        return self._jacobian if fresh else None
+    @property
+    def last(self) -> np.ndarray | None:
+        """The last Jacobian computed (``None`` before the first)."""
+        return self._jacobian

@@ -303,8 +303,8 @@ class Selector:
     ) -> dict[str, tuple[float, float, np.ndarray]]:
         """One linearized Gauss-Newton step per candidate added to ``base``.
 
-        The base model's Jacobian on the training part (forward differences: the one its fit
-        ended with, or new ones) and one column per candidate (its residual change at its
+        The base model's Jacobian on the training part (forward differences: the last its
+        fit computed, at its solution or the step before, or new ones) and one column per candidate (its residual change at its
         starting strength) give the least-squares step of the base parameters and the new
         strength; an effect without a sign whose step is negative predicts no gain.
 
