@@ -120,7 +120,8 @@ class FitProblem:
         self, record: Record, nominal: BeamParameters, sigma_z: float, sigma_pitch: float
     ):
         self.record = record
-        self._memo: dict[tuple[str, bytes, float], np.ndarray] = {}
+        # Residuals (and the simulation, when there is one) by model, parameters and end.
+        self._memo: dict[tuple[str, bytes, float], tuple[np.ndarray, TipTrajectory | None]] = {}
         self._nominal = nominal
         self.sigma_z = sigma_z
         self.sigma_pitch = sigma_pitch
@@ -186,20 +187,23 @@ class FitProblem:
         """
         key = self._key(model, x, end_s)
         if key in self._memo:  # e.g. a screening column at the strength a fit starts from
-            return self._memo[key].copy()
+            return self._memo[key][0].copy()
+        trajectory = None
         try:
             with np.errstate(all='ignore'):
-                residuals = self.residuals(self.simulate(model.beam(self.nominal, x), end_s, warm))
+                trajectory = self.simulate(model.beam(self.nominal, x), end_s, warm)
+            residuals = self.residuals(trajectory)
         except (SimulationDivergedError, RuntimeError):  # RuntimeError: no static equilibrium
             count = int(np.count_nonzero(self.record.t <= end_s))
             residuals = np.full(2 * count, DIVERGED_RESIDUAL)
-        self._remember(key, residuals)
+        self._remember(key, residuals, trajectory)
         return residuals.copy()
 
     def trajectory(self, model: Fittable, x: np.ndarray, end_s: float = math.inf) -> TipTrajectory:
-        """Simulates a model at ``x`` up to ``end_s``, remembering its residuals.
+        """A model's simulation at ``x`` up to ``end_s``, remembered with its residuals.
 
-        A fit that then starts at ``x`` (:meth:`fit`) finds them instead of simulating again.
+        One just simulated for residuals (the end of a fit) is not simulated again, and a
+        fit that starts at ``x`` (:meth:`fit`) finds the residuals.
 
         Args:
             model: The model.
@@ -213,19 +217,28 @@ class FitProblem:
             SimulationDivergedError: The modal solver cannot simulate the beam.
             RuntimeError: The beam has no static equilibrium.
         """
+        key = self._key(model, x, end_s)
+        remembered = self._memo.get(key, (None, None))[1]
+        if remembered is not None:
+            return remembered
         with np.errstate(all='ignore'):
             trajectory = self.simulate(model.beam(self.nominal, x), end_s)
-        self._remember(self._key(model, x, end_s), self.residuals(trajectory))
+        self._remember(key, self.residuals(trajectory), trajectory)
         return trajectory
 
     @staticmethod
     def _key(model: Fittable, x: np.ndarray, end_s: float) -> tuple[str, bytes, float]:
         return model.name, np.asarray(x, dtype=float).tobytes(), end_s
 
-    def _remember(self, key: tuple[str, bytes, float], residuals: np.ndarray) -> None:
+    def _remember(
+        self,
+        key: tuple[str, bytes, float],
+        residuals: np.ndarray,
+        trajectory: TipTrajectory | None,
+    ) -> None:
         if len(self._memo) >= MEMO_SIZE:
             self._memo.pop(next(iter(self._memo)))
-        self._memo[key] = residuals
+        self._memo[key] = (residuals, trajectory)
 
     def residuals(self, trajectory: TipTrajectory, start_s: float = -math.inf) -> np.ndarray:
         """Noise-normalized residuals (model minus measurement), z then pitch.

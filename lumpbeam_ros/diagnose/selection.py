@@ -304,9 +304,10 @@ class Selector:
         """One linearized Gauss-Newton step per candidate added to ``base``.
 
         The base model's Jacobian on the training part (forward differences: the last its
-        fit computed, at its solution or the step before, or new ones) and one column per candidate (its residual change at its
-        starting strength) give the least-squares step of the base parameters and the new
-        strength; an effect without a sign whose step is negative predicts no gain.
+        fit computed, at its solution or the step before, or new ones) and one column per
+        candidate (its residual change at its starting strength) give the least-squares step
+        of the base parameters and the new strength; an effect without a sign whose step is
+        negative predicts no gain.
 
         Args:
             base: The current model, fitted.

@@ -359,7 +359,7 @@ def _diagnose(
 
     nominal_model = nominal_candidate()
     nominal = problem.fit(nominal_model, np.zeros(2), train_end)
-    nominal_trajectory = problem.simulate(nominal.beam)
+    nominal_trajectory = problem.trajectory(nominal_model, nominal.x)
     sig = signatures(record, nominal_trajectory, measured_fit.offset)
 
     def start_strength(candidate: Candidate) -> float | None:
@@ -444,13 +444,13 @@ def _final_models(
         nominal ones when nothing is named), and the effects named.
     """
     final_nominal = problem.fit(nominal_candidate(), nominal_x)
-    before = problem.simulate(final_nominal.beam)
+    before = problem.trajectory(nominal_candidate(), final_nominal.x)
     if decision.missing_effect in (NONE, UNEXPLAINED):
         return final_nominal.beam, before, final_nominal.beam, before, ()
     chosen = selection.model
     final = problem.fit(chosen.model, chosen.fit.x)
     named = _named(chosen.model, final.x, selection.path, problem.sigma_z, train)
-    return final_nominal.beam, before, final.beam, problem.simulate(final.beam), named
+    return final_nominal.beam, before, final.beam, problem.trajectory(chosen.model, final.x), named
 
 
 def _decay_length(record: Record) -> float:
