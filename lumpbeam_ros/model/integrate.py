@@ -485,8 +485,8 @@ def friction_steps(
         current = e * current + drive[k] + gamma * f
         z[k] = current
         angle = loose + compliance * f
-        if abs(f) < torque:
-            continue  # sticking: the next step is decided alone too
+        if abs(f) < torque or k == count - 1:
+            continue  # sticking (the next step is decided alone too), or the grid's end
         delta = current - free_response[k]
         while True:
             end = min(count - 1, k + window)
