@@ -27,9 +27,9 @@ from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.model.simulate import SimulationDivergedError, WarmStart, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
-#: Finite-difference step of the fitted parameters (relative, at least 2e-3 absolute): well
-#: above the simulator's round-off and its dry-friction switching, well below any
-#: parameter's uncertainty.
+#: Finite-difference step of the fitted parameters, relative to their magnitude (scipy's
+#: ``diff_step``; :func:`forward_jacobian`): well above the simulator's round-off and its
+#: dry-friction switching, well below any parameter's uncertainty.
 DIFF_STEP = 2e-3
 
 #: Tolerances of the fits' least squares on the change of chi2 and of the parameters.

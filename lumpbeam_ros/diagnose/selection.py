@@ -3,7 +3,9 @@
 A :class:`Model` is the nominal beam plus any number of effects, fitted jointly (k_tE, beta
 and one strength per effect). The selection grows it one effect per round:
 
-1. Round 1 fits every single effect of the library on the training part of the record.
+1. Round 1 fits every single effect of the library on the training part of the record,
+   each from the best of its own start, the linearized step of 2. and (an effect without a
+   sign) the nominal fit, or from a start informed by the effect's signature.
 2. From round 2 on, the current model's residual is linearized: one Gauss-Newton step
    (the current model's Jacobian plus one column per remaining effect, at a small strength)
    predicts how much each effect would lower chi2, and only the most promising are fitted

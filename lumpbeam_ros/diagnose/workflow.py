@@ -15,7 +15,8 @@
    record up to ``train_fraction`` of the time after the event, checked on the rest (held
    out) and scored (:mod:`~lumpbeam_ros.diagnose.scoring`); the best joins the model when
    the data insist on it, and a second effect is searched on top of it the same way (a
-   pair only on a decay of at least ``PAIR_MIN_DECAY_S``).
+   pair only on a decay of at least ``PAIR_MIN_DECAY_S``). Dry friction's fits start where
+   the decay envelopes put them (:func:`dry_friction_start`).
 5. The selected model, if any, refit on the whole record; the gap before (nominal) and
    after (augmented) measured on the whole record.
 """
