@@ -453,10 +453,16 @@ def _first_round(
     # The linearized step of each effect (as in later rounds) is a second starting point:
     # a fit that starts where the data put it saves most of its iterations, and one the
     # linearization misjudges starts from the candidate's own start as before, whichever
-    # fits better. An effect without a sign has a third, the nominal fit itself (the effect
-    # off, on its bound): one the data do not hold then starts at its minimum instead of
-    # crawling back to the bound from a start that only the linearization preferred.
+    # fits better. An effect without a sign that the step predicts not to matter has a
+    # third, the nominal fit itself (the effect off, on its bound): one the data do not hold
+    # then starts at its minimum instead of crawling back to it from a start only the
+    # linearization preferred. (Not one predicted to matter: a fit that starts on the bound
+    # stays there, its finite differences being relative.)
     predictions = selector.screen(base, candidates)
+    gains = {
+        name: base.score.bic - selector.predicted_bic(chi2, base.model.n_parameters + 1)
+        for name, (chi2, _, _) in predictions.items()
+    }
     singles = []
     for c in candidates:
         informed = informed_start(base, c)
@@ -467,7 +473,10 @@ def _first_round(
             selector.fit(
                 Model((c,)),
                 c.start_x(nominal.x, start_strength(c)),
-                [_plausible_x(c, predictions[c.name][2]), *_off(c, nominal.x)],
+                [
+                    _plausible_x(c, predictions[c.name][2]),
+                    *(_off(c, nominal.x) if gains[c.name] < SCREEN_BIC else []),
+                ],
                 base,
             )
         )
@@ -479,7 +488,8 @@ def _first_round(
 def _off(candidate: Candidate, x: np.ndarray) -> list[np.ndarray]:
     """A fitted model's ``x`` with an unsigned candidate added at strength 0 (its bound).
 
-    A start for the candidate's fit (none for a signed one, whose minimum is seldom at 0).
+    A start for the fit of a candidate predicted not to matter (none for a signed one,
+    whose minimum is seldom at 0).
     """
     return [] if candidate.signed else [np.r_[x, 0.0]]
 
@@ -545,10 +555,10 @@ def _screened_round(
         informed = informed_start(base, c)
         if informed is None:
             strength = _plausible(c, predictions[name][1]) or c.start / c.scale
-            x0, others = np.r_[base.fit.x, strength], _off(c, base.fit.x)
+            x0 = np.r_[base.fit.x, strength]
         else:
-            x0, others = _plausible_x(c, informed), []
-        fitted.append(selector.fit(base.model.plus(c), x0, others, base))
+            x0 = _plausible_x(c, informed)
+        fitted.append(selector.fit(base.model.plus(c), x0, base=base))
     if fitted:
         return fitted, screened, None
     stop = RoundDecision(
