@@ -78,8 +78,6 @@ class Fit:
         n_residuals: Number of residuals (samples times two channels).
         evaluations: Simulations the fit took.
         physical: Whether the fitted values are inside their plausible ranges.
-        jacobian: The last Jacobian of the residuals the least squares computed (forward
-            differences at ``x`` or at the iterate before it, which met the tolerances).
         warm: The solver's remainders of the fit's last simulation, to start a nearby
             model's from (:class:`~lumpbeam_ros.model.simulate.WarmStart`), or ``None``.
     """
@@ -91,7 +89,6 @@ class Fit:
     n_residuals: int
     evaluations: int
     physical: bool
-    jacobian: np.ndarray | None = None
     warm: WarmStart | None = None
 
     @property
@@ -325,7 +322,6 @@ class FitProblem:
             n_residuals=int(result.fun.size),
             evaluations=self.simulations - start,
             physical=candidate.physical(result.x),
-            jacobian=jacobian.last,
             warm=warm,
         )
 
@@ -407,8 +403,3 @@ class _FinalJacobian:
         small = 0.0 < reduction < FIT_FTOL * self._cost
         step = float(np.linalg.norm(x - self._x))
         return small or step < FIT_XTOL * (FIT_XTOL + float(np.linalg.norm(self._x)))
-
-    @property
-    def last(self) -> np.ndarray | None:
-        """The last Jacobian computed (``None`` before the first)."""
-        return self._jacobian

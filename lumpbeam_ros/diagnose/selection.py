@@ -4,8 +4,8 @@ A :class:`Model` is the nominal beam plus any number of effects, fitted jointly 
 and one strength per effect). The selection grows it one effect per round:
 
 1. Round 1 fits every single effect of the library on the training part of the record,
-   each from the best of its own start, the linearized step of 2. and (an effect without a
-   sign) the nominal fit, or from a start informed by the effect's signature.
+   each from the better of its own start and the linearized step of 2., or from a start
+   informed by the effect's signature.
 2. From round 2 on, the current model's residual is linearized: one Gauss-Newton step
    (the current model's Jacobian plus one column per remaining effect, at a small strength)
    predicts how much each effect would lower chi2, and only the most promising are fitted
@@ -305,11 +305,10 @@ class Selector:
     ) -> dict[str, tuple[float, float, np.ndarray]]:
         """One linearized Gauss-Newton step per candidate added to ``base``.
 
-        The base model's Jacobian on the training part (forward differences: the last its
-        fit computed, at its solution or the step before, or new ones) and one column per
-        candidate (its residual change at its starting strength) give the least-squares step
-        of the base parameters and the new strength; an effect without a sign whose step is
-        negative predicts no gain.
+        The base model's Jacobian on the training part (forward differences) and one column
+        per candidate (its residual change at its starting strength) give the least-squares
+        step of the base parameters and the new strength; an effect without a sign whose
+        step is negative predicts no gain.
 
         Args:
             base: The current model, fitted.
@@ -322,9 +321,9 @@ class Selector:
         model, x = base.model, base.fit.x
         end = self.train_end
         r0 = self.problem.model_residuals(model, x, end)
-        jacobian = base.fit.jacobian
-        if jacobian is None or jacobian.shape != (r0.size, x.size):
-            jacobian = self._jacobian(model, x, r0)
+        # Its own steps, not the fit's last Jacobian: those are relative to the parameters,
+        # and a strength near 0 would see no slope (the predictions set the fits' starts).
+        jacobian = self._jacobian(model, x, r0)
         out = {}
         for c in candidates:
             wider = model.plus(c)
@@ -446,23 +445,15 @@ def _first_round(
         nominal.n_residuals,
         nominal.evaluations,
         nominal.physical,
-        nominal.jacobian,
-        nominal.warm,
+        warm=nominal.warm,
     )
     base = selector.evaluate(base_fit)
     # The linearized step of each effect (as in later rounds) is a second starting point:
     # a fit that starts where the data put it saves most of its iterations, and one the
     # linearization misjudges starts from the candidate's own start as before, whichever
-    # fits better. An effect without a sign that the step predicts not to matter has a
-    # third, the nominal fit itself (the effect off, on its bound): one the data do not hold
-    # then starts at its minimum instead of crawling back to it from a start only the
-    # linearization preferred. (Not one predicted to matter: a fit that starts on the bound
-    # stays there, its finite differences being relative.)
+    # fits better. (Not the nominal fit itself, the effect off on its bound: a fit that
+    # starts there stays there, its finite differences being relative to the strength.)
     predictions = selector.screen(base, candidates)
-    gains = {
-        name: base.score.bic - selector.predicted_bic(chi2, base.model.n_parameters + 1)
-        for name, (chi2, _, _) in predictions.items()
-    }
     singles = []
     for c in candidates:
         informed = informed_start(base, c)
@@ -473,25 +464,13 @@ def _first_round(
             selector.fit(
                 Model((c,)),
                 c.start_x(nominal.x, start_strength(c)),
-                [
-                    _plausible_x(c, predictions[c.name][2]),
-                    *(_off(c, nominal.x) if gains[c.name] < SCREEN_BIC else []),
-                ],
+                [_plausible_x(c, predictions[c.name][2])],
                 base,
             )
         )
     best_train = min([base, *singles], key=lambda e: e.fit.chi2)
     selector.phi = inflation(best_train.residuals[selector._both(selector.train)])
     return selector.rescore(base), [selector.rescore(e) for e in singles]
-
-
-def _off(candidate: Candidate, x: np.ndarray) -> list[np.ndarray]:
-    """A fitted model's ``x`` with an unsigned candidate added at strength 0 (its bound).
-
-    A start for the fit of a candidate predicted not to matter (none for a signed one,
-    whose minimum is seldom at 0).
-    """
-    return [] if candidate.signed else [np.r_[x, 0.0]]
 
 
 def _plausible(candidate: Candidate, strength: float) -> float:
