@@ -258,12 +258,11 @@ def dry_friction_start(
 
     A model without friction mimics a linear decay envelope with extra viscous damping, and
     a fit from there crawls along the valley where the two trade off (a dozen iterations from
-    0.1 to 1 N m). The envelopes separate them (:func:`~lumpbeam_ros.diagnose.signatures.
-    envelope_rates`): the viscous term scales with beta, the dry term with the torque. So
-    beta is scaled by the measured viscous term over the model's, and the torque is the
-    candidate's starting torque scaled by the measured dry term over the one that torque
-    adds to the model (a probe simulation at the fit's own starting point, remembered for
-    the fit).
+    0.1 to 1 N m). The envelopes separate them
+    (:func:`~lumpbeam_ros.diagnose.signatures.envelope_rates`): the viscous term scales with
+    beta, the dry term with the torque. So beta is scaled by the measured viscous term over
+    the model's, and the torque is the candidate's starting torque scaled by the measured
+    dry term over the one that torque adds to the model (one probe simulation).
 
     Args:
         problem: The record and the nominal beam.
