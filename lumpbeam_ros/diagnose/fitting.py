@@ -15,7 +15,7 @@ level, so a record tracked throughout is compared as it is.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -27,10 +27,14 @@ from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.model.simulate import SimulationDivergedError, WarmStart, simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
-#: Finite-difference step of the fitted parameters (relative, at least 2e-3 absolute): well
-#: above the simulator's round-off and its dry-friction switching, well below any
-#: parameter's uncertainty.
+#: Finite-difference step of the fitted parameters, relative to their magnitude (scipy's
+#: ``diff_step``; :func:`forward_jacobian`): well above the simulator's round-off and its
+#: dry-friction switching, well below any parameter's uncertainty.
 DIFF_STEP = 2e-3
+
+#: Tolerances of the fits' least squares on the change of chi2 and of the parameters.
+FIT_FTOL = 1e-4
+FIT_XTOL = 1e-4
 
 #: Residual of every sample when a model cannot be simulated (extreme parameters): far
 #: worse than any fit, so the least squares steps back.
@@ -74,6 +78,8 @@ class Fit:
         n_residuals: Number of residuals (samples times two channels).
         evaluations: Simulations the fit took.
         physical: Whether the fitted values are inside their plausible ranges.
+        warm: The solver's remainders of the fit's last simulation, to start a nearby
+            model's from (:class:`~lumpbeam_ros.model.simulate.WarmStart`), or ``None``.
     """
 
     candidate: Fittable
@@ -83,6 +89,7 @@ class Fit:
     n_residuals: int
     evaluations: int
     physical: bool
+    warm: WarmStart | None = None
 
     @property
     def name(self) -> str:
@@ -110,7 +117,8 @@ class FitProblem:
         self, record: Record, nominal: BeamParameters, sigma_z: float, sigma_pitch: float
     ):
         self.record = record
-        self._memo: dict[tuple[str, bytes, float], np.ndarray] = {}
+        # Residuals (and the simulation, when there is one) by model, parameters and end.
+        self._memo: dict[tuple[str, bytes, float], tuple[np.ndarray, TipTrajectory | None]] = {}
         self._nominal = nominal
         self.sigma_z = sigma_z
         self.sigma_pitch = sigma_pitch
@@ -174,19 +182,60 @@ class FitProblem:
         Returns:
             The stacked residuals (:meth:`residuals`).
         """
-        key = (model.name, np.asarray(x, dtype=float).tobytes(), end_s)
+        key = self._key(model, x, end_s)
         if key in self._memo:  # e.g. a screening column at the strength a fit starts from
-            return self._memo[key].copy()
+            return self._memo[key][0].copy()
+        trajectory = None
         try:
             with np.errstate(all='ignore'):
-                residuals = self.residuals(self.simulate(model.beam(self.nominal, x), end_s, warm))
+                trajectory = self.simulate(model.beam(self.nominal, x), end_s, warm)
+            residuals = self.residuals(trajectory)
         except (SimulationDivergedError, RuntimeError):  # RuntimeError: no static equilibrium
             count = int(np.count_nonzero(self.record.t <= end_s))
             residuals = np.full(2 * count, DIVERGED_RESIDUAL)
+        self._remember(key, residuals, trajectory)
+        return residuals.copy()
+
+    def trajectory(self, model: Fittable, x: np.ndarray, end_s: float = math.inf) -> TipTrajectory:
+        """A model's simulation at ``x`` up to ``end_s``, remembered with its residuals.
+
+        One just simulated for residuals (the end of a fit) is not simulated again, and a
+        fit that starts at ``x`` (:meth:`fit`) finds the residuals.
+
+        Args:
+            model: The model.
+            x: Its parameters.
+            end_s: Last time, s.
+
+        Returns:
+            The tip trajectory.
+
+        Raises:
+            SimulationDivergedError: The modal solver cannot simulate the beam.
+            RuntimeError: The beam has no static equilibrium.
+        """
+        key = self._key(model, x, end_s)
+        remembered = self._memo.get(key, (None, None))[1]
+        if remembered is not None:
+            return remembered
+        with np.errstate(all='ignore'):
+            trajectory = self.simulate(model.beam(self.nominal, x), end_s)
+        self._remember(key, self.residuals(trajectory), trajectory)
+        return trajectory
+
+    @staticmethod
+    def _key(model: Fittable, x: np.ndarray, end_s: float) -> tuple[str, bytes, float]:
+        return model.name, np.asarray(x, dtype=float).tobytes(), end_s
+
+    def _remember(
+        self,
+        key: tuple[str, bytes, float],
+        residuals: np.ndarray,
+        trajectory: TipTrajectory | None,
+    ) -> None:
         if len(self._memo) >= MEMO_SIZE:
             self._memo.pop(next(iter(self._memo)))
-        self._memo[key] = residuals
-        return residuals.copy()
+        self._memo[key] = (residuals, trajectory)
 
     def residuals(self, trajectory: TipTrajectory, start_s: float = -math.inf) -> np.ndarray:
         """Noise-normalized residuals (model minus measurement), z then pitch.
@@ -221,6 +270,7 @@ class FitProblem:
         end_s: float = math.inf,
         max_evaluations: int = 60,
         alternatives: Sequence[np.ndarray] = (),
+        warm: WarmStart | None = None,
     ) -> Fit:
         """Fits a candidate by bounded least squares on the samples up to ``end_s``.
 
@@ -231,16 +281,21 @@ class FitProblem:
             max_evaluations: Budget of residual evaluations (each one simulation).
             alternatives: Other starting points (e.g. a linearized step's prediction):
                 the fit starts from whichever of them and ``x0`` has the lowest chi2.
+            warm: Where the first simulation's sweeps start (a copy is taken; e.g. the
+                fit of the model this one extends): same result, fewer sweeps.
 
         Returns:
             The fit.
         """
         lo, hi = candidate.bounds()
         start = self.simulations
-        warm = WarmStart()  # each evaluation starts from the previous one's solution
+        # Each evaluation starts from the previous one's solution.
+        warm = WarmStart() if warm is None else warm.copy()
 
         def fun(x: np.ndarray) -> np.ndarray:
             return self.model_residuals(candidate, x, end_s, warm)
+
+        jacobian = _FinalJacobian(fun, lo, hi)
 
         starts = [
             np.clip(np.asarray(x, dtype=float), lo + 1e-9, hi - 1e-9) for x in (x0, *alternatives)
@@ -253,11 +308,11 @@ class FitProblem:
             fun,
             x0,
             bounds=(lo, hi),
-            diff_step=DIFF_STEP,
+            jac=jacobian,
             x_scale=1.0,
             max_nfev=max_evaluations,
-            xtol=1e-4,
-            ftol=1e-4,
+            xtol=FIT_XTOL,
+            ftol=FIT_FTOL,
         )
         return Fit(
             candidate=candidate,
@@ -267,4 +322,84 @@ class FitProblem:
             n_residuals=int(result.fun.size),
             evaluations=self.simulations - start,
             physical=candidate.physical(result.x),
+            warm=warm,
         )
+
+
+#: Step of a finite difference at a parameter of 0, where a relative step is none (scipy's
+#: for forward differences: the square root of the machine epsilon).
+ZERO_STEP = float(np.sqrt(np.finfo(float).eps))
+
+
+def forward_jacobian(
+    fun: Callable[[np.ndarray], np.ndarray],
+    x: np.ndarray,
+    f0: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+) -> np.ndarray:
+    """Forward-difference Jacobian, with the steps of scipy's ``'2-point'`` scheme.
+
+    The step is ``DIFF_STEP`` relative (``ZERO_STEP`` at 0), towards larger magnitudes,
+    turned back when it would leave the bounds, shortened when neither direction fits.
+
+    Args:
+        fun: The residuals.
+        x: Where.
+        f0: ``fun(x)``.
+        lo: Lower bounds.
+        hi: Upper bounds.
+
+    Returns:
+        The Jacobian, (f0.size, x.size).
+    """
+    sign = np.where(x >= 0.0, 1.0, -1.0)
+    h = DIFF_STEP * sign * np.abs(x)
+    h = np.where((x + h) - x == 0.0, ZERO_STEP * sign * np.maximum(1.0, np.abs(x)), h)
+    below, above = x - lo, hi - x
+    outside = (x + h < lo) | (x + h > hi)
+    fits = np.abs(h) <= np.maximum(below, above)
+    h = np.where(outside & fits, -h, h)
+    h = np.where(~fits & (above >= below), above, h)
+    h = np.where(~fits & (above < below), -below, h)
+    columns = []
+    for i in range(x.size):
+        shifted = x.copy()
+        shifted[i] += h[i]
+        columns.append((fun(shifted) - f0) / (shifted[i] - x[i]))
+    return np.column_stack(columns)
+
+
+class _FinalJacobian:
+    """The fits' Jacobian, skipping the one least squares computes only to stop.
+
+    scipy's trust-region loop computes the Jacobian after every accepted step, even one
+    that meets the tolerances and ends the fit: ``n`` simulations for nothing. A step that
+    meets them (by the test scipy applies, given a good agreement with its model, which a
+    converging fit has) gets the previous Jacobian back instead. Should the loop go on after
+    all, it steps once with that Jacobian (a quasi-Newton step) and then with fresh ones.
+    """
+
+    def __init__(self, fun: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray):
+        self._fun = fun
+        self._lo, self._hi = lo, hi
+        self._x: np.ndarray | None = None
+        self._cost = math.inf
+        self._jacobian: np.ndarray | None = None
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        f0 = self._fun(x)  # just evaluated by the least squares: remembered, not simulated
+        cost = 0.5 * float(f0 @ f0)
+        if self._jacobian is not None and self._x is not None and self._stops(x, cost):
+            self._x, self._cost = x.copy(), cost
+            return self._jacobian
+        self._jacobian = forward_jacobian(self._fun, x, f0, self._lo, self._hi)
+        self._x, self._cost = x.copy(), cost
+        return self._jacobian
+
+    def _stops(self, x: np.ndarray, cost: float) -> bool:
+        assert self._x is not None
+        reduction = self._cost - cost
+        small = 0.0 < reduction < FIT_FTOL * self._cost
+        step = float(np.linalg.norm(x - self._x))
+        return small or step < FIT_XTOL * (FIT_XTOL + float(np.linalg.norm(self._x)))

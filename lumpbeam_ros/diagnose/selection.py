@@ -3,7 +3,9 @@
 A :class:`Model` is the nominal beam plus any number of effects, fitted jointly (k_tE, beta
 and one strength per effect). The selection grows it one effect per round:
 
-1. Round 1 fits every single effect of the library on the training part of the record.
+1. Round 1 fits every single effect of the library on the training part of the record,
+   each from the better of its own start and the linearized step of 2., or from a start
+   informed by the effect's signature.
 2. From round 2 on, the current model's residual is linearized: one Gauss-Newton step
    (the current model's Jacobian plus one column per remaining effect, at a small strength)
    predicts how much each effect would lower chi2, and only the most promising are fitted
@@ -260,7 +262,11 @@ class Selector:
         )
 
     def fit(
-        self, model: Model, x0: np.ndarray, alternatives: Sequence[np.ndarray] = ()
+        self,
+        model: Model,
+        x0: np.ndarray,
+        alternatives: Sequence[np.ndarray] = (),
+        base: Evaluated | None = None,
     ) -> Evaluated:
         """Fits a model on the training part and evaluates it.
 
@@ -268,14 +274,31 @@ class Selector:
             model: The model.
             x0: Its starting parameters.
             alternatives: Other starting points (:meth:`FitProblem.fit`).
+            base: The fitted model this one extends: its solver remainders start the
+                simulations' sweeps.
         """
+        warm = None if base is None else base.fit.warm
         return self.evaluate(
-            self.problem.fit(model, x0, self.train_end, alternatives=alternatives)
+            self.problem.fit(model, x0, self.train_end, alternatives=alternatives, warm=warm)
         )
 
     def predicted_bic(self, chi2: float, n_parameters: int) -> float:
         """The BIC a fit of ``chi2`` would score."""
         return information_criteria(chi2, self.n_train, n_parameters, self.phi)[0]
+
+    def _jacobian(self, model: Model, x: np.ndarray, r0: np.ndarray) -> np.ndarray:
+        """Forward-difference Jacobian of a model's training residuals ``r0`` at ``x``."""
+        lo, hi = model.bounds()
+        columns = []
+        for i in range(x.size):
+            step = DIFF_STEP * max(1.0, abs(float(x[i])))
+            step = step if x[i] + step <= hi[i] else -step
+            shifted = x.copy()
+            shifted[i] += step
+            columns.append(
+                (self.problem.model_residuals(model, shifted, self.train_end) - r0) / step
+            )
+        return np.column_stack(columns)
 
     def screen(
         self, base: Evaluated, candidates: Sequence[Candidate]
@@ -298,20 +321,16 @@ class Selector:
         model, x = base.model, base.fit.x
         end = self.train_end
         r0 = self.problem.model_residuals(model, x, end)
-        lo, hi = model.bounds()
-        columns = []
-        for i in range(x.size):
-            step = DIFF_STEP * max(1.0, abs(float(x[i])))
-            step = step if x[i] + step <= hi[i] else -step
-            shifted = x.copy()
-            shifted[i] += step
-            columns.append((self.problem.model_residuals(model, shifted, end) - r0) / step)
-        jacobian = np.column_stack(columns)
+        # Its own steps, not the fit's last Jacobian: those are relative to the parameters,
+        # and a strength near 0 would see no slope (the predictions set the fits' starts).
+        jacobian = self._jacobian(model, x, r0)
         out = {}
         for c in candidates:
             wider = model.plus(c)
             start = c.start / c.scale
-            column = (self.problem.model_residuals(wider, np.r_[x, start], end) - r0) / start
+            warm = None if base.fit.warm is None else base.fit.warm.copy()
+            residuals = self.problem.model_residuals(wider, np.r_[x, start], end, warm)
+            column = (residuals - r0) / start
             full = np.column_stack([jacobian, column])
             step, *_ = np.linalg.lstsq(full, -r0, rcond=None)
             strength = float(step[-1])
@@ -339,6 +358,7 @@ def select(
     max_effects: int = MAX_EFFECTS,
     start_strength: Callable[[Candidate], float | None] = lambda c: None,
     exhaustive: bool = False,
+    informed_start: Callable[[Evaluated, Candidate], np.ndarray | None] = lambda b, c: None,
 ) -> Selection:
     """Forward selection of effects (see the module docstring).
 
@@ -352,11 +372,16 @@ def select(
         exhaustive: The baseline ``lumpbeam bench`` measures against: every combination of
             up to ``max_effects`` effects fitted from scratch (from the nominal fit), and
             each round choosing among those fits instead of screening.
+        informed_start: Where a fit of a candidate added to a fitted model starts instead
+            of the generic starts (``None``: those), e.g. dry friction's from the decay
+            envelopes. The generic starts are compared by chi2; a start informed by the
+            effect's own signature is taken as it is, since one inside the right valley may
+            still score worse than one beside it.
 
     Returns:
         The selection.
     """
-    base, fitted = _first_round(selector, nominal, candidates, start_strength)
+    base, fitted = _first_round(selector, nominal, candidates, start_strength, informed_start)
     combinations = (
         _every_combination(selector, nominal, candidates, max_effects) if exhaustive else None
     )
@@ -387,7 +412,7 @@ def select(
             ]
             screened = {}
             continue
-        fitted, screened, stop = _screened_round(selector, base, remaining)
+        fitted, screened, stop = _screened_round(selector, base, remaining, informed_start)
         if stop is not None:
             rounds.append(stop)
             break
@@ -402,6 +427,7 @@ def _first_round(
     nominal: Fit,
     candidates: Sequence[Candidate],
     start_strength: Callable[[Candidate], float | None],
+    informed_start: Callable[[Evaluated, Candidate], np.ndarray | None],
 ) -> tuple[Evaluated, list[Evaluated]]:
     """Round 1: the nominal model and every single effect, fitted and scored.
 
@@ -419,21 +445,29 @@ def _first_round(
         nominal.n_residuals,
         nominal.evaluations,
         nominal.physical,
+        warm=nominal.warm,
     )
     base = selector.evaluate(base_fit)
     # The linearized step of each effect (as in later rounds) is a second starting point:
-    # a fit that starts where the data put it saves most of its iterations (dry friction's
-    # from 0.1 to 1 N m takes a dozen), and one the linearization misjudges starts from the
-    # candidate's own start as before, whichever fits better.
+    # a fit that starts where the data put it saves most of its iterations, and one the
+    # linearization misjudges starts from the candidate's own start as before, whichever
+    # fits better. (Not the nominal fit itself, the effect off on its bound: a fit that
+    # starts there stays there, its finite differences being relative to the strength.)
     predictions = selector.screen(base, candidates)
-    singles = [
-        selector.fit(
-            Model((c,)),
-            c.start_x(nominal.x, start_strength(c)),
-            [_plausible_x(c, predictions[c.name][2])],
+    singles = []
+    for c in candidates:
+        informed = informed_start(base, c)
+        if informed is not None:
+            singles.append(selector.fit(Model((c,)), _plausible_x(c, informed), base=base))
+            continue
+        singles.append(
+            selector.fit(
+                Model((c,)),
+                c.start_x(nominal.x, start_strength(c)),
+                [_plausible_x(c, predictions[c.name][2])],
+                base,
+            )
         )
-        for c in candidates
-    ]
     best_train = min([base, *singles], key=lambda e: e.fit.chi2)
     selector.phi = inflation(best_train.residuals[selector._both(selector.train)])
     return selector.rescore(base), [selector.rescore(e) for e in singles]
@@ -470,7 +504,10 @@ def _every_combination(
 
 
 def _screened_round(
-    selector: Selector, base: Evaluated, remaining: Sequence[Candidate]
+    selector: Selector,
+    base: Evaluated,
+    remaining: Sequence[Candidate],
+    informed_start: Callable[[Evaluated, Candidate], np.ndarray | None] = lambda b, c: None,
 ) -> tuple[list[Evaluated], dict[str, float], Round | None]:
     """A round after the first: screen every remaining effect, fit the promising ones.
 
@@ -494,8 +531,13 @@ def _screened_round(
     fitted = []
     for name in promising:
         c = next(c for c in remaining if c.name == name)
-        strength = _plausible(c, predictions[name][1]) or c.start / c.scale
-        fitted.append(selector.fit(base.model.plus(c), np.r_[base.fit.x, strength]))
+        informed = informed_start(base, c)
+        if informed is None:
+            strength = _plausible(c, predictions[name][1]) or c.start / c.scale
+            x0 = np.r_[base.fit.x, strength]
+        else:
+            x0 = _plausible_x(c, informed)
+        fitted.append(selector.fit(base.model.plus(c), x0, base=base))
     if fitted:
         return fitted, screened, None
     stop = RoundDecision(

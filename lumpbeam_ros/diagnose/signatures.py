@@ -105,6 +105,28 @@ def envelope_terms(t: np.ndarray, amplitude: np.ndarray) -> dict[str, float]:
     }
 
 
+def envelope_rates(t: np.ndarray, amplitude: np.ndarray) -> tuple[float, float]:
+    """The viscous and dry decay terms of the peaks: ``-dA/dt = a A + b`` by least squares.
+
+    The classic separation of the two losses: a viscous one takes a fixed share of the
+    amplitude per cycle (``a``, proportional to the damping), dry friction a fixed amount
+    (``b``, proportional to its torque, by harmonic balance).
+
+    Args:
+        t: Peak times, s (both signs of the swing).
+        amplitude: Peak amplitudes, m.
+
+    Returns:
+        ``(a, b)`` in 1/s and m/s (NaN with fewer than 8 peaks).
+    """
+    if t.size < 8:
+        return float('nan'), float('nan')
+    rate = -(amplitude[2:] - amplitude[:-2]) / (t[2:] - t[:-2])
+    amp = amplitude[1:-1]
+    coef, *_ = np.linalg.lstsq(np.column_stack([amp, np.ones_like(amp)]), rate, rcond=None)
+    return float(coef[0]), float(coef[1])
+
+
 def envelope_law(terms: dict[str, float]) -> str:
     """``'linear'``, ``'amplitude_dependent'`` or ``'exponential'`` from :func:`envelope_terms`."""
     dry = terms['dry_m_per_s'] > 0.0 and terms['dry_f'] > ENVELOPE_F

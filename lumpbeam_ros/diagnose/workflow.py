@@ -15,13 +15,15 @@
    record up to ``train_fraction`` of the time after the event, checked on the rest (held
    out) and scored (:mod:`~lumpbeam_ros.diagnose.scoring`); the best joins the model when
    the data insist on it, and a second effect is searched on top of it the same way (a
-   pair only on a decay of at least ``PAIR_MIN_DECAY_S``).
+   pair only on a decay of at least ``PAIR_MIN_DECAY_S``). Dry friction's fits start where
+   the decay envelopes put them (:func:`dry_friction_start`).
 5. The selected model, if any, refit on the whole record; the gap before (nominal) and
    after (augmented) measured on the whole record.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -50,9 +52,15 @@ from lumpbeam_ros.diagnose.selection import (
     Selector,
     select,
 )
-from lumpbeam_ros.diagnose.signatures import Signatures, signatures
+from lumpbeam_ros.diagnose.signatures import (
+    Signatures,
+    decay_peaks,
+    envelope_rates,
+    signatures,
+)
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.parameters import BeamParameters
+from lumpbeam_ros.model.simulate import SimulationDivergedError
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
 #: Share of the time after the load event that the candidates are fitted on.
@@ -234,6 +242,61 @@ def measurement_error(record: Record) -> tuple[float, float]:
     return sigmas[0], sigmas[1]
 
 
+def _envelope(t: np.ndarray, z: np.ndarray, event_s: float) -> tuple[float, float]:
+    """Viscous and dry decay terms of a record's free decay (NaN if unmeasurable)."""
+    try:
+        level = decay_fit(t, z, event_s).offset
+    except LumpbeamError:
+        return float('nan'), float('nan')
+    return envelope_rates(*decay_peaks(t, z, event_s, level))
+
+
+def dry_friction_start(
+    problem: FitProblem, base: Model, base_x: np.ndarray, candidate: Candidate, end_s: float
+) -> np.ndarray | None:
+    """Where a fit of dry friction added to a fitted model should start, from the envelopes.
+
+    A model without friction mimics a linear decay envelope with extra viscous damping, and
+    a fit from there crawls along the valley where the two trade off (a dozen iterations from
+    0.1 to 1 N m). The envelopes separate them
+    (:func:`~lumpbeam_ros.diagnose.signatures.envelope_rates`): the viscous term scales with
+    beta, the dry term with the torque. So beta is scaled by the measured viscous term over
+    the model's, and the torque is the candidate's starting torque scaled by the measured
+    dry term over the one that torque adds to the model (one probe simulation).
+
+    Args:
+        problem: The record and the nominal beam.
+        base: The fitted model that friction would join.
+        base_x: Its parameters.
+        candidate: The dry friction candidate.
+        end_s: Last fitted time, s.
+
+    Returns:
+        The start ``x`` of ``base.plus(candidate)``, or ``None`` when an envelope cannot be
+        measured or does not show the dry term.
+    """
+    record = problem.record
+    event = record.event_time_s
+    keep = record.t <= end_s
+    probe_x = np.r_[base_x, candidate.start / candidate.scale]
+    try:
+        base_run = problem.trajectory(base, base_x, end_s)
+        probe = problem.trajectory(base.plus(candidate), probe_x, end_s)
+    except (SimulationDivergedError, RuntimeError):
+        return None
+    a_data, b_data = _envelope(record.t[keep], record.z[keep], event)
+    a_base, b_base = _envelope(base_run.t, base_run.z, event)
+    _, b_probe = _envelope(probe.t, probe.z, event)
+    per_probe = b_probe - b_base
+    values = (a_data, b_data, a_base, b_base, b_probe)
+    if not all(np.isfinite(values)) or min(a_data, a_base, per_probe) <= 0.0:
+        return None
+    x: np.ndarray = np.array(probe_x, dtype=float)
+    x[1] += math.log(a_data / a_base)
+    x[-1] *= max(b_data - b_base, 0.0) / per_probe
+    return x
+
+
 def _static_seed(model: TipTrajectory, record: Record, problem: FitProblem) -> BeamParameters:
     """Scales k_tE so the model's static drop at the event matches the data (B.12)."""
     beam = problem.nominal
@@ -296,13 +359,18 @@ def _diagnose(
 
     nominal_model = nominal_candidate()
     nominal = problem.fit(nominal_model, np.zeros(2), train_end)
-    nominal_trajectory = problem.simulate(nominal.beam)
+    nominal_trajectory = problem.trajectory(nominal_model, nominal.x)
     sig = signatures(record, nominal_trajectory, measured_fit.offset)
 
     def start_strength(candidate: Candidate) -> float | None:
         if candidate.name == 'sensor_latency' and sig.time_shift_s > candidate.start:
             return sig.time_shift_s  # the delay seen at the load event
         return None
+
+    def informed_start(base: Evaluated, candidate: Candidate) -> np.ndarray | None:
+        if candidate.name != 'coulomb_friction':
+            return None
+        return dry_friction_start(problem, base.model, base.fit.x, candidate, train_end)
 
     max_effects, limit = _effects_allowed(record)
     selector = Selector(problem, train, train_end)
@@ -313,6 +381,7 @@ def _diagnose(
         max_effects,
         start_strength,
         exhaustive,
+        informed_start,
     )
     decision = _decision(selection, limit)
 
@@ -375,13 +444,13 @@ def _final_models(
         nominal ones when nothing is named), and the effects named.
     """
     final_nominal = problem.fit(nominal_candidate(), nominal_x)
-    before = problem.simulate(final_nominal.beam)
+    before = problem.trajectory(nominal_candidate(), final_nominal.x)
     if decision.missing_effect in (NONE, UNEXPLAINED):
         return final_nominal.beam, before, final_nominal.beam, before, ()
     chosen = selection.model
     final = problem.fit(chosen.model, chosen.fit.x)
     named = _named(chosen.model, final.x, selection.path, problem.sigma_z, train)
-    return final_nominal.beam, before, final.beam, problem.simulate(final.beam), named
+    return final_nominal.beam, before, final.beam, problem.trajectory(chosen.model, final.x), named
 
 
 def _decay_length(record: Record) -> float:

@@ -30,7 +30,8 @@ from lumpbeam_ros.model.chain import LumpedChain, trig
 from lumpbeam_ros.model.modes import LinearModel
 
 #: Dry friction is stepped at first order (see ``_propagate_with_friction``): its grid is
-#: this many times finer than the smooth dynamics need.
+#: this many times finer than the smooth dynamics need (the remainder ``r`` stays on the
+#: coarse grid).
 FRICTION_REFINEMENT = 4
 
 #: Longest chain solved with single-threaded BLAS (see :meth:`ModalSolver.solve`).
@@ -158,21 +159,41 @@ class ModalSolver:
         Returns:
             Modal coordinates at the grid points, (T, 2n).
         """
-        e, h_phi1, h_phi2 = self._coefficients(h)
         u = forcing @ self._b.T
-        drive = np.empty_like(u)
-        drive[0] = z0
-        drive[1:] = (h_phi1 - h_phi2) * u[:-1] + h_phi2 * u[1:]
         if self.chain.coulomb_torque > 0.0:
-            return self._propagate_with_friction(drive, e, h_phi1)
-        return _free_response(drive, e)
+            return self._propagate_with_friction(z0, u, h)
+        e, h_phi1, h_phi2 = self._coefficients(h)
+        return _free_response(_hold_drive(z0, u, h_phi1, h_phi2), e)
 
-    def _propagate_with_friction(
-        self, drive: np.ndarray, e: np.ndarray, h_phi1: np.ndarray
-    ) -> np.ndarray:
-        """Steps the modal recurrence with dry friction at joint 1 (:func:`friction_steps`)."""
+    def _propagate_with_friction(self, z0: np.ndarray, u: np.ndarray, h: float) -> np.ndarray:
+        """Steps the modal recurrence with dry friction at joint 1 (:func:`friction_steps`).
+
+        On a grid ``FRICTION_REFINEMENT`` times finer than ``h``, the modal forcing ``u``
+        interpolated linearly between the coarse points: that is the first-order hold the
+        coarse grid assumes, so the finer grid only serves the friction's decisions, and the
+        remainder (most of a sweep's work) is evaluated on the coarse grid alone.
+
+        Args:
+            z0: Initial modal coordinates.
+            u: Modal forcing at the coarse grid points, (T, m).
+            h: Coarse grid spacing, s.
+
+        Returns:
+            Modal coordinates at the coarse grid points, (T, m).
+        """
+        fine = FRICTION_REFINEMENT
+        e, h_phi1, h_phi2 = self._coefficients(h / fine)
+        # Fine step j of coarse step k holds u_k + (j + s) / fine (u_{k+1} - u_k), s in [0, 1].
+        j = np.arange(fine)[:, None]
+        on_change = ((h_phi1 - h_phi2) * j + h_phi2 * (j + 1)) / fine  # (fine, m)
+        change = u[1:] - u[:-1]
+        steps = h_phi1 * u[:-1, None, :] + on_change * change[:, None, :]  # (T - 1, fine, m)
+        drive = np.empty(((u.shape[0] - 1) * fine + 1, u.shape[1]), dtype=complex)
+        drive[0] = z0
+        drive[1:] = steps.reshape(-1, u.shape[1])
         gamma = h_phi1 * self._b[:, 0]
-        return friction_steps(drive, e, gamma, self._v[0], self.chain.coulomb_torque)
+        z = friction_steps(drive, e, gamma, self._v[0], self.chain.coulomb_torque)
+        return z[::fine]
 
     def solve(
         self,
@@ -198,7 +219,7 @@ class ModalSolver:
             state: Initial angles and velocities.
             duration: Time span, s.
             step: Largest grid spacing, s (the grid is uniform, ending exactly at duration;
-                ``FRICTION_REFINEMENT`` times finer with dry friction).
+                dry friction is decided on one ``FRICTION_REFINEMENT`` times finer).
             tol: Convergence threshold on the change of the angles between sweeps, rad.
             max_sweeps: Sweeps before giving up.
             remainder: A starting remainder on the same grid (ignored if its shape differs).
@@ -223,8 +244,6 @@ class ModalSolver:
         max_sweeps: int,
         remainder: np.ndarray | None,
     ) -> ChainSolution | None:
-        if self.chain.coulomb_torque > 0.0:
-            step /= FRICTION_REFINEMENT
         steps = max(1, int(np.ceil(duration / step - 1e-9)))
         h = duration / steps
         t = np.linspace(0.0, duration, steps + 1)
@@ -331,6 +350,16 @@ class _OverBudgetError(Exception):
     """Raised from inside ``solve_ivp`` when the evaluations run out; carries the time."""
 
 
+def _hold_drive(
+    z0: np.ndarray, u: np.ndarray, h_phi1: np.ndarray, h_phi2: np.ndarray
+) -> np.ndarray:
+    """The first-order-hold increments of a modal forcing ``u``, with ``z0`` in row 0."""
+    drive = np.empty_like(u)
+    drive[0] = z0
+    drive[1:] = (h_phi1 - h_phi2) * u[:-1] + h_phi2 * u[1:]
+    return drive
+
+
 def _free_response(drive: np.ndarray, e: np.ndarray) -> np.ndarray:
     """``z_k = e z_{k-1} + drive_k`` per mode (``z_0 = drive_0``), by ``lfilter``."""
     z: np.ndarray = np.empty_like(drive)
@@ -382,18 +411,23 @@ def friction_steps_loop(
 
 _TABLES: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
 
+#: Rows of the stretch tables built first (:func:`_stretch_tables`): longer than most
+#: stretches of a swing on the friction grid; a longer one extends them.
+STRETCH_TABLE_ROWS = 512
+
 
 def _stretch_tables(
     e: np.ndarray, gamma: np.ndarray, angle_row: np.ndarray, count: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``e^m``, ``sum_{i<m} e^i`` and their joint-1 angles for ``m < count`` (cached).
+    """``e^m``, ``sum_{i<m} e^i`` and their joint-1 angles for ``m < count`` at least (cached).
 
     A fit simulates the same grid for the same chain in every sweep, so the tables are kept
-    for the last few recurrences (keyed by their exact bytes).
+    for the last few recurrences (keyed by their exact bytes). They are built only as long
+    as asked: a stretch lasts about half a swing, far less than the grid.
     """
-    key = e.tobytes() + gamma.tobytes() + angle_row.tobytes() + count.to_bytes(8, 'little')
+    key = e.tobytes() + gamma.tobytes() + angle_row.tobytes()
     tables = _TABLES.get(key)
-    if tables is None:
+    if tables is None or tables[0].shape[0] < count:
         powers = np.exp(np.log(e)[None, :] * np.arange(count)[:, None])
         sums = np.cumsum(np.vstack([np.zeros_like(e), powers[:-1]]), axis=0)
         tables = (powers, sums, powers * angle_row, (sums @ (angle_row * gamma)).real)
@@ -431,40 +465,52 @@ def friction_steps(
     compliance = float((angle_row @ gamma).real)
     free_response = _free_response(drive, e)
     free_angle = (free_response @ angle_row).real
-    powers, sums, angle_powers, angle_sums = _stretch_tables(e, gamma, angle_row, count)
+    tables = _stretch_tables(e, gamma, angle_row, min(count, STRETCH_TABLE_ROWS))
+    # A step decided alone: joint 1's angles by scalar arithmetic (Re(row . gamma f) is
+    # compliance * f), the state by three vector operations: the Python loop runs over every
+    # sticking step, so its cost per step is most of the solver's with friction.
+    drive_angle = (drive @ angle_row).real.tolist()
+    row_e = angle_row * e
     z = np.empty_like(drive)
     z[0] = current = drive[0]
     angle = float((angle_row @ current).real)
     k, window = 0, 32
     while k < count - 1:
-        free = e * current + drive[k + 1]
-        rotation = float((angle_row @ free).real) - angle
-        f = _friction_torque(rotation, compliance, torque)
-        current = free + gamma * f
         k += 1
+        loose = float((row_e @ current).real) + drive_angle[k]  # joint 1 if frictionless
+        rotation = loose - angle
+        f = -rotation / compliance
+        if abs(f) > torque:
+            f = -torque if rotation > 0.0 else torque
+        current = e * current + drive[k] + gamma * f
         z[k] = current
-        angle = float((angle_row @ current).real)
-        if abs(f) < torque:
-            continue  # sticking: the next step is decided alone too
+        angle = loose + compliance * f
+        if abs(f) < torque or k == count - 1:
+            continue  # sticking (the next step is decided alone too), or the grid's end
         delta = current - free_response[k]
         while True:
             end = min(count - 1, k + window)
-            m = np.arange(1, end - k + 1)
-            angles = (angle_powers[m] @ delta).real + free_angle[k + 1 : end + 1]
-            angles += f * angle_sums[m]
-            rotations = angles - np.concatenate([[angle], angles[:-1]]) - compliance * f
-            slides = (np.abs(rotations / compliance) > torque) & (
-                -torque * np.sign(rotations) == f
-            )
-            bad = np.flatnonzero(~slides)
+            if end - k >= tables[0].shape[0]:
+                tables = _stretch_tables(e, gamma, angle_row, min(count, 2 * (end - k) + 1))
+            powers, sums, angle_powers, angle_sums = tables
+            length = end - k  # steps m = 1 .. length ahead
+            angles = (angle_powers[1 : length + 1] @ delta).real + free_angle[k + 1 : end + 1]
+            angles += f * angle_sums[1 : length + 1]
+            rotations = angles - compliance * f
+            rotations[1:] -= angles[:-1]
+            rotations[0] -= angle
+            # Sliding on: a rotation beyond what the torque can hold, against the torque,
+            # -f * rotation > torque * torque * compliance (|f| = torque, compliance > 0).
+            bad = np.flatnonzero(-f * rotations <= torque * torque * compliance)
             if bad.size or end == count - 1:
                 break
             window *= 2
-        steps = int(bad[0]) if bad.size else m.size
+        steps = int(bad[0]) if bad.size else length
         if steps:
-            m = m[:steps]
             z[k + 1 : k + 1 + steps] = (
-                powers[m] * delta + free_response[k + 1 : k + 1 + steps] + f * gamma * sums[m]
+                powers[1 : steps + 1] * delta
+                + free_response[k + 1 : k + 1 + steps]
+                + f * gamma * sums[1 : steps + 1]
             )
             window = max(32, 2 * steps)
             k += steps

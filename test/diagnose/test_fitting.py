@@ -5,7 +5,12 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.diagnose.candidates import effect_candidates, nominal_candidate
-from lumpbeam_ros.diagnose.fitting import DIVERGED_RESIDUAL, FitProblem
+from lumpbeam_ros.diagnose.fitting import (
+    DIFF_STEP,
+    DIVERGED_RESIDUAL,
+    FitProblem,
+    forward_jacobian,
+)
 from lumpbeam_ros.diagnose.measurement import make_record
 from lumpbeam_ros.diagnose.selection import Model
 from lumpbeam_ros.diagnose.workflow import nominal_form
@@ -191,3 +196,62 @@ def test_a_new_nominal_beam_forgets_the_remembered_residuals():
     second = problem.model_residuals(nominal_candidate(), np.zeros(2))
     assert problem.simulations == 2
     assert np.max(np.abs(second)) < 1e-3 < np.max(np.abs(first))
+
+
+# -- finite differences and the final Jacobian ------------------------------------------------
+
+
+def _curve(x):
+    t = np.linspace(0.0, 1.0, 40)
+    return x[0] * np.exp(-x[1] * t) + x[2] * t**2 - np.cos(3.0 * t)
+
+
+@pytest.mark.parametrize(
+    ('x', 'lo', 'hi'),
+    [
+        ([0.3, -1.2, 0.0], [-1.0, -2.0, -1.0], [1.0, 2.0, 1.0]),  # negative, zero, inside
+        ([0.999, -1.9999, 2e-3], [-1.0, -2.0, 0.0], [1.0, 2.0, 1.0]),  # turned at a bound
+        ([0.5, 1.0, 1e-9], [0.5 - 1e-7, 0.0, 0.0], [0.5 + 1e-7, 2.0, 1e-9]),  # pinched
+    ],
+)
+def test_forward_differences_take_scipys_two_point_steps(x, lo, hi):
+    from scipy.optimize._numdiff import approx_derivative
+
+    x, lo, hi = (np.asarray(v, dtype=float) for v in (x, lo, hi))
+    ours = forward_jacobian(_curve, x, _curve(x), lo, hi)
+    scipys = approx_derivative(
+        _curve, x, method='2-point', rel_step=DIFF_STEP, f0=_curve(x), bounds=(lo, hi)
+    )
+    np.testing.assert_array_equal(ours, scipys)
+
+
+def test_the_fit_skips_the_jacobian_that_only_ends_it_and_lands_where_scipy_does():
+    from scipy.optimize import least_squares
+
+    problem = _problem(_record(_beam(1.03, 1.4)))
+    ours = problem.fit(nominal_candidate(), np.zeros(2))
+    evaluations = []
+
+    def fun(x):
+        evaluations.append(x)
+        return problem.model_residuals(nominal_candidate(), x)
+
+    lo, hi = nominal_candidate().bounds()
+    scipys = least_squares(
+        fun, np.zeros(2), bounds=(lo, hi), diff_step=DIFF_STEP, xtol=1e-4, ftol=1e-4
+    )
+    # The same iterates (to the solver's tolerance: ours start their sweeps warm), the
+    # skipped Jacobian coming after the last: fewer simulations.
+    np.testing.assert_allclose(ours.x, scipys.x, rtol=1e-8)
+    assert ours.evaluations <= len(evaluations) - 2
+
+
+def test_a_remembered_simulation_is_not_run_again():
+    problem = _problem(_record(NOMINAL))
+    model, x = nominal_candidate(), np.array([0.01, 0.1])
+    residuals = problem.model_residuals(model, x, 2.0)
+    trajectory = problem.trajectory(model, x, 2.0)
+    assert problem.simulations == 1
+    np.testing.assert_array_equal(problem.residuals(trajectory), residuals)
+    assert problem.trajectory(model, x) is problem.trajectory(model, x)
+    assert problem.simulations == 2

@@ -2,7 +2,13 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.diagnose.measurement import make_record
-from lumpbeam_ros.diagnose.signatures import decay_peaks, envelope_law, envelope_terms, time_shift
+from lumpbeam_ros.diagnose.signatures import (
+    decay_peaks,
+    envelope_law,
+    envelope_rates,
+    envelope_terms,
+    time_shift,
+)
 from lumpbeam_ros.model.trajectory import TipTrajectory
 
 T = np.arange(0.0, 12.0, 1.0 / 180.0)
@@ -45,3 +51,17 @@ def test_time_shift_finds_a_late_measurement(delay):
     model = TipTrajectory(T, T * 0, z_of(T), T * 0, T * 0)
     record = make_record(T, z_of(T - delay), T * 0, 4.5, [(2.0, 0.0)])
     assert time_shift(record, model) == pytest.approx(delay, abs=6e-4)
+
+
+@pytest.mark.parametrize(('viscous', 'dry'), [(0.05, 2e-4), (0.12, 0.0), (0.0, 1.5e-3)])
+def test_envelope_rates_separate_the_viscous_and_the_dry_loss(viscous, dry):
+    # Peaks half a 3 Hz period apart on dA/dt = -a A - b, solved exactly.
+    t = np.arange(0.0, 8.0, 1.0 / 6.0)
+    if viscous > 0.0:
+        amplitude = (0.02 + dry / viscous) * np.exp(-viscous * t) - dry / viscous
+    else:
+        amplitude = 0.02 - dry * t
+    a, b = envelope_rates(t, amplitude)
+    assert a == pytest.approx(viscous, abs=2e-4)
+    assert b == pytest.approx(dry, abs=2e-6)
+    assert all(np.isnan(envelope_rates(t[:7], amplitude[:7])))

@@ -10,10 +10,17 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from lumpbeam_ros.diagnose.candidates import SEARCHED_EFFECTS
+from lumpbeam_ros.diagnose.candidates import (
+    SEARCHED_EFFECTS,
+    effect_candidates,
+    nominal_candidate,
+)
+from lumpbeam_ros.diagnose.fitting import FitProblem
 from lumpbeam_ros.diagnose.measurement import record_from_trajectory
-from lumpbeam_ros.diagnose.workflow import diagnose
+from lumpbeam_ros.diagnose.selection import Model
+from lumpbeam_ros.diagnose.workflow import diagnose, dry_friction_start, nominal_form
 from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, load_beam_config
+from lumpbeam_ros.model.simulate import simulate_loads
 from lumpbeam_ros.model.trajectory import TipTrajectory
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, simulate_experiment
 
@@ -167,3 +174,25 @@ def test_json_form_has_the_spec_keys(diagnoses):
         assert set(d[gap]) == {'rms_m', 'max_m', 'frequency_error', 'damping_error'}
     assert all(set(c) == {'name', 'parameters', 'score'} for c in d['candidates'])
     assert d['candidates'][0]['parameters']['mass_kg'] == pytest.approx(0.3, rel=0.25)
+
+
+@pytest.mark.parametrize('torque', [0.0, 0.5])
+def test_dry_friction_starts_where_the_envelopes_put_it(torque):
+    # A noise-free drop with dry friction (or none): the nominal fit mimics it with extra
+    # damping; the envelopes give back the torque and the configured damping.
+    beam, drop = load_beam_config()
+    nominal = nominal_form(beam)
+    hidden = replace(nominal, effects=nominal.effects.with_effect('coulomb_friction', torque))
+    t = np.arange(0.0, 6.0, 1.0 / 180.0)
+    events = [(1.0, 0.0)]
+    trajectory = simulate_loads(hidden, t, events, drop.load_kg)
+    record = record_from_trajectory(trajectory, events, drop.load_kg)
+    problem = FitProblem(record, nominal, 20e-6, 1e-5)
+    fit = problem.fit(nominal_candidate(), np.zeros(2))
+    friction = next(c for c in effect_candidates(nominal) if c.name == 'coulomb_friction')
+    x = dry_friction_start(problem, Model(), fit.x, friction, np.inf)
+    assert x is not None
+    assert friction.value(x) == pytest.approx(torque, abs=0.05 * max(torque, 0.2))
+    assert abs(x[1]) < 0.05  # beta back at the configured one
+    if torque:
+        assert fit.x[1] > 0.1  # which the nominal fit had raised

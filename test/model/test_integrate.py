@@ -152,6 +152,20 @@ def test_sliding_stretches_in_one_go_match_the_step_by_step_friction(torque):
     np.testing.assert_allclose(fast, loop, rtol=0, atol=1e-12 * np.max(np.abs(loop)))
 
 
+@pytest.mark.parametrize('count', [2, 3, 40])
+def test_a_grid_ending_on_a_sliding_step_matches_the_step_by_step_friction(count):
+    beam = replace(BeamParameters(), effects=Effects().with_effect('coulomb_friction', 0.3))
+    chain, state = _released(beam)
+    solver = ModalSolver(chain)
+    e, gamma, angle_row = solver.friction_recurrence(1 / 720)
+    moving = ChainState(state.phi, np.full(beam.n_segments, 0.5))  # sliding from the start
+    drive = np.zeros((count, e.size), dtype=complex)
+    drive[0] = solver.modal_state(moving)
+    loop = friction_steps_loop(drive, e, gamma, angle_row, 0.3)
+    fast = friction_steps(drive, e, gamma, angle_row, 0.3)
+    np.testing.assert_allclose(fast, loop, rtol=0, atol=1e-12 * np.max(np.abs(loop)))
+
+
 #: An unstable beam (a strongly softening spring, k3 = -1e10 N m/rad^3, outside the
 #: parameter ranges): the modal solver gives up and Radau's steps shrink without end.
 RUNAWAY = """
