@@ -183,7 +183,9 @@ def publish(frames_path: str, rate_hz: float) -> int:
         infos.publish(bytes(info_message))
         images.publish(bytes(message))
     elapsed = time.perf_counter() - start
-    print(json.dumps({'published': count, 'duration_s': elapsed}), flush=True)
+    last_stamp_ns = sec * 1_000_000_000 + nanosec if count else 0
+    summary = {'published': count, 'duration_s': elapsed, 'last_stamp_ns': last_stamp_ns}
+    print(json.dumps(summary), flush=True)
     node.destroy_node()
     rclpy.shutdown()
     return 0
@@ -222,7 +224,9 @@ class ParamsAges:
 
     The identifier publishes on a timer, so while no pose comes in (the stream has ended, the
     camera stalled) it repeats the same window, and that message's age grows with the pause,
-    not with the chain's latency: such messages are counted, not timed.
+    not with the chain's latency: such messages are counted, not timed. So is the first
+    message whose window ends with the stream's last frame: it waits for the timer's next
+    tick (up to a period) with no newer frame to bring, its age is the timer's phase.
 
     Attributes:
         latencies_ms: Per timed message, its publication stamp minus the stamp of the newest
@@ -234,6 +238,19 @@ class ParamsAges:
         self.latencies_ms: list[float] = []
         self.repeated = 0
         self._newest_s = -math.inf
+        self._window_ends_s: list[float] = []
+
+    def end_of_stream(self, last_frame_s: float) -> None:
+        """Counts the messages whose newest frame is the stream's last as repeated, not timed.
+
+        Args:
+            last_frame_s: The stamp of the last frame published, s.
+        """
+        # Stamps travel as nanoseconds: a microsecond covers the float round trip.
+        keep = [end < last_frame_s - 1e-6 for end in self._window_ends_s]
+        self.repeated += keep.count(False)
+        self.latencies_ms = [v for v, k in zip(self.latencies_ms, keep, strict=True) if k]
+        self._window_ends_s = [e for e, k in zip(self._window_ends_s, keep, strict=True) if k]
 
     def add(self, published_ns: int, window_end_s: float) -> None:
         """Takes one message.
@@ -249,6 +266,7 @@ class ParamsAges:
             self.repeated += 1
             return
         self._newest_s = window_end_s
+        self._window_ends_s.append(window_end_s)
         self.latencies_ms.append(published_ns * 1e-6 - window_end_s * 1e3)
 
 
@@ -359,6 +377,7 @@ def measure(
         rclpy.shutdown(context=context)
         claim.release()
         folder.cleanup()
+    params.end_of_stream(int(result['last_stamp_ns']) * 1e-9)  # the sink has stopped
     return StreamFigures(
         int(result['published']),
         len(latencies),

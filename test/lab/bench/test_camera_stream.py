@@ -43,3 +43,12 @@ def test_the_stream_is_the_drop_test_from_before_the_release():
     still = round(BEFORE_RELEASE_S * 180.0)
     assert np.array_equal(frames[0], frames[still - 1])
     assert not np.array_equal(frames[still - 1], frames[still + 20])
+
+
+def test_the_message_that_brings_the_streams_last_frame_is_counted_not_timed():
+    # Frames end at 3.000 s; the 10 Hz timer's next tick publishes that window 80 ms later:
+    # the age of a window nothing newer could follow, not the chain's latency.
+    ages = _ages([(2.910, 2.900), (3.080, 3.000), (3.180, 3.000)])
+    ages.end_of_stream(3.000)
+    assert ages.latencies_ms == pytest.approx([10.0])
+    assert ages.repeated == 2
