@@ -141,6 +141,10 @@ class CameraNode(SchemaNode):
             # Raw: the bytes go to the same decoder as a bag's, without rclpy's copy.
             subscription(self, Image, IMAGE, self.on_image, raw=True)
             subscription(self, CameraInfoMsg, CAMERA_INFO, self.on_camera_info, raw=True)
+            # Said now, not at the first frame: a node's first log line costs tens of
+            # milliseconds, which the stream's first frames would wait for.
+            source = 'the configured intrinsics' if known is not None else CAMERA_INFO
+            self.get_logger().info(f'tracking {IMAGE} with {source}')
         period = float(self._param('diagnostics_period_s'))
         # Steady: the period's counts are timed with time.monotonic, and a live node spins on
         # the events executor, whose timers do not follow a simulated clock.
