@@ -13,6 +13,9 @@ details make the stop quiet and prompt:
 - SIGINT is handled even when the process started with it ignored (a background job of a
   shell script, where Ctrl-C reaches the whole job): otherwise a signal that arrives during
   the imports, before a node installs its own handler, is lost and the node runs on;
+- an interrupt raised inside a constructor leaves a half-built object whose ``__del__``
+  then fails on an attribute never set (rclpy's ``Task``); after an interrupt, those
+  ``AttributeError`` reports are dropped (:func:`quiet_half_built`), the rest still print;
 - once the work is done, the objects alive are frozen out of the garbage collector
   (:func:`gc.freeze`). The interpreter's shutdown collections otherwise walk the hundreds of
   thousands of objects of scipy and rclpy, about half a second on a loaded machine; they
@@ -23,6 +26,7 @@ from __future__ import annotations
 
 import gc
 import signal
+import sys
 import threading
 from collections.abc import Callable
 from types import FrameType
@@ -53,7 +57,26 @@ def raise_interrupt(signum: int, _frame: FrameType | None) -> None:
     Raises:
         SignalInterrupt: Always.
     """
+    if sys.unraisablehook is not quiet_half_built:
+        global _reported_hook
+        _reported_hook = sys.unraisablehook
+        sys.unraisablehook = quiet_half_built
     raise SignalInterrupt(signum)
+
+
+_reported_hook = sys.unraisablehook
+
+
+def quiet_half_built(unraisable: Any) -> None:
+    """The unraisable-exception hook after an interrupt (see the module docstring).
+
+    Args:
+        unraisable: What :data:`sys.unraisablehook` is given.
+    """
+    destructor = getattr(unraisable.object, '__name__', '') == '__del__'
+    if destructor and issubclass(unraisable.exc_type, AttributeError):
+        return
+    _reported_hook(unraisable)
 
 
 def signal_number(exc: KeyboardInterrupt) -> int:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import signal
 import subprocess
 import sys
@@ -83,3 +84,25 @@ def test_run_script_returns_the_code_and_freezes_the_heap(when):
     assert process.returncode == (100 + signal.SIGTERM if when == 'signal' else 7)
     frozen, default_handler = process.stdout.split()
     assert int(frozen) > 1000 and default_handler == 'True'
+
+
+class _HalfBuilt:
+    def __init__(self, interrupt: bool) -> None:
+        if interrupt:
+            raise_interrupt(signal.SIGTERM, None)
+        raise RuntimeError('not built')
+
+    def __del__(self) -> None:
+        self.never_set.clear()
+
+
+@pytest.mark.parametrize('interrupted', [True, False], ids=['after an interrupt', 'otherwise'])
+def test_a_half_built_objects_destructor_is_quiet_only_after_an_interrupt(
+    monkeypatch, interrupted
+):
+    reported = []
+    monkeypatch.setattr(sys, 'unraisablehook', reported.append)
+    with pytest.raises((SignalInterrupt, RuntimeError)):
+        _HalfBuilt(interrupted)
+    gc.collect()
+    assert [r.exc_type for r in reported] == ([] if interrupted else [AttributeError])
