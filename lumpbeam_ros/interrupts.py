@@ -15,7 +15,9 @@ details make the stop quiet and prompt:
   the imports, before a node installs its own handler, is lost and the node runs on;
 - an interrupt raised inside a constructor leaves a half-built object whose ``__del__``
   then fails on an attribute never set (rclpy's ``Task``); after an interrupt, those
-  ``AttributeError`` reports are dropped (:func:`quiet_half_built`), the rest still print;
+  ``AttributeError`` reports are dropped (:func:`quiet_half_built`), the rest still print,
+  and an interrupt raised while rclpy's C++ converts a call's arguments comes out as a
+  ``RuntimeError``, which a node after a signal takes as the stop (:func:`interrupted`);
 - once the work is done, the objects alive are frozen out of the garbage collector
   (:func:`gc.freeze`). The interpreter's shutdown collections otherwise walk the hundreds of
   thousands of objects of scipy and rclpy, about half a second on a loaded machine; they
@@ -57,6 +59,7 @@ def raise_interrupt(signum: int, _frame: FrameType | None) -> None:
     Raises:
         SignalInterrupt: Always.
     """
+    _received.append(signum)
     if sys.unraisablehook is not quiet_half_built:
         global _reported_hook
         _reported_hook = sys.unraisablehook
@@ -65,6 +68,13 @@ def raise_interrupt(signum: int, _frame: FrameType | None) -> None:
 
 
 _reported_hook = sys.unraisablehook
+#: The signals :func:`raise_interrupt` has handled in this process.
+_received: list[int] = []
+
+
+def interrupted() -> bool:
+    """Whether :func:`raise_interrupt` has handled a signal in this process."""
+    return bool(_received)
 
 
 def quiet_half_built(unraisable: Any) -> None:

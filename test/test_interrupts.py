@@ -9,6 +9,7 @@ import sys
 
 import pytest
 
+from lumpbeam_ros import interrupts
 from lumpbeam_ros.interrupts import SignalInterrupt, raise_interrupt, signal_number
 
 #: ``lumpbeam doctor`` whose work is generated code that receives the signal: what a
@@ -43,6 +44,13 @@ def test_an_interrupt_in_generated_code_keeps_the_commands_exit_code(tmp_path, s
     )
     assert process.returncode == 128 + sig, process.stderr
     assert process.stderr.strip() == 'lumpbeam doctor: interrupted'
+
+
+@pytest.fixture(autouse=True)
+def _process_state(monkeypatch):
+    # raise_interrupt records the signal and swaps the unraisable hook for the process.
+    monkeypatch.setattr(interrupts, '_received', [])
+    monkeypatch.setattr(sys, 'unraisablehook', sys.unraisablehook)
 
 
 def test_the_interrupt_names_its_signal():

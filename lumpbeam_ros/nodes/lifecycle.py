@@ -40,7 +40,7 @@ from rclpy.validate_namespace import validate_namespace
 from rclpy.validate_topic_name import validate_topic_name
 
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.interrupts import interrupt_on_signals, restore_handlers
+from lumpbeam_ros.interrupts import interrupt_on_signals, interrupted, restore_handlers
 from lumpbeam_ros.nodes.counts import write_counts
 
 #: Exit code of a node whose configuration is invalid.
@@ -90,6 +90,11 @@ def run_node(
         # rclpy's SIGINT/SIGTERM handler shuts the context down under a running callback,
         # whose next publish then fails: that is the stop, not a fault.
         if rclpy.ok():
+            raise
+    except RuntimeError:
+        # An interrupt raised inside rclpy's C++ (pybind11 converting a call's arguments)
+        # comes out as a RuntimeError: after a signal, that is the stop too.
+        if not interrupted():
             raise
     finally:
         if node is not None:

@@ -16,6 +16,7 @@ from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from std_msgs.msg import Float64
 
+from lumpbeam_ros import interrupts
 from lumpbeam_ros.errors import ConfigError, LumpbeamError
 from lumpbeam_ros.interface import (
     BEAM_PARAMS,
@@ -107,6 +108,31 @@ def test_a_shutdown_that_cuts_into_a_publish_is_a_quiet_stop(counts_dir, capsys)
     assert run_node('counting_node', _Publishing, lambda n: {'/x': n.sent}, [], run=run) == 0
     assert capsys.readouterr().err == ''
     assert read_counts(counts_dir)['counting_node']['published'] == {'/x': 1}
+
+
+@pytest.mark.parametrize('signalled', [True, False], ids=['after a signal', 'without one'])
+def test_a_runtime_error_is_the_stop_only_after_a_signal(counts_dir, monkeypatch, signalled):
+    # What pybind11 makes of an interrupt raised while it converts a call's arguments
+    # (seen when SIGTERM reached an identifier taking a message on a loaded machine).
+    monkeypatch.setattr(interrupts, '_received', [])
+    monkeypatch.setattr(sys, 'unraisablehook', sys.unraisablehook)
+
+    def run(node: _Publishing) -> None:
+        if signalled:
+            try:
+                interrupts.raise_interrupt(signal.SIGTERM, None)
+            except interrupts.SignalInterrupt:
+                pass
+        raise RuntimeError("Unable to convert call argument '0' to Python object")
+
+    def stop() -> int:
+        return run_node('counting_node', _Publishing, lambda n: {'/x': n.sent}, [], run=run)
+
+    if signalled:
+        assert stop() == 0
+    else:
+        with pytest.raises(RuntimeError, match='Unable to convert'):
+            stop()
 
 
 def test_a_middleware_error_while_running_is_not_hidden(counts_dir):
