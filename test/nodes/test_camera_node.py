@@ -223,7 +223,16 @@ def test_main_reads_a_bag_with_a_params_file_and_rejects_a_missing_bag(
     _write_bag(tmp_path / 'bag', frames[:6], info_bytes)
     env = ros_env(ros_graph.domain_id)
     base = [sys.executable, '-m', 'lumpbeam_ros.nodes.camera_node', '--ros-args']
-    params = ['--params-file', 'config/camera.yaml', '-p', 'diagnostics_period_s:=0.1']
+    # The node's wait starts before its diagnostics reach this graph, which under load takes
+    # seconds: the default 5 s could run out before the subscriber below exists. The poses
+    # go to a topic of this test's own: the domain's graph may still list an earlier test's
+    # /tip_pose subscriber, and the node would not wait for this one.
+    topic = '/late_subscriber/tip_pose'
+    params = [
+        '--params-file', 'config/camera.yaml',
+        '-p', 'diagnostics_period_s:=0.1', '-p', 'wait_for_subscriber_s:=60.0',
+        '-r', f'/tip_pose:={topic}',
+    ]  # fmt: skip
     statuses = ros_graph.collect('/diagnostics', DiagnosticArray, 10)
     process = subprocess.Popen(
         [*base, *params, '-p', f'bag_path:={tmp_path / "bag"}'],
@@ -234,13 +243,13 @@ def test_main_reads_a_bag_with_a_params_file_and_rejects_a_missing_bag(
         # before /tip_pose has a subscriber.
         assert ros_graph.spin_until(lambda: len(statuses) > 0, 30.0)
         ros_graph.spin_for(2.0)
-        poses = ros_graph.collect('/tip_pose', PoseStamped, QoSProfile(depth=100))
+        poses = ros_graph.collect(topic, PoseStamped, QoSProfile(depth=100))
         stdout, stderr = process.communicate(timeout=30)
     finally:
         process.kill()
     assert process.returncode == 0, stderr
     assert '6 frames, 6 poses' in stdout
-    assert ros_graph.spin_until(lambda: len(poses) == 6, 5.0), len(poses)
+    assert ros_graph.spin_until(lambda: len(poses) == 6, 5.0), (len(poses), stderr)
     missing = subprocess.run(
         [*base, '-p', f'bag_path:={tmp_path / "nope"}'],
         env=env, capture_output=True, text=True, timeout=60,
