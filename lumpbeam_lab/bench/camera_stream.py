@@ -198,8 +198,9 @@ def echo() -> int:
     from sensor_msgs.msg import Image
 
     from lumpbeam_ros.nodes.endpoints import publisher, subscription
-    from lumpbeam_ros.vision.messages import decode_image
+    from lumpbeam_ros.vision.messages import decode_image, prepare_decoders
 
+    prepare_decoders()  # as the camera node does: the baseline's first frame is no slower
     rclpy.init()
     node = rclpy.create_node('bench_echo')
     poses = publisher(node, PoseStamped, TIP_POSE)

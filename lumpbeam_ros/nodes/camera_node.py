@@ -76,7 +76,7 @@ from lumpbeam_ros.vision.bag_frames import bag_frames
 from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
 from lumpbeam_ros.vision.config import camera_config_from_parameters
 from lumpbeam_ros.vision.free_pose import rpy_quaternion
-from lumpbeam_ros.vision.messages import IMAGE_TYPES, decode_camera_info
+from lumpbeam_ros.vision.messages import IMAGE_TYPES, decode_camera_info, prepare_decoders
 from lumpbeam_ros.vision.session import TrackingSession
 from lumpbeam_ros.vision.sources import (
     DeviceSource,
@@ -138,6 +138,7 @@ class CameraNode(SchemaNode):
         self.footage_path = str(self._param('footage_path'))
         self.video_device = str(self._param('video_device'))
         if not self.in_process:
+            prepare_decoders()
             # Raw: the bytes go to the same decoder as a bag's, without rclpy's copy.
             subscription(self, Image, IMAGE, self.on_image, raw=True)
             subscription(self, CameraInfoMsg, CAMERA_INFO, self.on_camera_info, raw=True)

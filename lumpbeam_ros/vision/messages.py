@@ -14,7 +14,7 @@ from typing import NamedTuple
 import numpy as np
 
 from lumpbeam_ros.bagio import CameraInfoData, convert
-from lumpbeam_ros.bagio.typestore import deserialize
+from lumpbeam_ros.bagio.typestore import deserialize, prepare
 from lumpbeam_ros.errors import BagError
 from lumpbeam_ros.interface import (
     CAMERA_FRAME,
@@ -140,6 +140,15 @@ def decode_frame(data: bytes | memoryview, msgtype: str = IMAGE_TYPE) -> CameraF
     if msgtype == IMAGE_TYPE:
         return decode_image(data)
     raise BagError(f'{msgtype} is not an image type ({", ".join(IMAGE_TYPES)})')
+
+
+def prepare_decoders() -> None:
+    """Readies the decoders of images and camera infos before the first frame comes.
+
+    See :func:`~lumpbeam_ros.bagio.typestore.prepare`: a live node calls this before it
+    subscribes, so its first frame costs what the others do.
+    """
+    prepare((*IMAGE_TYPES, CAMERA_INFO_TYPE))
 
 
 def decode_camera_info(data: bytes | memoryview) -> CameraInfo:

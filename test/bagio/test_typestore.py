@@ -13,8 +13,10 @@ from lumpbeam_ros.bagio.typestore import (
     deserialize,
     is_known,
     message_class,
+    prepare,
     serialize,
     type_description,
+    typestore,
 )
 from lumpbeam_ros.errors import BagError
 
@@ -90,7 +92,15 @@ def test_message_class_builds_messages_of_its_type():
     assert pose.__msgtype__ == 'geometry_msgs/msg/Point' and (pose.x, pose.z) == (1.0, 3.0)
 
 
-@pytest.mark.parametrize('call', [message_class, type_description, lambda t: deserialize(b'', t)])
+def test_prepare_generates_the_code_of_a_type_and_of_the_types_it_nests():
+    prepare(['sensor_msgs/msg/Image'])
+    assert {'sensor_msgs/msg/Image', 'std_msgs/msg/Header'} <= set(typestore().cache)
+
+
+@pytest.mark.parametrize(
+    'call',
+    [message_class, type_description, lambda t: deserialize(b'', t), lambda t: prepare([t])],
+)
 @pytest.mark.parametrize('msgtype', ['my_pkg/msg/Thing', 'std_msgs/Float64'])
 def test_an_unknown_type_is_one_clear_error(call, msgtype):
     match = rf"unknown message type '{msgtype}' \(not in ROS 2 Jazzy\)"

@@ -5,9 +5,14 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.bagio import convert
-from lumpbeam_ros.bagio.typestore import serialize
+from lumpbeam_ros.bagio.typestore import serialize, typestore
 from lumpbeam_ros.errors import BagError, LumpbeamError
-from lumpbeam_ros.interface import CAMERA_FRAME, COMPRESSED_IMAGE_TYPE, IMAGE_TYPE
+from lumpbeam_ros.interface import (
+    CAMERA_FRAME,
+    CAMERA_INFO_TYPE,
+    COMPRESSED_IMAGE_TYPE,
+    IMAGE_TYPE,
+)
 from lumpbeam_ros.vision.camera_model import CameraInfo
 from lumpbeam_ros.vision.messages import (
     IMAGE_TYPES,
@@ -18,6 +23,7 @@ from lumpbeam_ros.vision.messages import (
     decode_compressed_image,
     decode_frame,
     decode_image,
+    prepare_decoders,
 )
 
 from .helpers import STAMP_NS, camera_info_cdr, compressed_cdr, encoded, image_cdr
@@ -124,6 +130,12 @@ def test_decode_frame_picks_the_type():
     np.testing.assert_array_equal(decode_frame(raw).pixels, GREY)
     np.testing.assert_array_equal(decode_frame(raw, IMAGE_TYPE).pixels, GREY)
     assert IMAGE_TYPES == (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE)
+
+
+def test_the_decoders_are_ready_before_the_first_frame():
+    typestore.cache_clear()  # a store that has decoded nothing yet
+    prepare_decoders()
+    assert {*IMAGE_TYPES, CAMERA_INFO_TYPE} <= set(typestore().cache)
 
 
 def test_another_type_is_not_an_image():
