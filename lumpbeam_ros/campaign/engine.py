@@ -7,6 +7,7 @@ is flushed at least once a second, so an interrupted campaign keeps what it comp
 
 from __future__ import annotations
 
+import logging
 import time
 from collections.abc import Sequence
 from contextlib import ExitStack
@@ -114,6 +115,10 @@ def start_client(
             # traceback after "interrupted"). Its worker processes are multiprocessing
             # children, which the interpreter ends at exit anyway.
             SpecCluster._instances.difference_update(set(SpecCluster._instances) - registered)
+            # The cluster's own loop goes on in its thread, and a worker start it abandons
+            # fails there; asyncio logs that task's exception, traceback and all, when the
+            # task is collected at exit.
+            logging.getLogger('asyncio').setLevel(logging.CRITICAL)
             raise
         stack.enter_context(cluster)
         return stack.enter_context(Client(cluster))
