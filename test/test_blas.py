@@ -1,5 +1,9 @@
 """The BLAS limit, read back through threadpoolctl's own report of the loaded libraries."""
 
+import ast
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 from threadpoolctl import threadpool_info, threadpool_limits
@@ -45,3 +49,23 @@ def test_one_thread_computes_the_same_products():
         solved = np.linalg.lstsq(a, a @ np.arange(40.0), rcond=None)[0]
     np.testing.assert_allclose(inside, a @ b, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(solved, np.arange(40.0), rtol=1e-9, atol=1e-9)
+
+
+def test_a_blas_loaded_after_the_first_limit_is_limited_too():
+    # In a fresh interpreter: the first limit sees numpy's BLAS only; scipy's, loaded later,
+    # must be limited by the next one.
+    code = (
+        'from threadpoolctl import threadpool_info, threadpool_limits\n'
+        'from lumpbeam_ros.blas import single_threaded_blas\n'
+        'with single_threaded_blas(): pass\n'
+        'import scipy.linalg\n'
+        'with threadpool_limits(limits=2, user_api="blas"), single_threaded_blas():\n'
+        '    print(sorted((p["filepath"], p["num_threads"]) for p in threadpool_info()'
+        ' if p["user_api"] == "blas"))\n'
+    )
+    result = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    pools = ast.literal_eval(result.stdout)
+    if len(pools) < 2:
+        pytest.skip("scipy shares numpy's BLAS here")
+    assert {threads for _, threads in pools} == {1}

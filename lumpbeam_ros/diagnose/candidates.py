@@ -82,6 +82,17 @@ class Candidate:
             hi.append(self.search_max / self.scale)
         return np.asarray(lo), np.asarray(hi)
 
+    def step_floor(self) -> np.ndarray:
+        """Magnitudes of ``x`` below which a fit's finite-difference step stops shrinking.
+
+        The effect's starting strength (small, but felt by the data); none for the
+        log-parameters, whose steps the data feel even at 0
+        (:func:`~lumpbeam_ros.diagnose.fitting.forward_jacobian`).
+        """
+        if self.parameter is None:
+            return np.zeros(2)
+        return np.array([0.0, 0.0, abs(self.start / self.scale)])
+
     def start_x(self, nominal_x: np.ndarray, strength: float | None = None) -> np.ndarray:
         """Starting point: the nominal model's refit values and a strength.
 

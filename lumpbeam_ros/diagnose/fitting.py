@@ -59,6 +59,9 @@ class Fittable(Protocol):
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """Bounds of the fitted ``x``."""
 
+    def step_floor(self) -> np.ndarray:
+        """Magnitudes of ``x`` below which a finite-difference step stops shrinking."""
+
     def beam(self, nominal: BeamParameters, x: np.ndarray) -> BeamParameters:
         """The beam that ``x`` describes."""
 
@@ -295,7 +298,7 @@ class FitProblem:
         def fun(x: np.ndarray) -> np.ndarray:
             return self.model_residuals(candidate, x, end_s, warm)
 
-        jacobian = _FinalJacobian(fun, lo, hi)
+        jacobian = _FinalJacobian(fun, lo, hi, candidate.step_floor())
 
         starts = [
             np.clip(np.asarray(x, dtype=float), lo + 1e-9, hi - 1e-9) for x in (x0, *alternatives)
@@ -337,11 +340,19 @@ def forward_jacobian(
     f0: np.ndarray,
     lo: np.ndarray,
     hi: np.ndarray,
+    floor: np.ndarray | None = None,
 ) -> np.ndarray:
     """Forward-difference Jacobian, with the steps of scipy's ``'2-point'`` scheme.
 
     The step is ``DIFF_STEP`` relative (``ZERO_STEP`` at 0), towards larger magnitudes,
     turned back when it would leave the bounds, shortened when neither direction fits.
+
+    A step relative to the parameter alone vanishes with it: at an effect's strength of
+    1e-9 (off, on its bound) it is 2e-12, whose residual change is the simulator's
+    tolerance (its sweeps start warm from the previous simulation), not the slope; a fit
+    there moved or stayed on that noise, and a diagnosis flipped on a change of the
+    noise estimate in its 14th digit. So the magnitude a step is relative to is at least
+    ``floor`` (the candidates' starting strengths, felt by the data).
 
     Args:
         fun: The residuals.
@@ -349,12 +360,15 @@ def forward_jacobian(
         f0: ``fun(x)``.
         lo: Lower bounds.
         hi: Upper bounds.
+        floor: Per parameter, the magnitude below which the step stops shrinking
+            (``None``: none, scipy's steps).
 
     Returns:
         The Jacobian, (f0.size, x.size).
     """
     sign = np.where(x >= 0.0, 1.0, -1.0)
-    h = DIFF_STEP * sign * np.abs(x)
+    magnitude = np.abs(x) if floor is None else np.maximum(np.abs(x), floor)
+    h = DIFF_STEP * sign * magnitude
     h = np.where((x + h) - x == 0.0, ZERO_STEP * sign * np.maximum(1.0, np.abs(x)), h)
     below, above = x - lo, hi - x
     outside = (x + h < lo) | (x + h > hi)
@@ -380,9 +394,16 @@ class _FinalJacobian:
     all, it steps once with that Jacobian (a quasi-Newton step) and then with fresh ones.
     """
 
-    def __init__(self, fun: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray):
+    def __init__(
+        self,
+        fun: Callable[[np.ndarray], np.ndarray],
+        lo: np.ndarray,
+        hi: np.ndarray,
+        floor: np.ndarray,
+    ):
         self._fun = fun
         self._lo, self._hi = lo, hi
+        self._floor = floor
         self._x: np.ndarray | None = None
         self._cost = math.inf
         self._jacobian: np.ndarray | None = None
@@ -393,7 +414,7 @@ class _FinalJacobian:
         if self._jacobian is not None and self._x is not None and self._stops(x, cost):
             self._x, self._cost = x.copy(), cost
             return self._jacobian
-        self._jacobian = forward_jacobian(self._fun, x, f0, self._lo, self._hi)
+        self._jacobian = forward_jacobian(self._fun, x, f0, self._lo, self._hi, self._floor)
         self._x, self._cost = x.copy(), cost
         return self._jacobian
 

@@ -97,6 +97,11 @@ class Model:
             lo, hi = np.r_[lo, c_lo[2]], np.r_[hi, c_hi[2]]
         return lo, hi
 
+    def step_floor(self) -> np.ndarray:
+        """Each parameter's finite-difference floor (:meth:`Candidate.step_floor`)."""
+        floors = [c.step_floor()[2:] for c in self.effects]
+        return np.concatenate([nominal_candidate().step_floor(), *floors])
+
     def beam(self, nominal: BeamParameters, x: np.ndarray) -> BeamParameters:
         """The beam that ``x`` describes: the refit nominal one with every effect on."""
         beam = nominal_candidate().beam(nominal, x)
@@ -451,8 +456,9 @@ def _first_round(
     # The linearized step of each effect (as in later rounds) is a second starting point:
     # a fit that starts where the data put it saves most of its iterations, and one the
     # linearization misjudges starts from the candidate's own start as before, whichever
-    # fits better. (Not the nominal fit itself, the effect off on its bound: a fit that
-    # starts there stays there, its finite differences being relative to the strength.)
+    # fits better. A step that predicts no gain starts the effect off, on its bound: the
+    # fit leaves it when the data's slope says so, its finite differences being taken at
+    # least at the starting strength's scale (:meth:`Candidate.step_floor`).
     predictions = selector.screen(base, candidates)
     singles = []
     for c in candidates:

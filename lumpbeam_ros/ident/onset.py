@@ -22,9 +22,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.ident.optimize import bounded_scalar_minimum
 
 #: Fraction of the time from the onset to the first peak that the onset fit covers.
 PEAK_FRACTION = 0.6
@@ -103,11 +103,8 @@ def fit_onset(t: np.ndarray, z: np.ndarray, departure: int, quiet_start: int, pe
     k = int(np.argmin(costs))
     bounds = (float(grid[max(k - 1, 0)]), float(grid[min(k + 1, grid.size - 1)]))
     step = (high - low) / (_GRID_POINTS - 1)
-    best = minimize_scalar(
-        lambda s: _residual(ts, zs, s),
-        bounds=bounds,
-        method='bounded',
-        options={'xatol': max(step * 1e-3, 1e-9)},
+    best = bounded_scalar_minimum(
+        lambda s: _residual(ts, zs, s), *bounds, xatol=max(step * 1e-3, 1e-9)
     )
     onset_s = float(best.x) if best.fun <= costs[k] else float(grid[k])
     coef = _solve(ts, zs, onset_s)[0]

@@ -26,11 +26,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.covariance import Covariance, sandwich_covariance
 from lumpbeam_ros.ident.mode_estimate import TWO_PI, ModeEstimate
+from lumpbeam_ros.ident.optimize import levenberg_marquardt
 
 #: A mode's starting point: (damped frequency in Hz, damping ratio).
 ModeGuess = tuple[float, float]
@@ -458,14 +458,8 @@ class DampedSinusoidFit:
         with np.errstate(over='ignore', invalid='ignore'):
             found = _gauss_newton(decay, y, x0) if start is not None else None
             if found is None:
-                solution = least_squares(
-                    lambda x: decay.value(x) - y,
-                    x0,
-                    jac=decay.jacobian,
-                    method='lm',
-                    x_scale='jac',
-                )
-                found = solution.x, int(solution.nfev)
+                solution = levenberg_marquardt(lambda x: decay.value(x) - y, decay.jacobian, x0)
+                found = solution.x, solution.n_evaluations
         x, evaluations = found
         if not np.all(np.isfinite(x)):
             raise LumpbeamError('damped-sinusoid fit did not converge')

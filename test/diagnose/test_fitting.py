@@ -15,7 +15,7 @@ from lumpbeam_ros.diagnose.measurement import make_record
 from lumpbeam_ros.diagnose.selection import Model
 from lumpbeam_ros.diagnose.workflow import nominal_form
 from lumpbeam_ros.model.parameters import BeamParameters
-from lumpbeam_ros.model.simulate import simulate_loads
+from lumpbeam_ros.model.simulate import WarmStart, simulate_loads
 
 NOMINAL = nominal_form(BeamParameters())
 RATE_HZ = 180.0
@@ -223,6 +223,36 @@ def test_forward_differences_take_scipys_two_point_steps(x, lo, hi):
         _curve, x, method='2-point', rel_step=DIFF_STEP, f0=_curve(x), bounds=(lo, hi)
     )
     np.testing.assert_array_equal(ours, scipys)
+
+
+def test_a_strength_off_on_its_bound_gets_the_datas_slope_not_the_simulators_tolerance():
+    # Quadratic drag hidden; its strength at 1e-9 (off, where a fit of a no-gain linear
+    # step starts). The column from three simulations that start their sweeps warm from
+    # different beams: a step relative to 1e-9 alone (2e-12) measures the sweeps'
+    # tolerance, one relative to the floor (the starting strength) the slope.
+    drag = next(c for c in effect_candidates(NOMINAL) if c.name == 'quadratic_drag')
+    model = Model((drag,))
+    problem = _problem(_record(_beam(quadratic_drag=0.5), noise=1.0))
+    lo, hi = model.bounds()
+    x = np.array([0.01, 0.05, 1e-9])
+    columns = {}
+    for name, floor in (('relative', None), ('floored', model.step_floor())):
+        columns[name] = []
+        for shift in (0.0, 0.02, -0.03):
+            warm = WarmStart()
+            problem.model_residuals(model, x + np.array([shift, shift, 0.0]), warm=warm)
+            problem.nominal = problem.nominal  # forget the remembered residuals
+
+            def fun(v, warm=warm):
+                return problem.model_residuals(model, v, warm=warm)
+
+            columns[name].append(forward_jacobian(fun, x, fun(x), lo, hi, floor)[:, 2])
+
+    def spread(cols):
+        return max(np.linalg.norm(c - cols[0]) for c in cols[1:]) / np.linalg.norm(cols[0])
+
+    assert spread(columns['floored']) < 1e-6 < 1e-2 < spread(columns['relative'])
+    np.testing.assert_array_equal(model.step_floor(), [0.0, 0.0, drag.start / drag.scale])
 
 
 def test_the_fit_skips_the_jacobian_that_only_ends_it_and_lands_where_scipy_does():
