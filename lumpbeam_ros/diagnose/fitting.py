@@ -312,8 +312,9 @@ class FitProblem:
         def column(x: np.ndarray) -> np.ndarray:
             # A Jacobian column's sweeps start from the point's own remainders (one
             # finite-difference step away), not from the previous column's (two): fewer
-            # sweeps, and the next step starts from the point's too.
-            return self.model_residuals(candidate, x, end_s, warm.copy())
+            # sweeps, and the next step starts from the point's too. With none yet (the
+            # point was remembered, not simulated), the first column leaves its own.
+            return self.model_residuals(candidate, x, end_s, warm.copy() if warm else warm)
 
         jacobian = _FinalJacobian(fun, lo, hi, column)
 

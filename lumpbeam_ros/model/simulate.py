@@ -55,6 +55,10 @@ class WarmStart:
         if remainder is not None:
             self._remainders[(start_s, load_kg)] = remainder
 
+    def __len__(self) -> int:
+        """The number of stretches with a remainder stored."""
+        return len(self._remainders)
+
     def copy(self) -> WarmStart:
         """An independent copy (the arrays are shared: they are never modified)."""
         other = WarmStart()
