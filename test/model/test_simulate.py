@@ -126,8 +126,10 @@ def test_a_warm_start_reaches_the_same_trajectory_in_fewer_sweeps(monkeypatch):
 
     cold = run(nearby)
     warm = WarmStart()
+    assert not warm  # empty: nothing to start from
     run(BEAM, warm)  # a fit's previous step
     assert warm.get(2.0, 0.0) is not None and warm.get(2.0, 4.5) is None
+    assert len(warm) == 1  # the one stretch that moves
     warmed = run(nearby, warm)
     # The same fixed point to the solver's tolerance (1e-11 rad between sweeps).
     assert np.max(np.abs(warmed.q - cold.q)) < 1e-9
