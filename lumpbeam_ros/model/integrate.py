@@ -39,6 +39,10 @@ FRICTION_REFINEMENT = 4
 #: change is predicted (:func:`_converged`).
 CONTRACTION = 0.5
 
+#: A contraction carried over from a similar solve is taken this many times larger: the
+#: beams of a fit's successive simulations differ a little, their contractions too.
+CONTRACTION_MARGIN = 3.0
+
 #: Longest chain solved with single-threaded BLAS (see :meth:`ModalSolver.solve`).
 SINGLE_THREAD_MAX_SEGMENTS = 64
 
@@ -69,6 +73,8 @@ class ChainSolution:
         method: ``'modal'`` or ``'radau'``: which integrator produced it.
         remainder: The modal solver's converged nonlinear remainder ``r`` on the grid,
             (len(t), n), to start a similar solve from (``None`` for Radau).
+        contraction: The largest ratio of successive sweeps' changes the modal solver saw
+            (or was given), for a similar solve (:meth:`ModalSolver.solve`); NaN if none.
     """
 
     t: np.ndarray
@@ -76,6 +82,7 @@ class ChainSolution:
     phi_dot: np.ndarray
     method: str
     remainder: np.ndarray | None = None
+    contraction: float = math.nan
 
     def final_state(self) -> ChainState:
         """The state at the last time."""
@@ -212,6 +219,7 @@ class ModalSolver:
         tol: float = 1e-11,
         max_sweeps: int = 40,
         remainder: np.ndarray | None = None,
+        contraction: float = math.nan,
     ) -> ChainSolution | None:
         """Integrates from ``state`` over ``duration`` on a uniform grid.
 
@@ -234,6 +242,9 @@ class ModalSolver:
                 (:func:`_converged`), rad.
             max_sweeps: Sweeps before giving up.
             remainder: A starting remainder on the same grid (ignored if its shape differs).
+            contraction: The contraction the solve that left ``remainder`` showed
+                (:attr:`ChainSolution.contraction`): with it, the change the third sweep
+                would make is predicted from the second's (:func:`_converged`).
 
         Returns:
             The solution on the grid (starting at 0), or ``None`` when the sweeps did not
@@ -241,9 +252,9 @@ class ModalSolver:
         """
         threads = nullcontext() if self._n > SINGLE_THREAD_MAX_SEGMENTS else single_threaded_blas()
         with threads:
-            solution = self._solve(state, duration, step, tol, max_sweeps, remainder)
+            solution = self._solve(state, duration, step, tol, max_sweeps, remainder, contraction)
             if solution is None and remainder is not None:
-                solution = self._solve(state, duration, step, tol, max_sweeps, None)
+                solution = self._solve(state, duration, step, tol, max_sweeps, None, math.nan)
         return solution
 
     def _solve(
@@ -254,6 +265,7 @@ class ModalSolver:
         tol: float,
         max_sweeps: int,
         remainder: np.ndarray | None,
+        contraction: float,
     ) -> ChainSolution | None:
         steps = max(1, int(np.ceil(duration / step - 1e-9)))
         h = duration / steps
@@ -266,6 +278,7 @@ class ModalSolver:
         forcing = np.array(remainder) if warm else np.zeros(shape)
         previous = None
         change = math.inf
+        seen = math.nan  # the largest ratio of successive changes
         for _ in range(max_sweeps):
             # A diverging sweep overflows on its way to the check below, which handles it.
             with np.errstate(over='ignore', invalid='ignore'):
@@ -275,8 +288,11 @@ class ModalSolver:
             d, d_dot = x[:, : self._n], x[:, self._n :]
             if previous is not None:
                 last, change = change, float(np.max(np.abs(d - previous)))
-                if _converged(change, last, tol):
-                    return ChainSolution(t, d + phi_eq, d_dot, 'modal', forcing)
+                if math.isfinite(last):
+                    seen = max(change / last, seen) if math.isfinite(seen) else change / last
+                if _converged(change, last, tol, contraction):
+                    shown = seen if math.isfinite(seen) else contraction
+                    return ChainSolution(t, d + phi_eq, d_dot, 'modal', forcing, shown)
             previous = d
             d_ddot = forcing @ self._m0_inv.T - d @ self._m0_inv_k.T - d_dot @ self._m0_inv_c.T
             phi = d + phi_eq
@@ -364,21 +380,26 @@ class _OverBudgetError(Exception):
     """Raised from inside ``solve_ivp`` when the evaluations run out; carries the time."""
 
 
-def _converged(change: float, last: float, tol: float) -> bool:
+def _converged(change: float, last: float, tol: float, expected: float = math.nan) -> bool:
     """Whether the sweeps have converged: the angles' change below ``tol``, or the next one.
 
     The sweeps contract geometrically (by 1e-3 to 3e-2 a sweep): once the last two changes
     show it, the next change, ``change * (change / last)``, is what the sweep after this
     one would move the angles by, the error of this one. Below ``tol`` it need not be run:
     a sweep fewer on most simulations, each as close to the fixed point as ``tol`` says.
+    After the first change alone, the contraction of a similar solve (a fit's previous
+    simulation), ``CONTRACTION_MARGIN`` times larger, stands in for the ratio.
 
     Args:
         change: Largest change of the angles in the last sweep, rad.
         last: The sweep before's (``inf`` if none).
         tol: The tolerance, rad.
+        expected: A similar solve's contraction (NaN: none).
     """
-    contracting = math.isfinite(last) and change < CONTRACTION * last
-    return change < tol or (contracting and change * change < tol * last)
+    if change < tol:
+        return True
+    ratio = change / last if math.isfinite(last) else CONTRACTION_MARGIN * expected
+    return ratio < CONTRACTION and change * ratio < tol
 
 
 def _hold_drive(
