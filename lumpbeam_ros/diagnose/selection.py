@@ -52,11 +52,6 @@ PAIR_MIN_DECAY_S = 3.0
 #: Candidates fitted in full per round after the first (the best screened).
 FULL_FITS = 2
 
-#: Where a round-1 fit starts whose linear step turns the effect off, as a share of the
-#: candidate's starting strength: next to no effect on the data, yet a strength whose
-#: relative finite differences see the slope.
-NEAR_OFF = 1e-3
-
 #: Predicted BIC gain below which a screened candidate is not fitted: well under
 #: ``SIGNIFICANT_BIC``, since the linear step is only a guide.
 SCREEN_BIC = 0.3 * SIGNIFICANT_BIC
@@ -465,17 +460,11 @@ def _first_round(
         if informed is not None:
             singles.append(selector.fit(Model((c,)), _plausible_x(c, informed), base=base))
             continue
-        _, strength, stepped = predictions[c.name]
-        if strength == 0.0:
-            # A step that turns the effect off starts just inside its bound, not on it: on
-            # it the strength's relative finite differences would see no slope, only the
-            # simulations' noise, and whether the fit ever left would be chance.
-            stepped = np.r_[stepped[:-1], NEAR_OFF * c.start / c.scale]
         singles.append(
             selector.fit(
                 Model((c,)),
                 c.start_x(nominal.x, start_strength(c)),
-                [_plausible_x(c, stepped)],
+                [_plausible_x(c, predictions[c.name][2])],
                 base,
             )
         )
