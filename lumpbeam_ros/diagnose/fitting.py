@@ -41,8 +41,15 @@ FIT_XTOL = 1e-4
 DIVERGED_RESIDUAL = 1e3
 
 #: Residual vectors remembered by model and parameters: a fit's start is often a point the
-#: screening has just simulated.
-MEMO_SIZE = 32
+#: screening simulated before the other candidates' fits, and the final fit on the whole
+#: record starts where its training fit was evaluated, rounds earlier. A diagnosis runs a
+#: few hundred simulations, so it keeps them all (a few MB).
+MEMO_SIZE = 1024
+
+#: Of those, the most recent keep their simulation too (each about 15 times the size of its
+#: residuals): a fit's end, simulated for residuals, is then not simulated again for its
+#: trajectory.
+TRAJECTORY_MEMO_SIZE = 32
 
 
 class Fittable(Protocol):
@@ -120,8 +127,9 @@ class FitProblem:
         self, record: Record, nominal: BeamParameters, sigma_z: float, sigma_pitch: float
     ):
         self.record = record
-        # Residuals (and the simulation, when there is one) by model, parameters and end.
-        self._memo: dict[tuple[str, bytes, float], tuple[np.ndarray, TipTrajectory | None]] = {}
+        # Residuals, and the recent simulations, by model, parameters and end.
+        self._memo: dict[tuple[str, bytes, float], np.ndarray] = {}
+        self._trajectories: dict[tuple[str, bytes, float], TipTrajectory] = {}
         self._nominal = nominal
         self.sigma_z = sigma_z
         self.sigma_pitch = sigma_pitch
@@ -136,7 +144,9 @@ class FitProblem:
     @nominal.setter
     def nominal(self, beam: BeamParameters) -> None:
         self._nominal = beam
-        self._memo.clear()  # residuals remembered for the old reference are not the new's
+        # Residuals remembered for the old reference are not the new's.
+        self._memo.clear()
+        self._trajectories.clear()
 
     def simulate(
         self, beam: BeamParameters, end_s: float = math.inf, warm: WarmStart | None = None
@@ -187,7 +197,7 @@ class FitProblem:
         """
         key = self._key(model, x, end_s)
         if key in self._memo:  # e.g. a screening column at the strength a fit starts from
-            return self._memo[key][0].copy()
+            return self._memo[key].copy()
         trajectory = None
         try:
             with np.errstate(all='ignore'):
@@ -218,7 +228,7 @@ class FitProblem:
             RuntimeError: The beam has no static equilibrium.
         """
         key = self._key(model, x, end_s)
-        remembered = self._memo.get(key, (None, None))[1]
+        remembered = self._trajectories.get(key)
         if remembered is not None:
             return remembered
         with np.errstate(all='ignore'):
@@ -238,7 +248,11 @@ class FitProblem:
     ) -> None:
         if len(self._memo) >= MEMO_SIZE:
             self._memo.pop(next(iter(self._memo)))
-        self._memo[key] = (residuals, trajectory)
+        self._memo[key] = residuals
+        if trajectory is not None:
+            if len(self._trajectories) >= TRAJECTORY_MEMO_SIZE:
+                self._trajectories.pop(next(iter(self._trajectories)))
+            self._trajectories[key] = trajectory
 
     def residuals(self, trajectory: TipTrajectory, start_s: float = -math.inf) -> np.ndarray:
         """Noise-normalized residuals (model minus measurement), z then pitch.
@@ -298,7 +312,14 @@ class FitProblem:
         def fun(x: np.ndarray) -> np.ndarray:
             return self.model_residuals(candidate, x, end_s, warm)
 
-        jacobian = _FinalJacobian(fun, lo, hi, candidate.step_floor())
+        def column(x: np.ndarray) -> np.ndarray:
+            # A Jacobian column's sweeps start from the point's own remainders (one
+            # finite-difference step away), not from the previous column's (two): fewer
+            # sweeps, and the next step starts from the point's too. With none yet (the
+            # point was remembered, not simulated), the first column leaves its own.
+            return self.model_residuals(candidate, x, end_s, warm.copy() if warm else warm)
+
+        jacobian = _FinalJacobian(fun, lo, hi, candidate.step_floor(), column)
 
         starts = [
             np.clip(np.asarray(x, dtype=float), lo + 1e-9, hi - 1e-9) for x in (x0, *alternatives)
@@ -392,6 +413,14 @@ class _FinalJacobian:
     meets them (by the test scipy applies, given a good agreement with its model, which a
     converging fit has) gets the previous Jacobian back instead. Should the loop go on after
     all, it steps once with that Jacobian (a quasi-Newton step) and then with fresh ones.
+
+    Args:
+        fun: The residuals, as least squares evaluates them.
+        lo: Lower bounds.
+        hi: Upper bounds.
+        floor: See :func:`forward_jacobian`.
+        column: The residuals at a finite-difference step (the same function, its
+            simulations started differently).
     """
 
     def __init__(
@@ -400,8 +429,10 @@ class _FinalJacobian:
         lo: np.ndarray,
         hi: np.ndarray,
         floor: np.ndarray,
+        column: Callable[[np.ndarray], np.ndarray],
     ):
         self._fun = fun
+        self._column = column
         self._lo, self._hi = lo, hi
         self._floor = floor
         self._x: np.ndarray | None = None
@@ -414,7 +445,7 @@ class _FinalJacobian:
         if self._jacobian is not None and self._x is not None and self._stops(x, cost):
             self._x, self._cost = x.copy(), cost
             return self._jacobian
-        self._jacobian = forward_jacobian(self._fun, x, f0, self._lo, self._hi, self._floor)
+        self._jacobian = forward_jacobian(self._column, x, f0, self._lo, self._hi, self._floor)
         self._x, self._cost = x.copy(), cost
         return self._jacobian
 

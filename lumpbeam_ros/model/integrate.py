@@ -17,6 +17,7 @@ the reference integrator, ``scipy.integrate.solve_ivp(method='Radau')`` on the s
 
 from __future__ import annotations
 
+import math
 from contextlib import nullcontext
 from dataclasses import dataclass
 
@@ -33,6 +34,14 @@ from lumpbeam_ros.model.modes import LinearModel
 #: this many times finer than the smooth dynamics need (the remainder ``r`` stays on the
 #: coarse grid).
 FRICTION_REFINEMENT = 4
+
+#: Largest ratio of successive sweeps' changes taken as a contraction, from which the next
+#: change is predicted (:func:`_converged`).
+CONTRACTION = 0.5
+
+#: A contraction carried over from a similar solve is taken this many times larger: the
+#: beams of a fit's successive simulations differ a little, their contractions too.
+CONTRACTION_MARGIN = 3.0
 
 #: Longest chain solved with single-threaded BLAS (see :meth:`ModalSolver.solve`).
 SINGLE_THREAD_MAX_SEGMENTS = 64
@@ -64,6 +73,8 @@ class ChainSolution:
         method: ``'modal'`` or ``'radau'``: which integrator produced it.
         remainder: The modal solver's converged nonlinear remainder ``r`` on the grid,
             (len(t), n), to start a similar solve from (``None`` for Radau).
+        contraction: The largest ratio of successive sweeps' changes the modal solver saw
+            (or was given), for a similar solve (:meth:`ModalSolver.solve`); NaN if none.
     """
 
     t: np.ndarray
@@ -71,6 +82,7 @@ class ChainSolution:
     phi_dot: np.ndarray
     method: str
     remainder: np.ndarray | None = None
+    contraction: float = math.nan
 
     def final_state(self) -> ChainState:
         """The state at the last time."""
@@ -187,10 +199,14 @@ class ModalSolver:
         j = np.arange(fine)[:, None]
         on_change = ((h_phi1 - h_phi2) * j + h_phi2 * (j + 1)) / fine  # (fine, m)
         change = u[1:] - u[:-1]
-        steps = h_phi1 * u[:-1, None, :] + on_change * change[:, None, :]  # (T - 1, fine, m)
-        drive = np.empty(((u.shape[0] - 1) * fine + 1, u.shape[1]), dtype=complex)
+        count, m = u.shape
+        drive = np.empty(((count - 1) * fine + 1, m), dtype=complex)
         drive[0] = z0
-        drive[1:] = steps.reshape(-1, u.shape[1])
+        np.add(  # the steps, (T - 1, fine, m), written in place
+            h_phi1 * u[:-1, None, :],
+            on_change * change[:, None, :],
+            out=drive[1:].reshape(count - 1, fine, m),
+        )
         gamma = h_phi1 * self._b[:, 0]
         z = friction_steps(drive, e, gamma, self._v[0], self.chain.coulomb_torque)
         return z[::fine]
@@ -203,6 +219,7 @@ class ModalSolver:
         tol: float = 1e-11,
         max_sweeps: int = 40,
         remainder: np.ndarray | None = None,
+        contraction: float = math.nan,
     ) -> ChainSolution | None:
         """Integrates from ``state`` over ``duration`` on a uniform grid.
 
@@ -220,9 +237,14 @@ class ModalSolver:
             duration: Time span, s.
             step: Largest grid spacing, s (the grid is uniform, ending exactly at duration;
                 dry friction is decided on one ``FRICTION_REFINEMENT`` times finer).
-            tol: Convergence threshold on the change of the angles between sweeps, rad.
+            tol: Convergence threshold on the change of the angles between sweeps, or on
+                the next sweep's change once the sweeps show their contraction
+                (:func:`_converged`), rad.
             max_sweeps: Sweeps before giving up.
             remainder: A starting remainder on the same grid (ignored if its shape differs).
+            contraction: The contraction the solve that left ``remainder`` showed
+                (:attr:`ChainSolution.contraction`): with it, the change the third sweep
+                would make is predicted from the second's (:func:`_converged`).
 
         Returns:
             The solution on the grid (starting at 0), or ``None`` when the sweeps did not
@@ -230,9 +252,9 @@ class ModalSolver:
         """
         threads = nullcontext() if self._n > SINGLE_THREAD_MAX_SEGMENTS else single_threaded_blas()
         with threads:
-            solution = self._solve(state, duration, step, tol, max_sweeps, remainder)
+            solution = self._solve(state, duration, step, tol, max_sweeps, remainder, contraction)
             if solution is None and remainder is not None:
-                solution = self._solve(state, duration, step, tol, max_sweeps, None)
+                solution = self._solve(state, duration, step, tol, max_sweeps, None, math.nan)
         return solution
 
     def _solve(
@@ -243,6 +265,7 @@ class ModalSolver:
         tol: float,
         max_sweeps: int,
         remainder: np.ndarray | None,
+        contraction: float,
     ) -> ChainSolution | None:
         steps = max(1, int(np.ceil(duration / step - 1e-9)))
         h = duration / steps
@@ -254,6 +277,8 @@ class ModalSolver:
         warm = remainder is not None and remainder.shape == shape
         forcing = np.array(remainder) if warm else np.zeros(shape)
         previous = None
+        change = math.inf
+        seen = math.nan  # the largest ratio of successive changes
         for _ in range(max_sweeps):
             # A diverging sweep overflows on its way to the check below, which handles it.
             with np.errstate(over='ignore', invalid='ignore'):
@@ -261,8 +286,13 @@ class ModalSolver:
             if not np.all(np.isfinite(x)):
                 return None
             d, d_dot = x[:, : self._n], x[:, self._n :]
-            if previous is not None and np.max(np.abs(d - previous)) < tol:
-                return ChainSolution(t, d + phi_eq, d_dot, 'modal', forcing)
+            if previous is not None:
+                last, change = change, float(np.max(np.abs(d - previous)))
+                if math.isfinite(last):
+                    seen = max(change / last, seen) if math.isfinite(seen) else change / last
+                if _converged(change, last, tol, contraction):
+                    shown = seen if math.isfinite(seen) else contraction
+                    return ChainSolution(t, d + phi_eq, d_dot, 'modal', forcing, shown)
             previous = d
             d_ddot = forcing @ self._m0_inv.T - d @ self._m0_inv_k.T - d_dot @ self._m0_inv_c.T
             phi = d + phi_eq
@@ -348,6 +378,28 @@ def solve_reference(
 
 class _OverBudgetError(Exception):
     """Raised from inside ``solve_ivp`` when the evaluations run out; carries the time."""
+
+
+def _converged(change: float, last: float, tol: float, expected: float = math.nan) -> bool:
+    """Whether the sweeps have converged: the angles' change below ``tol``, or the next one.
+
+    The sweeps contract geometrically (by 1e-3 to 3e-2 a sweep): once the last two changes
+    show it, the next change, ``change * (change / last)``, is what the sweep after this
+    one would move the angles by, the error of this one. Below ``tol`` it need not be run:
+    a sweep fewer on most simulations, each as close to the fixed point as ``tol`` says.
+    After the first change alone, the contraction of a similar solve (a fit's previous
+    simulation), ``CONTRACTION_MARGIN`` times larger, stands in for the ratio.
+
+    Args:
+        change: Largest change of the angles in the last sweep, rad.
+        last: The sweep before's (``inf`` if none).
+        tol: The tolerance, rad.
+        expected: A similar solve's contraction (NaN: none).
+    """
+    if change < tol:
+        return True
+    ratio = change / last if math.isfinite(last) else CONTRACTION_MARGIN * expected
+    return ratio < CONTRACTION and change * ratio < tol
 
 
 def _hold_drive(

@@ -9,6 +9,7 @@ Hermite splines of the angles (the solver gives their rates too).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -44,16 +45,31 @@ class WarmStart:
     """
 
     def __init__(self) -> None:
-        self._remainders: dict[tuple[float, float], np.ndarray] = {}
+        self._remainders: dict[tuple[float, float], tuple[np.ndarray, float]] = {}
 
     def get(self, start_s: float, load_kg: float) -> np.ndarray | None:
         """The remainder last stored for a stretch (``None``: none yet)."""
-        return self._remainders.get((start_s, load_kg))
+        stored = self._remainders.get((start_s, load_kg))
+        return None if stored is None else stored[0]
 
-    def put(self, start_s: float, load_kg: float, remainder: np.ndarray | None) -> None:
-        """Stores a stretch's converged remainder (``None`` is ignored)."""
+    def contraction(self, start_s: float, load_kg: float) -> float:
+        """The sweeps' contraction that the stretch's last solve showed (NaN: none)."""
+        return self._remainders.get((start_s, load_kg), (None, math.nan))[1]
+
+    def put(
+        self,
+        start_s: float,
+        load_kg: float,
+        remainder: np.ndarray | None,
+        contraction: float = math.nan,
+    ) -> None:
+        """Stores a stretch's converged remainder and contraction (``None`` is ignored)."""
         if remainder is not None:
-            self._remainders[(start_s, load_kg)] = remainder
+            self._remainders[(start_s, load_kg)] = (remainder, contraction)
+
+    def __len__(self) -> int:
+        """The number of stretches with a remainder stored."""
+        return len(self._remainders)
 
     def copy(self) -> WarmStart:
         """An independent copy (the arrays are shared: they are never modified)."""
@@ -153,10 +169,14 @@ class BeamSimulation:
             phi = np.repeat(self.state.phi[None, :], t_out.size, axis=0)
             return phi, np.repeat(self.state.phi_dot[None, :], t_out.size, axis=0)
         solver = self._solver(self.load_kg)
-        warm = None if self.warm is None else self.warm.get(self.time, self.load_kg)
-        solution = solver.solve(self.state, duration, self.step, remainder=warm)
+        stretch = (self.time, self.load_kg)
+        warm = None if self.warm is None else self.warm.get(*stretch)
+        contraction = math.nan if self.warm is None else self.warm.contraction(*stretch)
+        solution = solver.solve(
+            self.state, duration, self.step, remainder=warm, contraction=contraction
+        )
         if self.warm is not None and solution is not None:
-            self.warm.put(self.time, self.load_kg, solution.remainder)
+            self.warm.put(*stretch, solution.remainder, solution.contraction)
         if solution is None:
             if not self.stiff_fallback:
                 raise SimulationDivergedError(

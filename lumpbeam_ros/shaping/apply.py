@@ -103,12 +103,17 @@ def shape_trajectory(trajectory: JointTrajectory, impulses: Impulses) -> JointTr
     """
     times = shaped_times(trajectory, impulses)
     step = _even_step(trajectory.time_s)
+    delay = impulses.time_s - impulses.time_s[0]
     if step is not None and step <= MAX_STEP_S:
         shaped = _delayed_sum(trajectory.angles_rad, step, times.size, impulses)
-        return JointTrajectory(times, shaped, trajectory.joint_names)
-    delay = impulses.time_s - impulses.time_s[0]
-    shaped = np.zeros((times.size, trajectory.joint_count))
-    for j, angles in enumerate(trajectory.angles_rad.T):
-        for t_i, a_i in zip(delay, impulses.amplitude, strict=True):
-            shaped[:, j] += a_i * np.interp(times - t_i, trajectory.time_s, angles)
+    else:
+        shaped = np.zeros((times.size, trajectory.joint_count))
+        for j, angles in enumerate(trajectory.angles_rad.T):
+            for t_i, a_i in zip(delay, impulses.amplitude, strict=True):
+                shaped[:, j] += a_i * np.interp(times - t_i, trajectory.time_s, angles)
+    # Where every delayed copy is at rest the sum is the input's angle times the amplitudes'
+    # sum, 1 only up to round-off: a move to 0.5 rad would end at 0.4999999999999999.
+    start, end = trajectory.time_s[0], trajectory.time_s[-1] + delay[-1]
+    shaped[times <= start] = trajectory.angles_rad[0]
+    shaped[times >= end - 1e-9 * max(1.0, abs(end))] = trajectory.angles_rad[-1]
     return JointTrajectory(times, shaped, trajectory.joint_names)

@@ -133,6 +133,20 @@ def test_cubic_stiffness_shifts_the_frequency_as_duffing_predicts(k3):
     assert abs(period / balance - 1.0) < 0.1 * abs(exact / linear - 1.0)
 
 
+@pytest.mark.parametrize('torque', [0.0, 1.0])
+def test_sweeps_stopped_on_the_predicted_change_are_within_the_tolerance(torque):
+    beam = replace(BeamParameters(), effects=Effects().with_effect('coulomb_friction', torque))
+    chain, state = _released(beam)
+    solver = ModalSolver(chain)
+    tol = 1e-11
+    solution = solver.solve(state, 6.0, 1 / 180, tol=tol)
+    strict = solver.solve(state, 6.0, 1 / 180, tol=1e-15)
+    assert solution is not None and strict is not None
+    # The stop is a sweep early (the change the next sweep would make predicted from the
+    # contraction), yet as close to the fixed point as the tolerance says.
+    assert 0.0 < np.max(np.abs(solution.phi - strict.phi)) < tol
+
+
 @pytest.mark.parametrize('torque', [0.3, 1.0, 3.0])
 def test_sliding_stretches_in_one_go_match_the_step_by_step_friction(torque):
     beam = replace(BeamParameters(), effects=Effects().with_effect('coulomb_friction', torque))

@@ -126,8 +126,10 @@ def test_a_warm_start_reaches_the_same_trajectory_in_fewer_sweeps(monkeypatch):
 
     cold = run(nearby)
     warm = WarmStart()
+    assert not warm  # empty: nothing to start from
     run(BEAM, warm)  # a fit's previous step
     assert warm.get(2.0, 0.0) is not None and warm.get(2.0, 4.5) is None
+    assert len(warm) == 1  # the one stretch that moves
     warmed = run(nearby, warm)
     # The same fixed point to the solver's tolerance (1e-11 rad between sweeps).
     assert np.max(np.abs(warmed.q - cold.q)) < 1e-9
@@ -139,3 +141,35 @@ def test_a_warm_start_reaches_the_same_trajectory_in_fewer_sweeps(monkeypatch):
     sweeps.append(0)
     simulate_loads(nearby, shorter, [(2.0, 0.0)], 4.5)
     assert sweeps[-2] == sweeps[-1]
+
+
+@pytest.mark.parametrize('effect', [{}, {'coulomb_friction': 1.0}, {'quadratic_drag': 0.5}])
+def test_a_fits_warm_simulations_stay_within_the_solvers_tolerance(effect, monkeypatch):
+    from lumpbeam_ros.model import integrate
+    from lumpbeam_ros.model.simulate import WarmStart
+
+    effects = Effects()
+    for name, value in effect.items():
+        effects = effects.with_effect(name, value)
+    t = np.arange(0.0, 6.0, 1.0 / 180.0)
+    warm = WarmStart()
+    # A fit's steps: each run starts from the previous one's remainder and contraction, and
+    # may stop at its second sweep on the change predicted from them.
+    steps = [(1.0, 1.0), (1.002, 1.0), (1.0, 1.003), (0.997, 1.002), (1.004, 0.998)]
+    runs = []
+    for k, b in steps:
+        beam = replace(
+            BEAM,
+            effects=effects,
+            k_total_nm_per_rad=BEAM.k_total_nm_per_rad * k,
+            beta_identified=BEAM.beta_identified * b,
+        )
+        runs.append((beam, simulate_loads(beam, t, [(2.0, 0.0)], 4.5, warm=warm)))
+    assert np.isfinite(warm.contraction(2.0, 0.0))
+    solve = integrate.ModalSolver.solve
+    monkeypatch.setattr(
+        integrate.ModalSolver, 'solve', lambda self, *a, **k: solve(self, *a, **k, tol=1e-15)
+    )
+    for beam, run in runs:
+        strict = simulate_loads(beam, t, [(2.0, 0.0)], 4.5)
+        assert np.max(np.abs(run.q - strict.q)) < 1e-11  # the solver's tolerance, rad

@@ -48,13 +48,16 @@ def test_shaped_angles_are_the_weighted_sum_of_the_delayed_command(move):
     assert shaped.joint_names == move.joint_names
 
 
-def test_shaped_move_ends_later_at_rest_at_the_same_angles():
-    move = _move(joints=3)
-    impulses = design_shaper('zvd', [Mode(2.0, 0.05)])
+@pytest.mark.parametrize('rate_hz', [1000.0, 100.0])  # the fractional-delay path, resampled
+@pytest.mark.parametrize('mode', [Mode(2.0, 0.05), Mode(3.0123, 0.0071)])
+def test_shaped_move_starts_and_ends_at_rest_at_exactly_the_same_angles(rate_hz, mode):
+    move = _move(rate_hz=rate_hz, joints=3)
+    impulses = design_shaper('zvd', [mode])
     shaped = shape_trajectory(move, impulses)
     assert shaped.time_s[0] == move.time_s[0]
     assert shaped.time_s[-1] == pytest.approx(move.time_s[-1] + impulses.duration_s, abs=1e-12)
-    assert np.allclose(shaped.angles_rad[-1], move.angles_rad[-1], rtol=0, atol=1e-14)
+    np.testing.assert_array_equal(shaped.angles_rad[0], move.angles_rad[0])
+    np.testing.assert_array_equal(shaped.angles_rad[-1], move.angles_rad[-1])
     assert np.max(np.diff(shaped.time_s)) <= 1e-3 + 1e-15
 
 
