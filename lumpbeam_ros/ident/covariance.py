@@ -94,7 +94,9 @@ def _lag_and_autocovariance(residuals: np.ndarray) -> tuple[int, np.ndarray]:
     return int(np.clip(max(rule, 2 * length), 1, limit)), gamma
 
 
-def sandwich_covariance(jacobian: np.ndarray, residuals: np.ndarray) -> Covariance:
+def sandwich_covariance(
+    jacobian: np.ndarray, residuals: np.ndarray, prior: np.ndarray | None = None
+) -> Covariance:
     """Newey-West covariance of least-squares parameters.
 
     ``cov = (J^T J)^-1 M (J^T J)^-1`` with ``M = sum_k w_k gamma_k C_k`` over lags
@@ -102,9 +104,13 @@ def sandwich_covariance(jacobian: np.ndarray, residuals: np.ndarray) -> Covarian
     ``gamma_k`` and ``C_k = sum_i J_i J_{i+k}^T``. For white residuals it equals
     ``s^2 (J^T J)^-1`` up to sampling noise.
 
+    A prior enters as rows ``G`` of observations weighed to the residuals' variance
+    ``s^2``, independent of the data: ``(J^T J + G^T G)^-1 (M + s^2 G^T G) (J^T J + G^T G)^-1``.
+
     Args:
         jacobian: N x p Jacobian of the model at the solution.
         residuals: N residuals at the solution.
+        prior: The prior's weighted gradient rows (k x p), if any.
 
     Returns:
         The covariance.
@@ -112,7 +118,10 @@ def sandwich_covariance(jacobian: np.ndarray, residuals: np.ndarray) -> Covarian
     n, p = jacobian.shape
     dof = max(n - p, 1)
     s2 = float(residuals @ residuals) / dof
-    bread = np.linalg.pinv(jacobian.T @ jacobian)
+    information = jacobian.T @ jacobian
+    if prior is not None:
+        information = information + prior.T @ prior
+    bread = np.linalg.pinv(information)
     white = s2 * bread
     lag, gamma = _lag_and_autocovariance(residuals)
     kernel = _bartlett(lag) * gamma[: lag + 1] * (n / dof)
@@ -127,6 +136,8 @@ def sandwich_covariance(jacobian: np.ndarray, residuals: np.ndarray) -> Covarian
         # is a convolution of each Jacobian column with the kernel, O(N log N), not O(N lag).
         kernel = np.concatenate([kernel[:0:-1], kernel])
         meat = jacobian.T @ _convolve_same(jacobian, kernel)
+    if prior is not None:
+        meat = meat + s2 * (prior.T @ prior)
     matrix = bread @ meat @ bread
     # Bartlett-tapered biased autocovariances form a positive semi-definite Toeplitz matrix
     # (a Schur product of two), so the meat, and the result, are too; only rounding remains.

@@ -18,6 +18,7 @@ from lumpbeam_ros.bagio.tipseries import MAX_DROPPED_FRACTION, SampleCounts
 from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident import stiffness
+from lumpbeam_ros.ident.backbone import beam_backbone
 from lumpbeam_ros.ident.identification import (
     UNKNOWN,
     AnalysedWindow,
@@ -37,7 +38,12 @@ from lumpbeam_ros.ident.pencil import MatrixPencil
 from lumpbeam_ros.ident.release import Release, detect_release
 from lumpbeam_ros.ident.samples import PoseWindow
 from lumpbeam_ros.ident.settings import IdentifierConfig
-from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParameters, ModeGuess
+from lumpbeam_ros.ident.sinusoid import (
+    DampedSinusoidFit,
+    DampedSinusoidParameters,
+    ModeGuess,
+    ShiftPrior,
+)
 from lumpbeam_ros.model import rules
 from lumpbeam_ros.model.parameters import BeamParameters
 
@@ -198,8 +204,9 @@ def _identify(
         guesses = _initial_modes(t, z, config)
         if not guesses:
             return fail('no oscillation in the window', release=found)
+        prior = _shift_prior(beam, config) if given is None else None
         try:
-            params = _fit_decay(t, z, guesses, start, config)
+            params = _fit_decay(t, z, guesses, start, config, prior)
         except LumpbeamError as exc:
             return fail(f'no oscillation in the window ({exc})', release=found)
         rejection = _reject_mode(params.mode(lowest_mode(params)), params, config)
@@ -245,9 +252,8 @@ def _warm_fit(
     if t[-1] - previous.checked_at_s >= config.recheck_every_s:
         return None
     old = previous.params
-    fit = DampedSinusoidFit(n_modes=old.n_modes, drift=old.drift, nonlinear=old.nonlinear)
     try:
-        params = fit.fit(t, z, t0=start, start=old)
+        params = DampedSinusoidFit.like(old).fit(t, z, t0=start, start=old)
     except LumpbeamError:
         return None
     return FitState(release.time_s, params, previous.checks, previous.checked_at_s)
@@ -277,17 +283,38 @@ def _initial_modes(t: np.ndarray, z: np.ndarray, config: IdentifierConfig) -> li
     return [(first.damped_frequency_hz, first.damping_ratio)]
 
 
+def _shift_prior(beam: BeamParameters, config: IdentifierConfig) -> ShiftPrior | None:
+    """The beam's backbone as the prior of the frequency shift, or ``None``.
+
+    ``None`` when the prior is switched off or the model has no backbone (a beam without
+    gravity cannot be dropped): the shift is then fitted freely. Only for a beam's load
+    release: an arm's ring-down is another structure than the configured beam.
+    """
+    if config.shift_prior_std == 0.0:
+        return None
+    try:
+        backbone = beam_backbone(beam)
+    except LumpbeamError:
+        return None
+    return ShiftPrior(backbone.relative_per_m2, config.shift_prior_std)
+
+
 def _fit_decay(
-    t: np.ndarray, z: np.ndarray, guesses: list[ModeGuess], start: float, config: IdentifierConfig
+    t: np.ndarray,
+    z: np.ndarray,
+    guesses: list[ModeGuess],
+    start: float,
+    config: IdentifierConfig,
+    prior: ShiftPrior | None = None,
 ) -> DampedSinusoidParameters:
     """The least-squares decay, with the modes and nonlinear terms the data support.
 
-    The strongest mode first, with its nonlinear terms when :func:`_wants_nonlinear`; then
-    each further mode that stands out of the noise
+    The strongest mode first, with its nonlinear terms when :func:`_wants_nonlinear` (their
+    frequency shift held to ``prior``); then each further mode that stands out of the noise
     (:func:`~lumpbeam_ros.ident.modes.choose_modes`).
     """
     nonlinear = _wants_nonlinear(guesses[0], t[-1] - start, config)
-    fit = DampedSinusoidFit(n_modes=1, drift=config.drift, nonlinear=nonlinear)
+    fit = DampedSinusoidFit(n_modes=1, drift=config.drift, nonlinear=nonlinear, shift_prior=prior)
     params = fit.fit(t, z, initial=guesses[:1], t0=start)
     if config.max_modes > 1 and params.mode(0).decay_rate > 0.0:
         params = choose_modes(t, z, params, config).params

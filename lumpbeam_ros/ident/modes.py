@@ -241,8 +241,7 @@ def _refit(
     t: np.ndarray, z: np.ndarray, start: DampedSinusoidParameters
 ) -> DampedSinusoidParameters:
     """The least-squares fit from ``start`` (the last solution with the new mode added)."""
-    fit = DampedSinusoidFit(n_modes=start.n_modes, drift=start.drift, nonlinear=start.nonlinear)
-    return fit.fit(t, z, t0=start.t0, start=start)
+    return DampedSinusoidFit.like(start).fit(t, z, t0=start.t0, start=start)
 
 
 def _why_not(

@@ -146,6 +146,13 @@ class IdentifierConfig:
         'fitted stretch T',
         bounds=_POSITIVE,
     )
+    shift_prior_std: float = setting(
+        'fit.shift_prior_std',
+        0.1,
+        "the nonlinear fit's frequency shift is held to the beam model's backbone, give or "
+        'take this fraction of it (a prior); 0 leaves the shift free. Not used for an arm',
+        bounds=_NON_NEGATIVE,
+    )
     recheck_every_s: float = setting(
         'fit.recheck_every_s',
         10.0,

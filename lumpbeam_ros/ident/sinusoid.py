@@ -17,6 +17,12 @@ leading terms of a weakly nonlinear oscillator: a level shift ``e e^{-2 sigma_1 
 frequency shift ``q e^{-2 sigma_1 tau}`` (rad/s) in the first mode's phase,
 ``theta_1 = omega_1 tau + q (1 - e^{-2 sigma_1 tau}) / (2 sigma_1)``. Its ``omega_1`` and
 ``c`` are then the small-amplitude frequency and the true equilibrium.
+
+Over a record the sweep is nearly a ramp of the phase, so ``q`` is nearly collinear with
+``omega_1`` and fitting it costs the frequency most of its precision. A :class:`ShiftPrior`
+brings in what the model knows instead, ``q = gamma omega_1 A_1^2`` with the beam's backbone
+``gamma`` (:mod:`lumpbeam_ros.ident.backbone`), as one more observation weighed by its
+stated uncertainty (a maximum a posteriori fit).
 """
 
 from __future__ import annotations
@@ -37,6 +43,47 @@ ModeGuess = tuple[float, float]
 
 
 @dataclass(frozen=True)
+class ShiftPrior:
+    """What a model says of the first mode's frequency shift: ``q = gamma omega_1 A_1^2``.
+
+    Attributes:
+        relative_per_m2: ``gamma``, the backbone's relative shift per squared amplitude
+            (:class:`~lumpbeam_ros.ident.backbone.Backbone`), 1/m^2.
+        relative_std: The prediction's standard deviation as a fraction of it.
+    """
+
+    relative_per_m2: float
+    relative_std: float
+
+    def predicted(self, x: np.ndarray, first: int) -> float:
+        """``gamma omega_1 A_1^2`` at parameters ``x`` whose first mode starts at ``first``."""
+        a, b, _, w = x[first : first + 4]
+        return float(self.relative_per_m2 * w * (a * a + b * b))
+
+    def row(self, x: np.ndarray, first: int, weight: float) -> tuple[float, np.ndarray]:
+        """The weighted observation ``weight (q - gamma omega_1 A_1^2)`` and its gradient."""
+        a, b, _, w = x[first : first + 4]
+        gamma = self.relative_per_m2
+        gradient = np.zeros(x.size)
+        gradient[first] = -2.0 * gamma * w * a
+        gradient[first + 1] = -2.0 * gamma * w * b
+        gradient[first + 3] = -gamma * (a * a + b * b)
+        gradient[-1] = 1.0
+        return weight * (float(x[-1]) - self.predicted(x, first)), weight * gradient
+
+    def weight(self, x: np.ndarray, first: int, noise: float) -> float:
+        """The observation's weight: the residual noise over the prior's standard deviation.
+
+        The standard deviation is taken at ``x`` (the fit's start) and then held, so the
+        objective does not move under the solver; a floor of 1e-12 of ``omega_1`` keeps a
+        beam whose shift vanishes from an infinite weight.
+        """
+        w = abs(float(x[first + 3]))
+        std = self.relative_std * max(abs(self.predicted(x, first)), 1e-12 * w)
+        return noise / std if std > 0.0 else 0.0
+
+
+@dataclass(frozen=True)
 class DampedSinusoidParameters:
     """A fitted decay.
 
@@ -51,6 +98,7 @@ class DampedSinusoidParameters:
         nonlinear: Whether ``e`` and ``q`` (the amplitude-dependent level and frequency of
             the first mode) end ``x``.
         n_evaluations: Model evaluations the solver needed.
+        shift_prior: The prior ``q`` was fitted with, if any (a refit keeps it).
     """
 
     t0: float
@@ -62,6 +110,7 @@ class DampedSinusoidParameters:
     residual_rms: float
     nonlinear: bool = False
     n_evaluations: int = 0
+    shift_prior: ShiftPrior | None = None
 
     @property
     def _first_mode_index(self) -> int:
@@ -250,8 +299,51 @@ class _Decay:
         return jac
 
 
+class _Problem:
+    """What the solvers minimise: the data's residuals, and the prior's observation if any."""
+
+    def __init__(
+        self, decay: _Decay, y: np.ndarray, prior: ShiftPrior | None = None, weight: float = 0.0
+    ):
+        self.decay = decay
+        self.y = y
+        self.prior = prior
+        self.weight = weight
+
+    def residuals(self, x: np.ndarray) -> np.ndarray:
+        """The model minus the data, then the prior's weighted observation."""
+        residuals = np.asarray(self.decay.value(x) - self.y)
+        if self.prior is None:
+            return residuals
+        return np.append(residuals, self.prior.row(x, self.decay.first, self.weight)[0])
+
+    def jacobian(self, x: np.ndarray) -> np.ndarray:
+        """d residuals / d x."""
+        jacobian = self.decay.jacobian(x)
+        rows = self.prior_rows(x)
+        return jacobian if rows is None else np.vstack([jacobian, rows])
+
+    def prior_rows(self, x: np.ndarray) -> np.ndarray | None:
+        """The prior's weighted gradient as a one-row matrix (``None`` without a prior)."""
+        if self.prior is None:
+            return None
+        return self.prior.row(x, self.decay.first, self.weight)[1][None, :]
+
+    def solve(self, x0: np.ndarray, warm: bool) -> tuple[np.ndarray, int]:
+        """The least-squares solution from ``x0`` and the evaluations it took.
+
+        Gauss-Newton first when ``x0`` is next to the solution (``warm``), else (or when it
+        fails) Levenberg-Marquardt.
+        """
+        found = _gauss_newton(self, x0) if warm else None
+        if found is None:
+            solution = levenberg_marquardt(self.residuals, self.jacobian, x0)
+            found = solution.x, solution.n_evaluations
+        return found
+
+
 def _gauss_newton(
-    decay: _Decay, y: np.ndarray, x0: np.ndarray, max_steps: int = 6
+    problem: _Problem, x0: np.ndarray, max_steps: int = 6
 ) -> tuple[np.ndarray, int] | None:
     """Plain Gauss-Newton from a start next to the solution (a live window's last fit).
 
@@ -265,17 +357,17 @@ def _gauss_newton(
         residuals or it does not converge (the caller then runs the robust solver).
     """
     x = x0
-    residual = decay.value(x) - y
+    residual = problem.residuals(x)
     rss = float(residual @ residual)
-    tolerance = 1e-6 * rss / max(y.size - x.size, 1)
+    tolerance = 1e-6 * rss / max(problem.y.size - x.size, 1)
     for step in range(1, max_steps + 1):
-        jac = decay.jacobian(x)
+        jac = problem.jacobian(x)
         delta, *_ = np.linalg.lstsq(jac, -residual, rcond=None)
         linearised = residual + jac @ delta
         if rss - float(linearised @ linearised) < tolerance:
             return x, step
         trial = x + delta
-        trial_residual = decay.value(trial) - y
+        trial_residual = problem.residuals(trial)
         trial_rss = float(trial_residual @ trial_residual)
         if not trial_rss < rss:
             return None
@@ -382,6 +474,7 @@ class DampedSinusoidFit:
         max_frequency_hz: Band for the automatic starting frequency.
         nonlinear: Also fit the first mode's amplitude-dependent level and frequency (see
             the module docstring).
+        shift_prior: With ``nonlinear``, what the model predicts of the frequency shift.
     """
 
     def __init__(
@@ -391,15 +484,27 @@ class DampedSinusoidFit:
         min_frequency_hz: float = 0.05,
         max_frequency_hz: float = math.inf,
         nonlinear: bool = False,
+        shift_prior: ShiftPrior | None = None,
     ):
         if n_modes < 1:
             raise ValueError('n_modes must be at least 1')
         self.n_modes = n_modes
         self.drift = drift
         self.nonlinear = nonlinear
+        self.shift_prior = shift_prior
         self.min_frequency_hz = min_frequency_hz
         self.max_frequency_hz = max_frequency_hz
         self.params_: DampedSinusoidParameters | None = None
+
+    @classmethod
+    def like(cls, params: DampedSinusoidParameters) -> DampedSinusoidFit:
+        """A fit of the model ``params`` has: its modes, drift, nonlinear terms and prior."""
+        return cls(
+            n_modes=params.n_modes,
+            drift=params.drift,
+            nonlinear=params.nonlinear,
+            shift_prior=params.shift_prior,
+        )
 
     @property
     def n_params(self) -> int:
@@ -452,15 +557,27 @@ class DampedSinusoidFit:
         else:
             x0 = self._start(tau, y, list(initial or []))
         decay = _Decay(tau, self.n_modes, self.drift, self.nonlinear)
+        problem = _Problem(decay, y)
+        prior = self.shift_prior if self.nonlinear else None
+        evaluations = 0
         # A trial step can give a mode a growing envelope that overflows to inf: both solvers
         # reject such a step (its residual is not smaller), and a non-finite solution is
         # refused below, so numpy's warnings would only alarm a reader of the node's log.
         with np.errstate(over='ignore', invalid='ignore'):
-            found = _gauss_newton(decay, y, x0) if start is not None else None
-            if found is None:
-                solution = levenberg_marquardt(lambda x: decay.value(x) - y, decay.jacobian, x0)
-                found = solution.x, solution.n_evaluations
-        x, evaluations = found
+            warm = start is not None
+            if prior is not None:
+                # The prior is weighed against the residual noise: a previous window's, or
+                # that of a fit without the prior, which then starts the one with it.
+                if start is not None:
+                    noise = start.residual_rms
+                else:
+                    x0, evaluations = problem.solve(x0, warm=False)
+                    noise = float(np.sqrt(np.mean((decay.value(x0) - y) ** 2)))
+                    warm = True
+                weight = prior.weight(x0, decay.first, noise) if np.all(np.isfinite(x0)) else 0.0
+                problem = _Problem(decay, y, prior, weight)
+            x, used = problem.solve(x0, warm)
+            evaluations += used
         if not np.all(np.isfinite(x)):
             raise LumpbeamError('damped-sinusoid fit did not converge')
         # A negative omega is the same mode with b (and the sweep) negated; keep it positive.
@@ -472,7 +589,7 @@ class DampedSinusoidFit:
                 if m == 0 and self.nonlinear:
                     x[-1] = -x[-1]
         residuals = decay.value(x) - y
-        cov = sandwich_covariance(decay.jacobian(x), residuals)
+        cov = sandwich_covariance(decay.jacobian(x), residuals, problem.prior_rows(x))
         self.params_ = DampedSinusoidParameters(
             origin,
             x,
@@ -483,6 +600,7 @@ class DampedSinusoidFit:
             float(np.sqrt(np.mean(residuals**2))),
             self.nonlinear,
             evaluations,
+            prior,
         )
         return self.params_
 

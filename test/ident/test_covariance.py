@@ -35,6 +35,24 @@ def test_white_residuals_give_the_textbook_covariance():
     assert choose_lag(rng.normal(size=3000)) == int(4 * 30 ** (2 / 9))
 
 
+@pytest.mark.parametrize('weight', [0.0, 0.5, 3.0])
+def test_a_prior_row_adds_its_information(weight):
+    # Prior rows are observations of the residuals' variance: with white residuals the
+    # covariance is s^2 (J^T J + G^T G)^-1, its diagonal shrinking where the prior bears.
+    rng = np.random.default_rng(3)
+    jac = rng.normal(size=(3000, 2))
+    res = rng.normal(size=3000)
+    prior = np.array([[weight * math.sqrt(3000.0), 0.0]])
+    cov = sandwich_covariance(jac, res, prior)
+    s2 = float(res @ res) / (3000 - 2)
+    expected = s2 * np.linalg.inv(jac.T @ jac + prior.T @ prior)
+    np.testing.assert_allclose(cov.white, expected, rtol=1e-12)
+    np.testing.assert_allclose(np.diag(cov.matrix), np.diag(expected), rtol=0.1)
+    alone = sandwich_covariance(jac, res)
+    assert cov.matrix[0, 0] == pytest.approx(alone.matrix[0, 0] / (1.0 + weight**2), rel=0.1)
+    assert cov.matrix[1, 1] == pytest.approx(alone.matrix[1, 1], rel=0.05)
+
+
 def test_mean_of_correlated_series_has_a_wider_error():
     rng = np.random.default_rng(3)
     e = rng.normal(size=20000)

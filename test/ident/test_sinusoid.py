@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, spectral_peak_hz
+from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit, ShiftPrior, spectral_peak_hz
 
 T = np.arange(0.0, 8.0, 1.0 / 180.0)
 F_D, ZETA, OFFSET, AMP = 3.1, 0.01, -0.01, 0.02
@@ -107,6 +107,47 @@ def test_nonlinear_terms_remove_the_amplitude_bias():
     assert params.level_shift_m == pytest.approx(3e-5, rel=1e-6)
     assert params.offset == pytest.approx(OFFSET, abs=1e-12)
     assert DampedSinusoidFit().fit(T, y).frequency_shift_hz == 0.0
+
+
+#: The backbone that gives :func:`_weakly_nonlinear` its shift: q = gamma f A^2, 1/m^2.
+GAMMA = 2e-3 / (F_D * AMP**2)
+
+
+def test_a_shift_prior_gives_back_the_frequency_precision_the_free_shift_costs():
+    rng = np.random.default_rng(4)
+    y = _weakly_nonlinear(T) + rng.normal(0.0, 200e-6, T.size)
+    free = DampedSinusoidFit(nonlinear=True).fit(T, y)
+    held = DampedSinusoidFit(nonlinear=True, shift_prior=ShiftPrior(GAMMA, 0.1)).fit(T, y)
+    assert held.shift_prior == ShiftPrior(GAMMA, 0.1)
+    assert free.shift_prior is None
+    f_free, f_held = free.mode(0), held.mode(0)
+    assert f_held.damped_frequency_hz_std < f_free.damped_frequency_hz_std / 1.5
+    for mode in (f_free, f_held):
+        assert abs(mode.damped_frequency_hz - F_D) < 3.0 * mode.damped_frequency_hz_std
+    assert held.frequency_shift_hz == pytest.approx(2e-3, rel=0.3)
+
+
+def test_noise_free_data_overrule_a_wrong_prior():
+    # The prior is weighed against the residual noise: with none, the data alone decide.
+    y = _weakly_nonlinear(T)
+    params = DampedSinusoidFit(nonlinear=True, shift_prior=ShiftPrior(-GAMMA, 0.01)).fit(T, y)
+    assert params.frequency_shift_hz == pytest.approx(2e-3, rel=1e-6)
+    assert params.mode(0).damped_frequency_hz == pytest.approx(F_D, rel=1e-9)
+
+
+def test_a_refit_keeps_the_model_and_the_prior():
+    rng = np.random.default_rng(5)
+    y = _weakly_nonlinear(T) + rng.normal(0.0, 200e-6, T.size)
+    cold = DampedSinusoidFit(nonlinear=True, shift_prior=ShiftPrior(GAMMA, 0.1)).fit(T, y)
+    again = DampedSinusoidFit.like(cold)
+    assert (again.nonlinear, again.shift_prior, again.n_modes) == (True, cold.shift_prior, 1)
+    warm = again.fit(T, y, start=cold)
+    assert warm.mode(0).damped_frequency_hz == pytest.approx(
+        cold.mode(0).damped_frequency_hz, abs=0.01 * cold.mode(0).damped_frequency_hz_std
+    )
+    # A linear fit has no shift to hold: the prior is kept for a later nonlinear refit only.
+    linear = DampedSinusoidFit(shift_prior=ShiftPrior(GAMMA, 0.1)).fit(T, y)
+    assert linear.shift_prior is None and linear.frequency_shift_hz == 0.0
 
 
 @pytest.mark.parametrize('nonlinear', [False, True])
