@@ -1,11 +1,12 @@
 """Identifier and peers against the Cramér-Rao bound: frequency and damping of the first mode.
 
 The data: the nonlinear lumped model's drop test (the configured beam, 4.5 kg released at
-2 s, 12 s at 180 Hz) with white pose noise of 20 um, 200 um and 1 mm, over seeded trials.
-The truth: the first mode of the unloaded chain (frequency and damping ratio), the
-small-amplitude limit.
+2 s, 12 s at 180 Hz) with white pose noise of 20 um, 200 um and 1 mm, over seeded trials;
+then the same in MuJoCo (the chain in MuJoCo's own multibody dynamics, which shares none of
+the product's code). The truth: the first mode of the unloaded chain (frequency and damping
+ratio), the small-amplitude limit (MuJoCo's from its own linearization).
 
-Two bounds, computed in the same run, both for the tip z from the release to the end in
+Three bounds, computed in the same run, all for the tip z from the release to the end in
 white noise of the level's sigma (Fisher information ``J^T J / sigma^2``, ``J`` by central
 differences; the bound on a parameter's standard deviation is the square root of that
 diagonal element of the inverse):
@@ -21,6 +22,10 @@ diagonal element of the inverse):
   fast), so an estimator of the small-amplitude frequency that does not know how much is
   bounded by this one; a linear fit is as precise as the linear bound but biased by the
   amplitude-averaged shift.
+- *backbone*: the nonlinear one with what the identifier knows by default, the beam
+  model's backbone (:mod:`lumpbeam_ros.ident.backbone`) as a prior on the shift,
+  ``q = gamma f A^2`` give or take ``fit.shift_prior_std`` of it (a Bayesian bound: the
+  prior's information added to the data's). It lies between the other two.
 
 Peers on the same samples (from 20 ms after the release to the end, the identifier's):
 ERA (pyyeti's :class:`pyyeti.era.ERA`, a benchmark-only dependency) and covariance-driven
@@ -28,26 +33,32 @@ SSI (:func:`~lumpbeam_lab.ident.ssi_cov.ssi_cov_modes`; pyOMA2 does not install 
 
 Each row reports, per level: the identifier's RMS error of ``f`` (bias included) against
 the linear bound, and beside it the bias, the standard deviation and the largest error, the
-nonlinear bound, the peers' RMS errors, the same for ``zeta``, the median of the
-identifier's own reported standard deviations (whether they hold: the RMS error in units of
-them) and the fraction of trials whose truth lies within 3 of them. The levels scale the
-same seeded noise, so their ratios are alike by construction, not three confirmations.
+other bounds, the identifier with the shift fitted freely (``free_shift_``, the default
+before the backbone) and with ``fit.nonlinear`` never (``linear_``), the peers' RMS
+errors, the same for ``zeta``, the median of the identifier's own reported standard
+deviations (whether they hold: the RMS error in units of them) and the fraction of trials
+whose truth lies within 3 of them. The levels scale the same seeded noise, so their ratios
+are alike by construction, not three confirmations.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
 from lumpbeam_lab.bench.bench_result import BenchResult
 from lumpbeam_lab.bench.ident import model_truth
 from lumpbeam_lab.ident.ssi_cov import ssi_cov_modes
+from lumpbeam_lab.mujoco_arm import mujoco_drop_test
 from lumpbeam_ros.blas import single_threaded_blas
+from lumpbeam_ros.ident.backbone import beam_backbone
 from lumpbeam_ros.ident.identify import identify
 from lumpbeam_ros.ident.samples import PoseWindow, clean_window
 from lumpbeam_ros.ident.settings import IdentifierConfig
+from lumpbeam_ros.ident.sinusoid import ShiftPrior
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, load_beam_config
 from lumpbeam_ros.model.simulate import simulate_drop_test
 from lumpbeam_ros.model.statics import static_tip_deflection
@@ -61,6 +72,8 @@ DURATION_S = 12.0
 SKIP_S = IdentifierConfig().skip_after_release_s
 #: Pose noise levels, m (and rad for the pitch).
 LEVELS_M = (20e-6, 200e-6, 1e-3)
+#: Whose drop tests: the product's lumped model and MuJoCo's chain (independent).
+SOURCES = ('model', 'mujoco')
 #: Trials per level: enough that an RMS ratio is known to about 15 %.
 SEEDS = 20
 #: The peers' frequency band: above the offset's near-zero poles, below Nyquist.
@@ -92,13 +105,18 @@ def damped_sinusoid(t: np.ndarray, theta: np.ndarray) -> np.ndarray:
     return np.asarray(z)
 
 
-def cramer_rao(t: np.ndarray, theta: np.ndarray, sigma: float) -> np.ndarray:
+def cramer_rao(
+    t: np.ndarray, theta: np.ndarray, sigma: float, prior: ShiftPrior | None = None
+) -> np.ndarray:
     """Standard-deviation bounds of ``theta`` for :func:`damped_sinusoid` in white noise.
 
     Args:
         t: Sample times from the release, s.
         theta: ``(c, A, zeta, f, p)`` or ``(c, A, zeta, f, p, e, q)``.
         sigma: Noise standard deviation, m.
+        prior: With the 7 parameters: the backbone's prior on ``q``, whose information
+            ``g g^T / s^2`` is added (``g`` the gradient of ``q - gamma f A^2``, ``s`` its
+            standard deviation).
 
     Returns:
         The bound on each parameter's standard deviation, same order.
@@ -112,6 +130,12 @@ def cramer_rao(t: np.ndarray, theta: np.ndarray, sigma: float) -> np.ndarray:
         columns.append((damped_sinusoid(t, up) - damped_sinusoid(t, down)) / (2.0 * step))
     jacobian = np.column_stack(columns)
     fisher = jacobian.T @ jacobian / sigma**2
+    if prior is not None:
+        gamma, amplitude, f = prior.relative_per_m2, float(theta[1]), float(theta[3])
+        gradient = np.array([0.0, -2.0 * gamma * f * amplitude, 0.0, -gamma * amplitude**2])
+        gradient = np.concatenate([gradient, [0.0, 0.0, 1.0]])
+        std = prior.relative_std * gamma * f * amplitude**2
+        fisher += np.outer(gradient, gradient) / std**2
     return np.asarray(np.sqrt(np.diag(np.linalg.inv(fisher))))
 
 
@@ -200,26 +224,57 @@ def _errors(
     return details
 
 
-def level_row(sigma: float, seeds: int, peers: dict[str, Peer] | None = None) -> BenchResult:
+@dataclass(frozen=True)
+class DropData:
+    """A noise-free drop test and the truth of its first mode."""
+
+    t: np.ndarray
+    z: np.ndarray
+    pitch: np.ndarray
+    natural_frequency_hz: float
+    damping_ratio: float
+
+
+def drop_data(beam: BeamParameters, source: str) -> DropData:
+    """The drop test of ``beam``: the product's lumped model's or MuJoCo's (``mujoco``).
+
+    MuJoCo's chain is the independent model: its own multibody dynamics and integrator
+    (:func:`~lumpbeam_lab.mujoco_arm.mujoco_drop_test`); its truth is its own linearization.
+    """
+    if source == 'mujoco':
+        drop = mujoco_drop_test(beam, LOAD_KG, RELEASE_S, DURATION_S, RATE_HZ)
+        return DropData(drop.t, drop.z, drop.pitch, drop.natural_frequency_hz, drop.damping_ratio)
+    exact = simulate_drop_test(beam, DropTestConfig(LOAD_KG, RELEASE_S, DURATION_S), RATE_HZ)
+    truth = model_truth(beam)
+    return DropData(
+        exact.t, exact.z, exact.pitch, truth['natural_frequency_hz'], truth['damping_ratio']
+    )
+
+
+def level_row(
+    sigma: float, seeds: int, peers: dict[str, Peer] | None = None, source: str = 'model'
+) -> BenchResult:
     """The identifier's and the peers' frequency and damping errors at one noise level.
 
-    Besides the identifier as configured (``fit.nonlinear`` auto) it runs the identifier
-    with ``fit.nonlinear`` never (``linear_``): the linear model's bias against its variance.
+    Besides the identifier as configured (``fit.nonlinear`` auto, the shift held to the
+    backbone) it runs the identifier with the shift free (``free_shift_``) and with
+    ``fit.nonlinear`` never (``linear_``): the linear model's bias against its variance.
 
     Args:
         sigma: Pose noise, m.
         seeds: Trials.
         peers: The peers to run on the same trials (default :data:`PEERS`).
+        source: Whose drop test: ``model`` (the product's) or ``mujoco``.
 
     Returns:
-        The ``crb_<level>`` row.
+        The ``crb_<level>`` row (``crb_mujoco_<level>`` on MuJoCo's drop).
     """
     peers = PEERS if peers is None else peers
     beam, _ = load_beam_config()
-    truth = model_truth(beam)
-    exact = simulate_drop_test(beam, DropTestConfig(LOAD_KG, RELEASE_S, DURATION_S), RATE_HZ)
+    exact = drop_data(beam, source)
     configs = {
         '': IdentifierConfig(max_fit_s=DURATION_S),
+        'free_shift_': IdentifierConfig(max_fit_s=DURATION_S, shift_prior_std=0.0),
         'linear_': IdentifierConfig(max_fit_s=DURATION_S, nonlinear='never'),
     }
     decay = exact.t >= RELEASE_S + SKIP_S
@@ -227,8 +282,8 @@ def level_row(sigma: float, seeds: int, peers: dict[str, Peer] | None = None) ->
     first: dict[str, float] = {}
     for seed in range(seeds):
         rng = np.random.default_rng(1000 + seed)
-        z = exact.z + rng.normal(0.0, sigma, len(exact))
-        pitch = exact.pitch + rng.normal(0.0, sigma, len(exact))
+        z = exact.z + rng.normal(0.0, sigma, exact.t.size)
+        pitch = exact.pitch + rng.normal(0.0, sigma, exact.t.size)
         window = clean_window(exact.t, z, pitch)
         estimates: dict[str, float] = {}
         for prefix, config in configs.items():
@@ -248,7 +303,9 @@ def level_row(sigma: float, seeds: int, peers: dict[str, Peer] | None = None) ->
     bound = cramer_rao(t, theta, sigma)
     shifts = [first['level_shift'], first['frequency_shift']]
     bound_nl = cramer_rao(t, np.concatenate([theta, shifts]), sigma)
-    f_truth, zeta_truth = truth['natural_frequency_hz'], truth['damping_ratio']
+    prior = ShiftPrior(beam_backbone(beam).relative_per_m2, configs[''].shift_prior_std)
+    bound_prior = cramer_rao(t, np.concatenate([theta, shifts]), sigma, prior)
+    f_truth, zeta_truth = exact.natural_frequency_hz, exact.damping_ratio
     f_bound, zeta_bound = float(bound[3]), float(bound[2])
     details: dict[str, float | int] = {
         'noise_m': sigma,
@@ -256,17 +313,22 @@ def level_row(sigma: float, seeds: int, peers: dict[str, Peer] | None = None) ->
         'f_truth_hz': f_truth,
         'f_bound': f_bound,
         'f_bound_nonlinear': float(bound_nl[3]),
+        'f_bound_backbone': float(bound_prior[3]),
         'zeta_truth': zeta_truth,
         'zeta_bound': zeta_bound,
         'zeta_bound_nonlinear': float(bound_nl[2]),
+        'zeta_bound_backbone': float(bound_prior[2]),
     }
     for prefix in [*configs, *(f'{name}_' for name in peers)]:
         reported = prefix in configs
         details.update(_errors(f'{prefix}f', found, f_truth, f_bound, reported))
         details.update(_errors(f'{prefix}zeta', found, zeta_truth, zeta_bound, reported))
-    details['f_rms_over_bound_nonlinear'] = details['f_error_rms'] / details['f_bound_nonlinear']
+    for bound_name in ('nonlinear', 'backbone'):
+        details[f'f_rms_over_bound_{bound_name}'] = (
+            details['f_error_rms'] / details[f'f_bound_{bound_name}']
+        )
     return BenchResult(
-        name=f'crb_{sigma * 1e6:g}um',
+        name=f'crb_{"mujoco_" if source == "mujoco" else ""}{sigma * 1e6:g}um',
         value=float(details['f_error_rms']),
         unit='Hz RMS error of f',
         baseline='Cramér-Rao bound of f (one damped sinusoid, white noise)',
@@ -283,6 +345,7 @@ def run(quick: bool = False) -> list[BenchResult]:
         quick: Two trials per level instead of :data:`SEEDS`.
 
     Returns:
-        One row per level, 20 um first.
+        One row per level, 20 um first, on the model's drop and then on MuJoCo's.
     """
-    return [level_row(sigma, 2 if quick else SEEDS) for sigma in LEVELS_M]
+    seeds = 2 if quick else SEEDS
+    return [level_row(sigma, seeds, source=source) for source in SOURCES for sigma in LEVELS_M]

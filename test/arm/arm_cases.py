@@ -2,24 +2,15 @@
 
 import numpy as np
 
+from lumpbeam_lab.mujoco_arm import beam_as_arm
 from lumpbeam_ros.arm.config import ArmConfig, arm_from_mapping
 from lumpbeam_ros.arm.drive import SmoothMotion
 from lumpbeam_ros.model.parameters import BeamParameters
 
-#: The identified beam's damping as a spring-by-spring beta: c_E / k_E (B.13, B.23).
-PAPER_BETA = 12 * 0.08 / 3899.1
-
 
 def paper_beam_arm(beam: BeamParameters) -> ArmConfig:
     """The identified paper beam (mounted mass at the free end) as a one-link arm."""
-    link = {
-        'length_m': beam.length_m,
-        'n_segments': beam.n_segments,
-        'k_total_nm_per_rad': beam.k_total_nm_per_rad,
-        'mass_kg': beam.mass_kg,
-        'damping_beta': beam.beta_identified * beam.c_total / beam.k_total_nm_per_rad,
-    }
-    return arm_from_mapping({'arm': {'payload_kg': beam.tip_mass_kg, 'links': [link]}}, 'paper')
+    return beam_as_arm(beam)
 
 
 def small_arm(n_links: int, plane: str = 'vertical') -> ArmConfig:

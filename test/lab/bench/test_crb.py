@@ -52,6 +52,7 @@ def test_quick_rows_compare_the_identifier_and_a_peer_with_the_bounds():
     d = row.details
     assert d['f_rms_over_bound'] == pytest.approx(row.value / row.baseline_value)
     assert d['f_bound_nonlinear'] > 5.0 * d['f_bound']
+    assert d['f_bound'] < d['f_bound_backbone'] < 2.0 * d['f_bound']
     # No estimator beats the bound by much over two trials; the identifier's damping is
     # close to it and its reported sds hold.
     assert d['zeta_rms_over_bound'] > 0.1 and d['zeta_rms_in_reported_std'] < 3.0
@@ -61,3 +62,21 @@ def test_quick_rows_compare_the_identifier_and_a_peer_with_the_bounds():
     for prefix in ('linear_', 'ssi_cov_'):
         assert 0.3 < d[f'{prefix}f_rms_over_bound'] < 6.0
         assert d[f'{prefix}f_error_bias'] > 0.0
+    # The shift held to the backbone, the frequency is within a few bounds (and so is the
+    # free shift's, against its own, larger bound).
+    assert d['f_rms_over_bound'] < 4.0
+    assert d['free_shift_f_rms_over_bound'] < 4.0 * d['f_bound_nonlinear'] / d['f_bound']
+
+
+def test_the_backbone_prior_brings_the_shifts_bound_back_towards_the_linear_one():
+    t = np.arange(0.0, 10.0, 1.0 / RATE)
+    theta = np.array([0.0, 0.04, 0.0024, 3.0, 0.0, 7e-6, 2e-5])
+    bounds = [
+        crb.cramer_rao(t, theta, 2e-5, crb.ShiftPrior(0.0045, std))[3] for std in (1e-6, 0.1, 1e6)
+    ]
+    linear, nonlinear = crb.cramer_rao(t, theta[:5], 2e-5)[3], crb.cramer_rao(t, theta, 2e-5)[3]
+    # A sure prior leaves the linear bound (nearly: the level shift is still unknown), a
+    # vague one the nonlinear bound; 10 % of the shift lies between.
+    assert bounds[0] == pytest.approx(linear, rel=0.05)
+    assert bounds[2] == pytest.approx(nonlinear, rel=1e-3)
+    assert bounds[0] < bounds[1] < bounds[2]
