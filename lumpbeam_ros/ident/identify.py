@@ -199,12 +199,12 @@ def _identify(
             unusable=True,
             release=found,
         )
-    state = _warm_fit(t, z, start, release, previous, config)
+    prior = _shift_prior(beam, config) if given is None else None
+    state = _warm_fit(t, z, start, release, previous, config, prior)
     if state is None:
         guesses = _initial_modes(t, z, config)
         if not guesses:
             return fail('no oscillation in the window', release=found)
-        prior = _shift_prior(beam, config) if given is None else None
         try:
             params = _fit_decay(t, z, guesses, start, config, prior)
         except LumpbeamError as exc:
@@ -245,15 +245,26 @@ def _warm_fit(
     release: Release,
     previous: FitState | None,
     config: IdentifierConfig,
+    prior: ShiftPrior | None,
 ) -> FitState | None:
-    """The fit restarted from ``previous``, or ``None`` when a full identification is due."""
+    """The fit restarted from ``previous``, or ``None`` when a full identification is due.
+
+    It keeps the previous model, but for the nonlinear terms: a decay that has grown long
+    enough for them since (:func:`_wants_nonlinear`) gets them, held to ``prior``, or its
+    frequency would keep the linear model's amplitude-averaged bias until the next check.
+    """
     if previous is None or not _same_release(previous.release_time_s, release.time_s):
         return None
     if t[-1] - previous.checked_at_s >= config.recheck_every_s:
         return None
     old = previous.params
+    fit = DampedSinusoidFit.like(old)
+    first = old.mode(0)
+    guess = (first.damped_frequency_hz, first.damping_ratio)
+    if not old.nonlinear and _wants_nonlinear(guess, t[-1] - start, config):
+        fit = DampedSinusoidFit(old.n_modes, old.drift, nonlinear=True, shift_prior=prior)
     try:
-        params = DampedSinusoidFit.like(old).fit(t, z, t0=start, start=old)
+        params = fit.fit(t, z, t0=start, start=old)
     except LumpbeamError:
         return None
     return FitState(release.time_s, params, previous.checks, previous.checked_at_s)

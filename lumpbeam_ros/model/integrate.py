@@ -7,7 +7,7 @@ nonlinear remainder ``r``:
     r = -(M(phi) - M0) phi'' - S(phi) phi'^2 + g G (cos phi - cos phi_eq + sin phi_eq d) + Q_e.
 
 The linear part is solved exactly in its complex modal coordinates (each mode a first-order
-recurrence with a first-order-hold input, run by ``scipy.signal.lfilter``); ``r`` is then
+recurrence with a first-order-hold input, run as a doubling scan); ``r`` is then
 evaluated for the whole time grid at once with a few matrix products, and the two steps
 alternate (waveform relaxation) until the trajectory stops changing. A beam's deflection
 angles are small, so ``r`` is a fraction of a percent of the forces and a handful of sweeps
@@ -22,8 +22,6 @@ from contextlib import nullcontext
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.signal import lfilter
 
 from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.errors import SolverBudgetError
@@ -340,6 +338,10 @@ def solve_reference(
             per second simulated so far. The equations are too stiff or unstable to simulate
             (they would run for hours).
     """
+    # Imported here: the modal solver, which nearly every simulation ends in, needs no scipy,
+    # and importing it would cost `lumpbeam analyze` (whose backbone simulates) its start-up.
+    from scipy.integrate import solve_ivp
+
     n = chain.n
     t0 = float(t_eval[0])
     duration = float(t_eval[-1]) - t0
@@ -413,10 +415,21 @@ def _hold_drive(
 
 
 def _free_response(drive: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """``z_k = e z_{k-1} + drive_k`` per mode (``z_0 = drive_0``), by ``lfilter``."""
-    z: np.ndarray = np.empty_like(drive)
-    for m in range(e.size):
-        z[:, m] = lfilter([1.0], [1.0, -e[m]], drive[:, m])
+    """``z_k = e z_{k-1} + drive_k`` per mode (``z_0 = drive_0``), by a doubling scan.
+
+    After pass ``s``, ``z_k`` sums ``e^j drive_{k-j}`` for ``j < 2^s`` (Hillis and Steele's
+    parallel prefix, 1986): ``log2 N`` whole-array passes instead of N steps, as fast as
+    ``scipy.signal.lfilter`` mode by mode and within 1e-13 of it, without importing
+    scipy.signal (about as long as a whole ``lumpbeam analyze``).
+    """
+    z: np.ndarray = drive.copy()
+    power = np.asarray(e).copy()
+    shift = 1
+    while shift < z.shape[0]:
+        # The right-hand side is evaluated into a temporary first: the old z, as the scan needs.
+        z[shift:] += power * z[:-shift]
+        power = power * power
+        shift *= 2
     return z
 
 

@@ -13,11 +13,11 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.interpolate import CubicHermiteSpline
 
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.interface import POSE_RATE_HZ
 from lumpbeam_ros.model.chain import LumpedChain
+from lumpbeam_ros.model.hermite import hermite
 from lumpbeam_ros.model.integrate import ChainState, ModalSolver, solve_reference
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.model.sensor import measured_position
@@ -193,8 +193,7 @@ class BeamSimulation:
             return solution.phi[-1:].repeat(t_out.size, 0), solution.phi_dot[-1:].repeat(
                 t_out.size, 0
             )
-        spline = CubicHermiteSpline(grid_t, solution.phi, solution.phi_dot, axis=0)
-        return spline(t_out), spline(t_out, 1)
+        return hermite(grid_t, solution.phi, solution.phi_dot, t_out)
 
 
 def simulate_loads(

@@ -5,11 +5,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from scipy.integrate import quad
+from scipy.signal import lfilter
 
 from lumpbeam_ros.model.chain import LumpedChain
 from lumpbeam_ros.model.integrate import (
     ChainState,
     ModalSolver,
+    _free_response,
     friction_steps,
     friction_steps_loop,
     solve_reference,
@@ -211,3 +213,18 @@ def test_the_reference_integrator_stops_at_its_budget(k3):
     assert run.stdout.startswith('refused: the reference integrator spent ')
     assert 'too stiff or unstable to simulate' in run.stdout
     assert run.stderr == ''  # no numpy warnings on the way
+
+
+@pytest.mark.parametrize('n', [1, 2, 3, 500, 2161])
+def test_the_modal_recurrence_is_lfilters(n):
+    # Lightly damped (|e| near 1) to heavily damped modes, as a chain's.
+    rng = np.random.default_rng(n)
+    poles = np.concatenate(
+        [[-0.045 + 19.2j], -rng.uniform(1e-3, 50.0, 9) + 1j * rng.uniform(1, 3e3, 9)]
+    )
+    e = np.exp(poles / 360.0)
+    drive = rng.normal(size=(n, 10)) + 1j * rng.normal(size=(n, 10))
+    expected = np.column_stack([lfilter([1.0], [1.0, -e[m]], drive[:, m]) for m in range(10)])
+    found = _free_response(drive, e)
+    np.testing.assert_allclose(found, expected, rtol=0.0, atol=1e-13 * np.abs(expected).max())
+    assert np.array_equal(drive[0], found[0])
