@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from lumpbeam_ros.model.chain import LumpedChain
-from lumpbeam_ros.model.integrate import hold_weights
+from lumpbeam_ros.model.integrate import first_order_scan, hold_weights
 from lumpbeam_ros.model.modes import LinearModel
 
 #: Joint travel a linearization serves (half of it on either side), rad. On the bench's arm
@@ -49,9 +49,6 @@ RELINEARIZE_RAD = 0.4
 
 #: A jump of the rates at a piece's start at least this large is a kick (a knot), rad/s.
 KICK_RAD_S = 1e-6
-
-#: A mode's ``e^{lambda t}`` below this is gone for the scan (double rounding).
-_NEGLIGIBLE = 1e-17
 
 #: How far the first guess of a window carries the deflections' starting rate, s.
 GUESS_HORIZON_S = 0.02
@@ -179,7 +176,7 @@ class _Modes:
             g[1] = self.q_before * self.product(before, self.b) + w_at[0] + w_after[1]
         np.add(w_before[:-2], w_at[1:-1], out=g[2:])
         g[2:] += w_after[2:]
-        z = _scan(g, self.e)
+        z = first_order_scan(g, self.e)
         return np.asarray((z.view(float) if self.is_complex else z) @ self.v)
 
 
@@ -234,25 +231,6 @@ def _interleaved(b: np.ndarray) -> np.ndarray:
     out = np.empty((b.shape[0], 2 * b.shape[1]))
     out[:, 0::2], out[:, 1::2] = b.real, b.imag
     return out
-
-
-def _scan(z: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """``z_k = e z_{k-1} + g_k`` (``z_0 = g_0``) for every column, by doubling, in place.
-
-    ``z`` holds ``g`` on entry. The columns are ordered by decreasing ``|e|``; a pass leaves
-    out those whose ``e^step`` has fallen below the rounding of what it adds to (a mode that
-    has died out).
-    """
-    power = e.copy()
-    step = 1
-    while step < z.shape[0]:
-        alive = int(np.count_nonzero(np.abs(power) > _NEGLIGIBLE))
-        if alive == 0:
-            break
-        z[step:, :alive] += power[:alive] * z[:-step, :alive]
-        power = power * power
-        step *= 2
-    return z
 
 
 class DeflectionSolver:

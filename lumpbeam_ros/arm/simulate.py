@@ -32,7 +32,6 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
-from scipy.interpolate import CubicHermiteSpline
 
 from lumpbeam_ros.arm.drive import JointMotion, SampledMotion
 from lumpbeam_ros.arm.ltv import DeflectionSolver, RigidMotion
@@ -40,6 +39,7 @@ from lumpbeam_ros.arm.model import ArmModel
 from lumpbeam_ros.arm.statics import arm_equilibrium
 from lumpbeam_ros.blas import single_threaded_blas
 from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.model.hermite import hermite
 from lumpbeam_ros.model.integrate import ChainState, ModalSolver
 from lumpbeam_ros.model.modes import LinearModel
 
@@ -284,27 +284,7 @@ def _simulate_modal(
     t = np.concatenate(grid_t)
     if t.size < 2:
         return np.vstack(grid_phi), np.vstack(grid_rate)
-    return _hermite(t, np.vstack(grid_phi), np.vstack(grid_rate), t_eval)
-
-
-def _hermite(
-    t: np.ndarray, y: np.ndarray, y_dot: np.ndarray, at: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """The cubic Hermite interpolation of ``(y, y')`` on ``t`` and its derivative at ``at``.
-
-    Only the intervals asked for are evaluated: building a spline object on the whole grid
-    cost more than the solver's ring-down sweeps.
-    """
-    i = np.clip(np.searchsorted(t, at, side='right') - 1, 0, t.size - 2)
-    step = (t[i + 1] - t[i])[:, None]
-    s = (at - t[i])[:, None] / step
-    y0, y1, m0, m1 = y[i], y[i + 1], y_dot[i] * step, y_dot[i + 1] * step
-    s2 = s * s
-    s3 = s2 * s
-    value = (2 * s3 - 3 * s2 + 1) * y0 + (s3 - 2 * s2 + s) * m0 + (3 * s2 - 2 * s3) * y1
-    value += (s3 - s2) * m1
-    rate = (6 * s2 - 6 * s) * (y0 - y1) + (3 * s2 - 4 * s + 1) * m0 + (3 * s2 - 2 * s) * m1
-    return value, rate / step
+    return hermite(t, np.vstack(grid_phi), np.vstack(grid_rate), t_eval)
 
 
 def _simulate_lsoda(
@@ -403,5 +383,4 @@ def _ring_down(
     solution = ModalSolver(chain, linear).solve(state, float(times[-1]), RING_DOWN_STEP_S)
     if solution is None:
         return None
-    spline = CubicHermiteSpline(solution.t, solution.phi, solution.phi_dot, axis=0)
-    return spline(times), spline.derivative()(times)
+    return hermite(solution.t, solution.phi, solution.phi_dot, times)

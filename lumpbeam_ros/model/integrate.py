@@ -415,21 +415,38 @@ def _hold_drive(
 
 
 def _free_response(drive: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """``z_k = e z_{k-1} + drive_k`` per mode (``z_0 = drive_0``), by a doubling scan.
+    """``z_k = e z_{k-1} + drive_k`` per mode (``z_0 = drive_0``): :func:`first_order_scan`."""
+    return first_order_scan(drive.copy(), e)
 
-    After pass ``s``, ``z_k`` sums ``e^j drive_{k-j}`` for ``j < 2^s`` (Hillis and Steele's
-    parallel prefix, 1986): ``log2 N`` whole-array passes instead of N steps, as fast as
-    ``scipy.signal.lfilter`` mode by mode and within 1e-13 of it, without importing
-    scipy.signal (about as long as a whole ``lumpbeam analyze``).
+
+#: A mode's ``e^step`` below this adds nothing the rounding keeps: the scan leaves it out.
+NEGLIGIBLE_POWER = 1e-17
+
+
+def first_order_scan(z: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """``z_k = e z_{k-1} + g_k`` (``z_0 = g_0``) for every column, by doubling, in place.
+
+    ``z`` holds ``g`` on entry. After pass ``s``, ``z_k`` sums ``e^j g_{k-j}`` for
+    ``j < 2^s`` (Hillis and Steele's parallel prefix, 1986): ``log2 N`` whole-array passes
+    instead of N steps, as fast as ``scipy.signal.lfilter`` column by column and within
+    1e-13 of it, without importing scipy.signal (about as long as a whole
+    ``lumpbeam analyze``). Columns ordered by decreasing ``|e|`` let a pass leave out the
+    trailing ones whose ``e^step`` is below :data:`NEGLIGIBLE_POWER` (modes that have died
+    out); in another order every column is scanned.
     """
-    z: np.ndarray = drive.copy()
     power = np.asarray(e).copy()
-    shift = 1
-    while shift < z.shape[0]:
+    step = 1
+    while step < z.shape[0]:
+        alive = np.abs(power) > NEGLIGIBLE_POWER
+        count = int(np.argmin(alive)) if not alive.all() else alive.size
+        if alive[count:].any():
+            count = alive.size
+        if count == 0:
+            break
         # The right-hand side is evaluated into a temporary first: the old z, as the scan needs.
-        z[shift:] += power * z[:-shift]
+        z[step:, :count] += power[:count] * z[:-step, :count]
         power = power * power
-        shift *= 2
+        step *= 2
     return z
 
 

@@ -6,24 +6,13 @@ import numpy as np
 import pytest
 
 from arm.arm_cases import small_arm
-from lumpbeam_ros.arm.ltv import SERIES_RAD, DeflectionSolver, RigidMotion, _scan, _turned
+from lumpbeam_ros.arm.ltv import SERIES_RAD, DeflectionSolver, RigidMotion, _turned
 from lumpbeam_ros.arm.model import ArmModel
 from lumpbeam_ros.arm.statics import arm_equilibrium
 
 
 def _joint_angles(model):
     return lambda phi: np.diff(phi, axis=-1, prepend=0.0)[..., model.link_starts]
-
-
-def test_the_doubling_scan_is_the_recurrence():
-    rng = np.random.default_rng(3)
-    e = np.array([0.999 * np.exp(0.3j), 0.7 * np.exp(2j), 0.01, 1e-30])
-    g = rng.normal(size=(37, 4)) + 1j * rng.normal(size=(37, 4))
-    z = np.empty_like(g)
-    z[0] = g[0]
-    for k in range(1, 37):
-        z[k] = e * z[k - 1] + g[k]
-    assert _scan(g, e) == pytest.approx(z, abs=1e-13)
 
 
 @pytest.mark.parametrize('largest', [SERIES_RAD, 3.0])

@@ -5,12 +5,11 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from scipy.interpolate import CubicHermiteSpline
 
 from arm.arm_cases import paper_beam_arm, small_arm, smooth_move
 from lumpbeam_ros.arm.drive import SampledMotion
 from lumpbeam_ros.arm.model import ArmModel
-from lumpbeam_ros.arm.simulate import _hermite, _MomentumForm, simulate_arm
+from lumpbeam_ros.arm.simulate import _MomentumForm, simulate_arm
 from lumpbeam_ros.arm.statics import arm_equilibrium
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.model.chain import LumpedChain
@@ -20,17 +19,6 @@ from lumpbeam_ros.model.parameters import load_beam_config
 BEAM, _ = load_beam_config(None)
 STILL_2 = SampledMotion.from_arrays(np.array([0.0, 1.0]), np.zeros((2, 2)))
 STILL_3 = SampledMotion.from_arrays(np.array([0.0, 1.0]), np.zeros((2, 3)))
-
-
-def test_the_output_interpolation_is_scipys_cubic_hermite_spline():
-    rng = np.random.default_rng(2)
-    t = np.cumsum(rng.uniform(0.1, 1.0, 20))
-    y, y_dot = rng.normal(size=(20, 3)), rng.normal(size=(20, 3))
-    at = np.concatenate([t[[0, 4, -1]], np.sort(rng.uniform(t[0], t[-1], 40))])
-    spline = CubicHermiteSpline(t, y, y_dot, axis=0)
-    value, rate = _hermite(t, y, y_dot, at)
-    assert value == pytest.approx(spline(at), abs=1e-13)
-    assert rate == pytest.approx(spline(at, 1), abs=1e-13)
 
 
 def test_an_arm_held_still_stays_at_rest():

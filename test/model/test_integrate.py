@@ -12,6 +12,7 @@ from lumpbeam_ros.model.integrate import (
     ChainState,
     ModalSolver,
     _free_response,
+    first_order_scan,
     friction_steps,
     friction_steps_loop,
     solve_reference,
@@ -228,3 +229,23 @@ def test_the_modal_recurrence_is_lfilters(n):
     found = _free_response(drive, e)
     np.testing.assert_allclose(found, expected, rtol=0.0, atol=1e-13 * np.abs(expected).max())
     assert np.array_equal(drive[0], found[0])
+
+
+@pytest.mark.parametrize(
+    'e',
+    [
+        [0.999 * np.exp(0.3j), 0.7 * np.exp(2j), 0.01, 1e-30],
+        # Out of order: the dying modes first, a living one after them.
+        [1e-30, 0.01, 0.7 * np.exp(2j), 0.999 * np.exp(0.3j)],
+    ],
+    ids=['slowest_first', 'dying_first'],
+)
+def test_the_doubling_scan_is_the_recurrence(e):
+    e = np.asarray(e)
+    rng = np.random.default_rng(3)
+    g = rng.normal(size=(37, 4)) + 1j * rng.normal(size=(37, 4))
+    z = np.empty_like(g)
+    z[0] = g[0]
+    for k in range(1, 37):
+        z[k] = e * z[k - 1] + g[k]
+    assert first_order_scan(g, e) == pytest.approx(z, abs=1e-13)
