@@ -38,7 +38,7 @@ AMPLITUDE_OF_LENGTH = 0.02
 #: Periods of the first mode simulated per amplitude.
 PERIODS = 16
 #: Samples per period of the first mode.
-SAMPLES_PER_PERIOD = 60
+SAMPLES_PER_PERIOD = 40
 #: The simulator's steps per sample: with two, ``gamma`` is within 0.1 % of MuJoCo's for the
 #: paper's beam (one step per sample leaves it 0.2 % low; a grid off the samples, some %).
 STEPS_PER_SAMPLE = 2
