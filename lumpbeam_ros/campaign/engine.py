@@ -8,6 +8,7 @@ is flushed at least once a second, so an interrupted campaign keeps what it comp
 from __future__ import annotations
 
 import logging
+import multiprocessing
 import time
 from collections.abc import Sequence
 from contextlib import ExitStack
@@ -30,6 +31,8 @@ from lumpbeam_ros.progress import Progress
 
 #: Seconds to wait for a scheduler given by address before giving up.
 CONNECT_TIMEOUT_S = 10.0
+#: How long an abandoned worker process is given to end once told to, s.
+_ABANDONED_WORKER_JOIN_S = 5.0
 
 
 @dataclass(frozen=True)
@@ -101,6 +104,7 @@ def start_client(
         from distributed.deploy.spec import SpecCluster
 
         registered = set(SpecCluster._instances)
+        children = set(multiprocessing.active_children())
         try:
             cluster = LocalCluster(
                 n_workers=workers,
@@ -119,6 +123,12 @@ def start_client(
             # fails there; asyncio logs that task's exception, traceback and all, when the
             # task is collected at exit.
             logging.getLogger('asyncio').setLevel(logging.CRITICAL)
+            # A worker still starting reads its start-up state (a semaphore among it) from
+            # this process; once this one has exited the semaphore is gone, and the worker
+            # prints a traceback of its own. Ended first, it has nothing to print.
+            for child in set(multiprocessing.active_children()) - children:
+                child.terminate()
+                child.join(_ABANDONED_WORKER_JOIN_S)
             raise
         stack.enter_context(cluster)
         return stack.enter_context(Client(cluster))
