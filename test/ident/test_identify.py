@@ -259,6 +259,22 @@ def test_the_backbone_holds_the_frequency_shift(drop_case, beam, prior_std, held
     assert (f.std < 3e-5) == held, f.std
 
 
+def test_a_warm_fit_takes_the_nonlinear_terms_once_the_decay_is_long_enough(drop_case):
+    trajectory, truth = drop_case()
+    config = IdentifierConfig(recheck_every_s=100.0)
+    # One second after the release the decay is too short for them (fit.nonlinear auto).
+    _, state = identify_from(_window(trajectory.between(0.0, 3.0), True), BEAM, config)
+    assert not state.params.nonlinear
+    whole = _window(trajectory, True)
+    result, warm = identify_from(whole, BEAM, config, previous=state)
+    assert warm.checked_at_s == state.checked_at_s  # restarted, not identified anew
+    assert warm.params.nonlinear and warm.params.shift_prior is not None
+    f = result.estimates.natural_frequency_hz
+    assert abs(f.value - truth.natural_frequency_hz) < 3.0 * f.std
+    cold = identify(whole, BEAM, config).estimates.natural_frequency_hz
+    assert abs(f.value - cold.value) < 0.05 * cold.std
+
+
 def test_a_new_release_restarts_the_identification(drop_case):
     trajectory, _ = drop_case()
     window = _window(trajectory, True)
