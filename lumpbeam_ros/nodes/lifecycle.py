@@ -10,7 +10,8 @@ One place for what each node's ``main`` did alike (:func:`run_node`):
 * what the node published is written for the demo's per-topic counts
   (:mod:`lumpbeam_ros.nodes.counts`) however it stopped.
 
-A node fed at camera rate spins with :func:`spin_events` instead of ``rclpy.spin``.
+A node fed at camera rate spins with :func:`spin_events` instead of ``rclpy.spin``, or with
+:func:`spin_live`, which keeps ``rclpy.spin`` for a node on a simulated clock.
 
 The commands that run a node in their own loop (``lumpbeam play``, ``lumpbeam record``) take
 their namespace from :func:`checked_namespace`, their topic names from :func:`checked_topics`
@@ -115,12 +116,14 @@ def spin_events(node: Node) -> None:
 
     ``rclpy.spin``'s executor rebuilds its wait set from every entity of the node (a dozen
     with the parameter services) in Python on each wake; at 180 frames a second that was a
-    third of the camera node's CPU (doc/validation.md, 'Speed'). The events executor
-    dispatches each event from C++. It is rclpy's experimental executor: its timers do not
-    follow a simulated clock, so only a node whose timers all run on the steady clock may
-    spin here. Its own ``spin`` only returns when the context's Python shutdown runs, which
-    rclpy's signal handler does not call: the loop returns to Python every
-    :data:`EVENTS_POLL_S` to see the context shut down and to run the signal handlers.
+    third of the camera node's CPU and half of the identifier's (doc/validation.md,
+    'Speed'). The events executor dispatches each event from C++. It is rclpy's experimental
+    executor: its timers followed ``/clock`` in a check with rclpy 7.1.5, but rclcpp's events
+    executor's do not, so a node whose timers must follow ``/clock`` spins with
+    :func:`spin_live`, which keeps rclpy's own executor on a simulated clock.
+    Its own ``spin`` only returns when the context's Python shutdown runs, which rclpy's
+    signal handler does not call: the loop returns to Python every :data:`EVENTS_POLL_S` to
+    see the context shut down and to run the signal handlers.
 
     Args:
         node: The node; its context is the one watched.
@@ -134,6 +137,28 @@ def spin_events(node: Node) -> None:
             executor.spin_once(timeout_sec=EVENTS_POLL_S)
     finally:
         executor.shutdown()
+
+
+def live_spinner(node: Node) -> Callable[[Node], None]:
+    """How :func:`spin_live` spins ``node``: by its clock, read once at the start.
+
+    Args:
+        node: The node, its ``use_sim_time`` parameter set.
+
+    Returns:
+        :func:`spin_events` on wall time; ``rclpy.spin`` with ``use_sim_time``, whose timers
+        follow ``/clock`` in every rclpy release (a bag replayed with ``lumpbeam play``).
+    """
+    return rclpy.spin if node.get_parameter('use_sim_time').value else spin_events
+
+
+def spin_live(node: Node) -> None:
+    """Spins a node fed at camera rate whose timers follow the ROS clock (:func:`live_spinner`).
+
+    Args:
+        node: The node; its context is the one watched.
+    """
+    live_spinner(node)(node)
 
 
 def checked_namespace(namespace: str | None) -> str:
