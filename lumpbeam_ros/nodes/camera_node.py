@@ -76,7 +76,7 @@ from lumpbeam_ros.vision.bag_frames import bag_frames
 from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
 from lumpbeam_ros.vision.config import camera_config_from_parameters
 from lumpbeam_ros.vision.free_pose import rpy_quaternion
-from lumpbeam_ros.vision.messages import IMAGE_TYPES, decode_camera_info, prepare_decoders
+from lumpbeam_ros.vision.messages import IMAGE_TYPES, prepare_decoders
 from lumpbeam_ros.vision.session import TrackingSession
 from lumpbeam_ros.vision.sources import (
     DeviceSource,
@@ -167,7 +167,7 @@ class CameraNode(SchemaNode):
     def on_camera_info(self, data: bytes) -> None:
         """Takes the camera's intrinsics (published beside every frame)."""
         try:
-            changed = self.session.set_camera_info(decode_camera_info(data))
+            changed = self.session.set_camera_info_message(data)
         except LumpbeamError as exc:
             self._took_camera_info(False, str(exc))
         else:
