@@ -20,11 +20,12 @@ and their rclpy session and stop request from :func:`stoppable_session`.
 
 from __future__ import annotations
 
+import functools
 import sys
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from types import FrameType
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import rclpy
 from rclpy.exceptions import (
@@ -125,18 +126,48 @@ def spin_events(node: Node) -> None:
     signal handler does not call: the loop returns to Python every :data:`EVENTS_POLL_S` to
     see the context shut down and to run the signal handlers.
 
+    That executor logs an exception leaving a callback as FATAL, with its stack, before it
+    passes it on; a signal's interrupt in a callback that computes, or a publish the
+    shutdown cut into, is the stop, not a fault (:func:`run_node`). So the node's
+    subscription and timer callbacks hand what they raise to this loop, which raises it as
+    ``rclpy.spin`` would, and no callback runs after it.
+
     Args:
         node: The node; its context is the one watched.
     """
     from rclpy.experimental import EventsExecutor
 
+    raised: list[BaseException] = []
+    for entity in (*node.subscriptions, *node.timers):
+        entity.callback = _raising_in_the_loop(entity.callback, raised)
     executor = EventsExecutor(context=node.context)
     executor.add_node(node)
     try:
-        while node.context.ok():
+        while node.context.ok() and not raised:
             executor.spin_once(timeout_sec=EVENTS_POLL_S)
+        if raised:
+            raise raised[0]
     finally:
         executor.shutdown()
+
+
+def _raising_in_the_loop(
+    callback: Callable[..., Any], raised: list[BaseException]
+) -> Callable[..., Any]:
+    """``callback``, keeping what it raises in ``raised`` (see :func:`spin_events`)."""
+
+    # wraps: rclpy reads the callback's signature (message only, or with its info).
+    @functools.wraps(callback)
+    def call(*args: Any) -> Any:
+        if raised:
+            return None
+        try:
+            return callback(*args)
+        except BaseException as exc:  # noqa: BLE001 - raised again by spin_events' loop
+            raised.append(exc)
+            return None
+
+    return call
 
 
 def live_spinner(node: Node) -> Callable[[Node], None]:
