@@ -147,8 +147,8 @@ class CameraNode(SchemaNode):
             source = 'the configured intrinsics' if known is not None else CAMERA_INFO
             self.get_logger().info(f'tracking {IMAGE} with {source}')
         period = float(self._param('diagnostics_period_s'))
-        # Steady: the period's counts are timed with time.monotonic, and a live node spins on
-        # the events executor, whose timers do not follow a simulated clock.
+        # Steady: the period's counts are timed with time.monotonic (and the node's clock may
+        # be a replay's /clock).
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.create_timer(period if period > 0 else 1.0, self.publish_diagnostics, clock=steady)
 
