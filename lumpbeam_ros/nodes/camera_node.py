@@ -76,7 +76,7 @@ from lumpbeam_ros.vision.bag_frames import bag_frames
 from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
 from lumpbeam_ros.vision.config import camera_config_from_parameters
 from lumpbeam_ros.vision.free_pose import rpy_quaternion
-from lumpbeam_ros.vision.messages import IMAGE_TYPES, decode_camera_info, prepare_decoders
+from lumpbeam_ros.vision.messages import IMAGE_TYPES, prepare_decoders
 from lumpbeam_ros.vision.session import TrackingSession
 from lumpbeam_ros.vision.sources import (
     DeviceSource,
@@ -147,8 +147,8 @@ class CameraNode(SchemaNode):
             source = 'the configured intrinsics' if known is not None else CAMERA_INFO
             self.get_logger().info(f'tracking {IMAGE} with {source}')
         period = float(self._param('diagnostics_period_s'))
-        # Steady: the period's counts are timed with time.monotonic, and a live node spins on
-        # the events executor, whose timers do not follow a simulated clock.
+        # Steady: the period's counts are timed with time.monotonic (and the node's clock may
+        # be a replay's /clock).
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.create_timer(period if period > 0 else 1.0, self.publish_diagnostics, clock=steady)
 
@@ -167,7 +167,7 @@ class CameraNode(SchemaNode):
     def on_camera_info(self, data: bytes) -> None:
         """Takes the camera's intrinsics (published beside every frame)."""
         try:
-            changed = self.session.set_camera_info(decode_camera_info(data))
+            changed = self.session.set_camera_info_message(data)
         except LumpbeamError as exc:
             self._took_camera_info(False, str(exc))
         else:

@@ -56,7 +56,7 @@ from lumpbeam_ros.interface import (
 )
 from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
-from lumpbeam_ros.nodes.lifecycle import run_node
+from lumpbeam_ros.nodes.lifecycle import run_node, spin_live
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
 from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA
 
@@ -212,6 +212,9 @@ class IdentifierNode(SchemaNode):
 def main(args: Sequence[str] | None = None) -> int:
     """Runs the node until Ctrl-C (console script ``identifier_node``).
 
+    On wall time it spins on rclpy's events executor, which takes each pose without
+    rebuilding a wait set (:func:`~lumpbeam_ros.nodes.lifecycle.spin_live`).
+
     Args:
         args: Command-line arguments (default ``sys.argv``), incl. ``--ros-args``.
 
@@ -219,7 +222,11 @@ def main(args: Sequence[str] | None = None) -> int:
         0, or 2 when the configuration is invalid (one line on stderr).
     """
     return run_node(
-        IDENTIFIER_SCHEMA.node, IdentifierNode, lambda node: {BEAM_PARAMS: node.updates}, args
+        IDENTIFIER_SCHEMA.node,
+        IdentifierNode,
+        lambda node: {BEAM_PARAMS: node.updates},
+        args,
+        run=spin_live,
     )
 
 

@@ -10,7 +10,8 @@ One place for what each node's ``main`` did alike (:func:`run_node`):
 * what the node published is written for the demo's per-topic counts
   (:mod:`lumpbeam_ros.nodes.counts`) however it stopped.
 
-A node fed at camera rate spins with :func:`spin_events` instead of ``rclpy.spin``.
+A node fed at camera rate spins with :func:`spin_events` instead of ``rclpy.spin``, or with
+:func:`spin_live`, which keeps ``rclpy.spin`` for a node on a simulated clock.
 
 The commands that run a node in their own loop (``lumpbeam play``, ``lumpbeam record``) take
 their namespace from :func:`checked_namespace`, their topic names from :func:`checked_topics`
@@ -19,11 +20,12 @@ and their rclpy session and stop request from :func:`stoppable_session`.
 
 from __future__ import annotations
 
+import functools
 import sys
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from types import FrameType
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import rclpy
 from rclpy.exceptions import (
@@ -115,25 +117,79 @@ def spin_events(node: Node) -> None:
 
     ``rclpy.spin``'s executor rebuilds its wait set from every entity of the node (a dozen
     with the parameter services) in Python on each wake; at 180 frames a second that was a
-    third of the camera node's CPU (doc/validation.md, 'Speed'). The events executor
-    dispatches each event from C++. It is rclpy's experimental executor: its timers do not
-    follow a simulated clock, so only a node whose timers all run on the steady clock may
-    spin here. Its own ``spin`` only returns when the context's Python shutdown runs, which
-    rclpy's signal handler does not call: the loop returns to Python every
-    :data:`EVENTS_POLL_S` to see the context shut down and to run the signal handlers.
+    third of the camera node's CPU and half of the identifier's (doc/validation.md,
+    'Speed'). The events executor dispatches each event from C++. It is rclpy's experimental
+    executor: its timers followed ``/clock`` in a check with rclpy 7.1.5, but rclcpp's events
+    executor's do not, so a node whose timers must follow ``/clock`` spins with
+    :func:`spin_live`, which keeps rclpy's own executor on a simulated clock.
+    Its own ``spin`` only returns when the context's Python shutdown runs, which rclpy's
+    signal handler does not call: the loop returns to Python every :data:`EVENTS_POLL_S` to
+    see the context shut down and to run the signal handlers.
+
+    That executor logs an exception leaving a callback as FATAL, with its stack, before it
+    passes it on; a signal's interrupt in a callback that computes, or a publish the
+    shutdown cut into, is the stop, not a fault (:func:`run_node`). So the node's
+    subscription and timer callbacks hand what they raise to this loop, which raises it as
+    ``rclpy.spin`` would, and no callback runs after it.
 
     Args:
         node: The node; its context is the one watched.
     """
     from rclpy.experimental import EventsExecutor
 
+    raised: list[BaseException] = []
+    for entity in (*node.subscriptions, *node.timers):
+        entity.callback = _raising_in_the_loop(entity.callback, raised)
     executor = EventsExecutor(context=node.context)
     executor.add_node(node)
     try:
-        while node.context.ok():
+        while node.context.ok() and not raised:
             executor.spin_once(timeout_sec=EVENTS_POLL_S)
+        if raised:
+            raise raised[0]
     finally:
         executor.shutdown()
+
+
+def _raising_in_the_loop(
+    callback: Callable[..., Any], raised: list[BaseException]
+) -> Callable[..., Any]:
+    """``callback``, keeping what it raises in ``raised`` (see :func:`spin_events`)."""
+
+    # wraps: rclpy reads the callback's signature (message only, or with its info).
+    @functools.wraps(callback)
+    def call(*args: Any) -> Any:
+        if raised:
+            return None
+        try:
+            return callback(*args)
+        except BaseException as exc:  # noqa: BLE001 - raised again by spin_events' loop
+            raised.append(exc)
+            return None
+
+    return call
+
+
+def live_spinner(node: Node) -> Callable[[Node], None]:
+    """How :func:`spin_live` spins ``node``: by its clock, read once at the start.
+
+    Args:
+        node: The node, its ``use_sim_time`` parameter set.
+
+    Returns:
+        :func:`spin_events` on wall time; ``rclpy.spin`` with ``use_sim_time``, whose timers
+        follow ``/clock`` in every rclpy release (a bag replayed with ``lumpbeam play``).
+    """
+    return rclpy.spin if node.get_parameter('use_sim_time').value else spin_events
+
+
+def spin_live(node: Node) -> None:
+    """Spins a node fed at camera rate whose timers follow the ROS clock (:func:`live_spinner`).
+
+    Args:
+        node: The node; its context is the one watched.
+    """
+    live_spinner(node)(node)
 
 
 def checked_namespace(namespace: str | None) -> str:

@@ -19,7 +19,7 @@ from typing import Literal
 
 from lumpbeam_ros.bagio.reader import BagReader, RawMessage
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.vision.messages import CameraFrame, decode_camera_info, decode_frame
+from lumpbeam_ros.vision.messages import CameraFrame, decode_frame
 from lumpbeam_ros.vision.session import TrackingSession
 
 ItemKind = Literal['image', 'camera_info', 'other']
@@ -80,7 +80,7 @@ def bag_frames(
             return
         if raw.topic == camera_info_topic and follow_info:
             try:
-                changed = session.set_camera_info(decode_camera_info(raw.data))
+                changed = session.set_camera_info_message(raw.data)
             except LumpbeamError as exc:
                 yield BagItem(raw, 'camera_info', problem=str(exc))
             else:

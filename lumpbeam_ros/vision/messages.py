@@ -27,6 +27,9 @@ from lumpbeam_ros.vision.sources.pixels import decode_compressed, tracker_pixels
 
 #: The image message types the tracker reads.
 IMAGE_TYPES = (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE)
+#: Where the stamp ends in the CDR bytes of a message that starts with a ``std_msgs/Header``:
+#: after the 4-byte encapsulation header, ``sec`` (int32) and ``nanosec`` (uint32).
+HEADER_STAMP_END = 12
 
 
 class CameraFrame(NamedTuple):

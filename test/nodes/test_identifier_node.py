@@ -30,6 +30,7 @@ from lumpbeam_ros.model.modes import chain_modes
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
 from lumpbeam_ros.model.statics import static_tip_deflection
 from lumpbeam_ros.nodes.identifier_node import IdentifierNode
+from lumpbeam_ros.nodes.lifecycle import live_spinner, spin_events
 from lumpbeam_ros.resources import config_path
 from lumpbeam_ros.shaping.estimate import estimate_from_status
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
@@ -295,6 +296,20 @@ def test_parameters_are_validated():
         node.destroy_node()
     finally:
         rclpy.shutdown(context=context)
+
+
+@pytest.mark.parametrize('sim_time', [False, True], ids=['wall time', 'use_sim_time'])
+def test_a_live_node_spins_on_the_events_executor_and_a_replay_on_rclpys(ros_graph, sim_time):
+    import rclpy
+
+    node = IdentifierNode(
+        context=ros_graph.context, parameter_overrides={'use_sim_time': sim_time}
+    )
+    try:
+        # On /clock, rclpy's own executor: its timers follow a simulated clock in every release.
+        assert live_spinner(node) is (rclpy.spin if sim_time else spin_events)
+    finally:
+        node.destroy_node()
 
 
 def test_main_takes_the_params_file_and_rejects_a_bad_one(ros_graph, tmp_path):

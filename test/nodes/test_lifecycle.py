@@ -27,7 +27,7 @@ from lumpbeam_ros.interface import (
 )
 from lumpbeam_ros.model.parameters import load_beam_config
 from lumpbeam_ros.nodes.counts import COUNTS_DIR_ENV, read_counts
-from lumpbeam_ros.nodes.lifecycle import CONFIG_ERROR, run_node
+from lumpbeam_ros.nodes.lifecycle import CONFIG_ERROR, run_node, spin_events
 from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 from lumpbeam_ros.synthetic.images import ImageOptions
 
@@ -142,6 +142,27 @@ def test_a_middleware_error_while_running_is_not_hidden(counts_dir):
     with pytest.raises(_rclpy.RCLError, match='failed to take'):
         run_node('counting_node', _Publishing, lambda n: {'/x': n.sent}, [], run=run)
     assert read_counts(counts_dir)['counting_node']['published'] == {'/x': 0}
+
+
+@pytest.mark.parametrize('error', [interrupts.SignalInterrupt(signal.SIGTERM), ValueError('bad')])
+def test_what_an_events_callback_raises_leaves_the_spin_unlogged(ros_graph, capfd, error):
+    node = Node('raising_node', context=ros_graph.context)
+    calls = []
+
+    def tick() -> None:
+        calls.append(1)
+        raise error
+
+    node.create_timer(0.01, tick)
+    node.create_subscription(Float64, 'x', lambda _msg: calls.append(2), 10)
+    try:
+        with pytest.raises(type(error)):
+            spin_events(node)
+    finally:
+        node.destroy_node()
+    assert calls == [1]
+    # The events executor logs what leaves a callback as FATAL, a stop signal included.
+    assert capfd.readouterr().err == ''
 
 
 #: A node whose callback computes without end (a solve that never converges).

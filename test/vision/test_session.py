@@ -7,8 +7,11 @@ import numpy as np
 import pytest
 
 from lumpbeam_lab.camera.accuracy import render_frames
-from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.bagio import convert
+from lumpbeam_ros.bagio.typestore import serialize
+from lumpbeam_ros.errors import BagError, LumpbeamError
 from lumpbeam_ros.interface import COMPRESSED_IMAGE_TYPE
+from lumpbeam_ros.vision.messages import camera_info_to_data
 from lumpbeam_ros.vision.session import SessionStats, TrackingSession
 from lumpbeam_ros.vision.tracker import TrackStatus
 
@@ -58,6 +61,41 @@ def test_the_same_intrinsics_keep_the_tracker_and_new_ones_replace_it(session, c
     assert session.tracker is not tracker and session.camera_info is other
     distorted = dataclasses.replace(other, d=np.array([0.01, 0.0, 0.0, 0.0, 0.0]))
     assert session.set_camera_info(distorted) is True
+
+
+def _info_cdr(info, stamp_ns, **changes):
+    data = dataclasses.replace(camera_info_to_data(info), **changes)
+    return serialize(convert.camera_info(stamp_ns, data))
+
+
+def test_camera_info_messages_rebuild_the_tracker_only_on_new_intrinsics(config, no_calibration):
+    session = TrackingSession(no_calibration)
+    info = config.camera_info
+    assert session.set_camera_info_message(_info_cdr(info, 1)) is True
+    tracker = session.tracker
+    # Beside every frame: the same intrinsics under the next stamp keep the tracker.
+    assert session.set_camera_info_message(_info_cdr(info, 2)) is False
+    assert session.tracker is tracker
+    smaller = info.scaled(320, 240)
+    assert session.set_camera_info_message(_info_cdr(smaller, 3)) is True
+    assert session.camera_info.width == 320 and session.tracker is not tracker
+    assert session.set_camera_info_message(_info_cdr(info, 4)) is True
+    assert session.camera_info.width == info.width
+
+
+def test_a_refused_camera_info_message_is_refused_again(config, no_calibration):
+    session = TrackingSession(no_calibration)
+    for stamp in (1, 2):  # a refusal is not remembered as taken
+        uncalibrated = _info_cdr(config.camera_info, stamp, k=np.zeros((3, 3)))
+        with pytest.raises(LumpbeamError, match='uncalibrated'):
+            session.set_camera_info_message(uncalibrated)
+        assert session.tracker is None
+    good = _info_cdr(config.camera_info, 3)
+    assert session.set_camera_info_message(good) is True
+    with pytest.raises(BagError):
+        session.set_camera_info_message(good[:40])
+    tracker = session.tracker
+    assert session.set_camera_info_message(good) is False and session.tracker is tracker
 
 
 @pytest.mark.parametrize('model', ['curved', '', 'PLANE'])
