@@ -39,6 +39,7 @@ from lumpbeam_ros.interface import (
     IMAGE,
     TIP_POSE,
 )
+from lumpbeam_ros.realtime import set_realtime_priority
 from lumpbeam_ros.resources import large_frames_profile
 from lumpbeam_ros.ros_domain import claim_domain_id
 
@@ -191,8 +192,12 @@ def publish(frames_path: str, rate_hz: float) -> int:
     return 0
 
 
-def echo() -> int:
-    """The baseline process: decode each image, publish a pose with its stamp, no tracking."""
+def echo(realtime_priority: int = 0) -> int:
+    """The baseline process: decode each image, publish a pose with its stamp, no tracking.
+
+    Args:
+        realtime_priority: As the camera node's ``realtime_priority`` (0: normal).
+    """
     import rclpy
     from geometry_msgs.msg import PoseStamped
     from sensor_msgs.msg import Image
@@ -203,6 +208,9 @@ def echo() -> int:
     prepare_decoders()  # as the camera node does: the baseline's first frame is no slower
     rclpy.init()
     node = rclpy.create_node('bench_echo')
+    problem = set_realtime_priority(realtime_priority)
+    if problem:
+        node.get_logger().warning(problem)
     poses = publisher(node, PoseStamped, TIP_POSE)
 
     def on_image(data: bytes) -> None:
@@ -389,23 +397,34 @@ def measure(
     )
 
 
-def camera_node_command() -> list[str]:
+def camera_node_command(realtime_priority: int = 0) -> list[str]:
     """The camera node as a process, taking its intrinsics from the stream."""
-    return [sys.executable, '-m', 'lumpbeam_ros.nodes.camera_node']
+    return [
+        sys.executable,
+        '-m',
+        'lumpbeam_ros.nodes.camera_node',
+        '--ros-args',
+        '-p',
+        f'realtime_priority:={realtime_priority}',
+    ]
 
 
-def identifier_command(publish_rate_hz: float) -> list[str]:
+def identifier_command(publish_rate_hz: float, realtime_priority: int = 0) -> list[str]:
     """The identifier node as a process, on wall time, publishing at ``publish_rate_hz``."""
     from lumpbeam_ros.demo.graph import node_command
 
     return node_command(
-        'lumpbeam_ros.nodes.identifier_node', '-p', f'publish_rate_hz:={publish_rate_hz}'
+        'lumpbeam_ros.nodes.identifier_node',
+        '-p',
+        f'publish_rate_hz:={publish_rate_hz}',
+        '-p',
+        f'realtime_priority:={realtime_priority}',
     )
 
 
-def echo_command() -> list[str]:
+def echo_command(realtime_priority: int = 0) -> list[str]:
     """The echo baseline as a process."""
-    return [sys.executable, '-m', __name__, 'echo']
+    return [sys.executable, '-m', __name__, 'echo', '--realtime-priority', str(realtime_priority)]
 
 
 def _main(argv: Sequence[str] | None = None) -> int:
@@ -414,10 +433,11 @@ def _main(argv: Sequence[str] | None = None) -> int:
     pub = sub.add_parser('publish')
     pub.add_argument('frames', help='.npy file of mono8 frames')
     pub.add_argument('rate', type=float)
-    sub.add_parser('echo')
+    echo_args = sub.add_parser('echo')
+    echo_args.add_argument('--realtime-priority', type=int, default=0)
     args = parser.parse_args(argv)
     if args.role == 'echo':
-        return echo()
+        return echo(args.realtime_priority)
     return publish(args.frames, args.rate)
 
 

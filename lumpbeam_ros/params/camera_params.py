@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from lumpbeam_ros.interface import BASE_FRAME, CAMERA_INFO, CAMERA_NODE, IMAGE
 from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec, settings_specs
+from lumpbeam_ros.realtime import REALTIME_PRIORITY
 from lumpbeam_ros.vision.config import (
     BoardSettings,
     SensorSettings,
@@ -29,6 +30,7 @@ def _double(
 
 _NODE = (
     ParameterSpec('frame_id', 'string', BASE_FRAME, 'header.frame_id of the published poses'),
+    REALTIME_PRIORITY,
     ParameterSpec(
         'bag_path',
         'string',

@@ -9,6 +9,7 @@ from __future__ import annotations
 from lumpbeam_ros.ident.settings import IDENTIFIER_SETTINGS
 from lumpbeam_ros.interface import IDENTIFIER_NODE
 from lumpbeam_ros.params.schema import ParameterSchema, ParameterSpec
+from lumpbeam_ros.realtime import REALTIME_PRIORITY
 
 #: The parameters that are not identification settings (not in config/identifier.yaml).
 _NODE = (
@@ -19,6 +20,7 @@ _NODE = (
         "beam parameter file (as config/paper_beam.yaml); empty: the package's paper_beam.yaml",
     ),
     ParameterSpec('hardware_id', 'string', 'beam', 'DiagnosticStatus.hardware_id of /beam_params'),
+    REALTIME_PRIORITY,
 )
 
 IDENTIFIER_SCHEMA = ParameterSchema(
