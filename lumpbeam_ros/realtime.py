@@ -37,10 +37,23 @@ def set_realtime_priority(priority: int) -> str:
         priority: 1 to 99; 0 leaves the scheduling as it is.
 
     Returns:
-        ``''``, or one line saying why it could not (nothing was changed then).
+        ``''``, or one line saying why it could not (the first refusal stops it).
     """
     if priority == 0:
         return ''
+    return _set_every_thread('SCHED_FIFO', priority)
+
+
+def set_normal_scheduling() -> str:
+    """Puts every thread of this process back on the normal scheduler (``SCHED_OTHER``).
+
+    Returns:
+        ``''``, or one line saying why it could not.
+    """
+    return _set_every_thread('SCHED_OTHER', 0)
+
+
+def _set_every_thread(policy: str, priority: int) -> str:
     setter = getattr(os, 'sched_setscheduler', None)
     if setter is None:
         return f'realtime_priority {priority}: no real-time scheduling on this system; ignored'
@@ -51,7 +64,7 @@ def set_realtime_priority(priority: int) -> str:
     param = os.sched_param(priority)
     for tid in threads:
         try:
-            setter(tid, os.SCHED_FIFO, param)
+            setter(tid, getattr(os, policy), param)
         except ProcessLookupError:
             continue  # the thread ended meanwhile
         except PermissionError:

@@ -13,16 +13,20 @@ from lumpbeam_ros.realtime import REALTIME_PRIORITY, set_realtime_priority
 #: threads stay on the normal scheduler.
 _PROBE = """
 import json, os, sys, threading
-from lumpbeam_ros.realtime import set_realtime_priority
+from lumpbeam_ros.realtime import set_normal_scheduling, set_realtime_priority
 started = threading.Event()
 threading.Thread(target=lambda: (started.set(), threading.Event().wait(5)), daemon=True).start()
 started.wait()
 problem = set_realtime_priority(int(sys.argv[1]))
 late = threading.Thread(target=lambda: threading.Event().wait(5), daemon=True)
 late.start()
-threads = {tid: (os.sched_getscheduler(int(tid)), os.sched_getparam(int(tid)).sched_priority)
-           for tid in os.listdir('/proc/self/task')}
-print(json.dumps({'problem': problem, 'threads': threads, 'fifo': os.SCHED_FIFO}))
+def policies():
+    return {tid: (os.sched_getscheduler(int(tid)), os.sched_getparam(int(tid)).sched_priority)
+            for tid in os.listdir('/proc/self/task')}
+threads = policies()
+back = set_normal_scheduling()
+print(json.dumps({'problem': problem, 'threads': threads, 'fifo': os.SCHED_FIFO,
+                  'back': back, 'after': policies(), 'other': os.SCHED_OTHER}))
 """
 
 
@@ -44,6 +48,9 @@ def test_every_thread_goes_fifo_or_the_node_is_told_why_not():
     else:
         # The threads there before and the one started after (it inherits).
         assert len(found['threads']) == 3 and policies == {(found['fifo'], 20)}
+        # And back, all of them.
+        assert found['back'] == ''
+        assert {tuple(p) for p in found['after'].values()} == {(found['other'], 0)}
 
 
 def test_zero_leaves_the_scheduler_alone():

@@ -39,7 +39,7 @@ from lumpbeam_ros.interface import (
     IMAGE,
     TIP_POSE,
 )
-from lumpbeam_ros.realtime import set_realtime_priority
+from lumpbeam_ros.realtime import set_normal_scheduling, set_realtime_priority
 from lumpbeam_ros.resources import large_frames_profile
 from lumpbeam_ros.ros_domain import claim_domain_id
 
@@ -285,6 +285,7 @@ def measure(
     rate_hz: float,
     large_frames: bool = True,
     downstream: Sequence[str] = (),
+    sink_priority: int = 0,
 ) -> StreamFigures:
     """Runs a consumer process (the camera node or the echo) against the publisher process.
 
@@ -296,6 +297,9 @@ def measure(
         large_frames: Give the publisher and the consumer :data:`LARGE_FRAMES_PROFILE`.
         downstream: A process fed by the consumer that publishes ``/beam_params`` (the
             identifier node); empty for none.
+        sink_priority: Real-time priority of this process's threads while the frames flow
+            (0: the normal scheduler), set once every other process has started (they do
+            not inherit it): the sink must not be the one other work delays.
 
     Returns:
         The figures.
@@ -366,12 +370,17 @@ def measure(
             [sys.executable, '-m', __name__, *args], env=env, stdout=subprocess.PIPE, text=True
         )
         processes.append(publisher)
+        problem = set_realtime_priority(sink_priority)
+        if problem:
+            print(f'camera_stream: {problem}', file=sys.stderr)
         out, _ = publisher.communicate(timeout=duration_s + 60.0)
         if publisher.returncode != 0:
             raise RuntimeError(f'publisher exited with {publisher.returncode}')
         result = json.loads(out.strip().splitlines()[-1])
         time.sleep(0.5)  # the last frames in flight
     finally:
+        if sink_priority:
+            set_normal_scheduling()
         for process in processes:
             if process.poll() is None:
                 process.terminate()
