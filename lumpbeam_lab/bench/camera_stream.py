@@ -131,12 +131,13 @@ def drop_test_frames(width: int, height: int, rate_hz: float, duration_s: float)
     return np.stack([f.image for f in frames])
 
 
-def publish(frames_path: str, rate_hz: float) -> int:
+def publish(frames_path: str, rate_hz: float, realtime_priority: int = 0) -> int:
     """The publisher process: offers the frames at ``rate_hz`` and prints what it published.
 
     Args:
         frames_path: A ``.npy`` file of mono8 frames (N x height x width).
         rate_hz: Offered frame rate, Hz.
+        realtime_priority: As a camera driver's on a shared machine (0: normal).
 
     Returns:
         0.
@@ -160,6 +161,9 @@ def publish(frames_path: str, rate_hz: float) -> int:
     info_message = bytearray(serialize(convert.camera_info(0, camera_info_to_data(info))))
     rclpy.init()
     node = rclpy.create_node('bench_camera')
+    problem = set_realtime_priority(realtime_priority)
+    if problem:
+        node.get_logger().warning(problem)
     images = publisher(node, Image, IMAGE)
     infos = publisher(node, CameraInfo, CAMERA_INFO)
     deadline = time.monotonic() + 20.0
@@ -286,6 +290,7 @@ def measure(
     large_frames: bool = True,
     downstream: Sequence[str] = (),
     sink_priority: int = 0,
+    publisher_priority: int = 0,
 ) -> StreamFigures:
     """Runs a consumer process (the camera node or the echo) against the publisher process.
 
@@ -300,6 +305,8 @@ def measure(
         sink_priority: Real-time priority of this process's threads while the frames flow
             (0: the normal scheduler), set once every other process has started (they do
             not inherit it): the sink must not be the one other work delays.
+        publisher_priority: The publisher's real-time priority, as a camera driver's
+            (0: the normal scheduler).
 
     Returns:
         The figures.
@@ -365,7 +372,8 @@ def measure(
             if time.monotonic() > deadline or any(p.poll() is not None for p in processes):
                 raise RuntimeError(f'no publisher of {", ".join(unheard)} appeared')
             time.sleep(0.05)
-        args = ['publish', frames_path, str(rate_hz)]
+        args = ['publish', frames_path, str(rate_hz), '--realtime-priority']
+        args.append(str(publisher_priority))
         publisher = subprocess.Popen(
             [sys.executable, '-m', __name__, *args], env=env, stdout=subprocess.PIPE, text=True
         )
@@ -442,12 +450,13 @@ def _main(argv: Sequence[str] | None = None) -> int:
     pub = sub.add_parser('publish')
     pub.add_argument('frames', help='.npy file of mono8 frames')
     pub.add_argument('rate', type=float)
+    pub.add_argument('--realtime-priority', type=int, default=0)
     echo_args = sub.add_parser('echo')
     echo_args.add_argument('--realtime-priority', type=int, default=0)
     args = parser.parse_args(argv)
     if args.role == 'echo':
         return echo(args.realtime_priority)
-    return publish(args.frames, args.rate)
+    return publish(args.frames, args.rate, args.realtime_priority)
 
 
 if __name__ == '__main__':
