@@ -8,13 +8,12 @@ decays with the squared envelope, nearly a ramp of the phase over a record), so 
 estimate costs the frequency most of its precision; the model knows it instead.
 
 ``gamma`` is measured on the model itself: the undamped chain of the configured geometry,
-without effects, released from the static deflection under two tip loads (tip amplitudes of
-:data:`AMPLITUDE_OF_LENGTH` and half of it), each over :data:`PERIODS` periods; a damped
-sinusoid fitted to each tip z gives ``omega`` and ``A``, and
-``gamma = (omega_2 - omega_1) / (omega_0 (A_2^2 - A_1^2))``. The difference of two
-amplitudes cancels whatever offset the integration or the fit would give both. ``gamma``
-scales the frequency, so it hardly depends on the stiffness (within 1 % over a stiffness
-range of 2.4 for the paper's beam): a beam whose stiffness is not yet known gives it too.
+without effects, released from its static deflection under a tip load (a tip amplitude of
+:data:`AMPLITUDE_OF_LENGTH` of the length) over :data:`PERIODS` periods; a damped sinusoid
+fitted to the tip z gives ``omega`` and ``A``, and ``gamma = (omega - omega_0) / (omega_0
+A^2)`` with ``omega_0`` the chain's linear first mode (B.16 linearised). ``gamma`` scales the
+frequency, so it hardly depends on the stiffness (within 0.3 % over a stiffness range of 2.4
+for the paper's beam): a beam whose stiffness is not yet known gives it too.
 """
 
 from __future__ import annotations
@@ -24,23 +23,22 @@ import math
 from dataclasses import dataclass, replace
 
 from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.mode_estimate import TWO_PI
 from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit
 from lumpbeam_ros.model.adopt import first_mode
 from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, Effects
 from lumpbeam_ros.model.simulate import simulate_drop_test
 from lumpbeam_ros.model.statics import static_tip_deflection
 
-#: The larger release amplitude, as a fraction of the beam's length: large enough that the
-#: shift (some ppm) stands far above what the second mode and the fit leave, small enough
-#: that the ``A^4`` term is negligible (under 1 % of ``gamma`` at twice this).
+#: The release amplitude, as a fraction of the beam's length: large enough that the shift
+#: (some ppm) stands far above what the second mode and the fit leave, small enough that the
+#: ``A^4`` term is negligible (under 1 % of ``gamma`` at twice this).
 AMPLITUDE_OF_LENGTH = 0.02
 #: Periods of the first mode simulated per amplitude.
 PERIODS = 16
 #: Samples per period of the first mode.
 SAMPLES_PER_PERIOD = 40
 #: The simulator's steps per sample: with two, ``gamma`` is within 0.1 % of MuJoCo's for the
-#: paper's beam (one step per sample leaves it 0.2 % low; a grid off the samples, some %).
+#: paper's beam (one step per sample leaves it lower; a grid off the samples, some % off).
 STEPS_PER_SAMPLE = 2
 
 
@@ -61,7 +59,7 @@ class Backbone:
 def beam_backbone(beam: BeamParameters) -> Backbone:
     """The backbone of ``beam``'s chain (see the module docstring).
 
-    Cached per beam: it costs two short simulations (some tens of milliseconds).
+    Cached per beam: it costs a short simulation (about 15 ms).
 
     Args:
         beam: The beam; its damping and effects are left out.
@@ -79,17 +77,11 @@ def beam_backbone(beam: BeamParameters) -> Backbone:
     if not (per_kg > 0.0 and math.isfinite(per_kg) and f0 > 0.0):
         raise LumpbeamError('backbone: the beam does not sag under a tip load')
     rate = SAMPLES_PER_PERIOD * f0
-    drop_s = PERIODS / f0
-    step = 1.0 / (STEPS_PER_SAMPLE * rate)
-    measured = []
-    for fraction in (0.5, 1.0):
-        load = fraction * AMPLITUDE_OF_LENGTH * beam.length_m / per_kg
-        tip = simulate_drop_test(chain, DropTestConfig(load, 0.0, drop_s), rate, step)
-        params = DampedSinusoidFit(n_modes=1).fit(tip.t, tip.z)
-        mode = params.mode(0)
-        measured.append((TWO_PI * mode.natural_frequency_hz, mode.amplitude))
-    (w1, a1), (w2, a2) = measured
-    gamma = (w2 - w1) / (TWO_PI * f0 * (a2 * a2 - a1 * a1))
+    load = AMPLITUDE_OF_LENGTH * beam.length_m / per_kg
+    drop = DropTestConfig(load, 0.0, PERIODS / f0)
+    tip = simulate_drop_test(chain, drop, rate, 1.0 / (STEPS_PER_SAMPLE * rate))
+    mode = DampedSinusoidFit(n_modes=1).fit(tip.t, tip.z).mode(0)
+    gamma = (mode.natural_frequency_hz - f0) / (f0 * mode.amplitude**2)
     if not math.isfinite(gamma):
-        raise LumpbeamError('backbone: the fitted frequencies are not finite')
+        raise LumpbeamError('backbone: the fitted frequency is not finite')
     return Backbone(float(gamma), float(f0))
