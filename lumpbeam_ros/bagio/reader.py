@@ -490,7 +490,14 @@ class FileWalk:
     # -- a complete file: chunk by chunk, through the summary -------------------------------
 
     def _indexed(self, buffer: mmap.mmap) -> Iterator[tuple[Schema | None, Channel, Message]]:
+        wanted = self._wanted_channels()
         for index in self.chunk_indexes:
+            if wanted is not None and index.message_index_offsets:
+                if wanted.isdisjoint(index.message_index_offsets):
+                    # Its message index (in the CRC-checked summary) lists none of the
+                    # wanted channels: a topic of a few messages, as /tip_load, is read
+                    # from its own chunks, not from every chunk of the poses beside it.
+                    continue
             records = self._indexed_chunk(buffer, index)
             if records is None:
                 start = index.chunk_start_offset
@@ -504,6 +511,12 @@ class FileWalk:
             chunk = list(self._records(records))
             chunk.sort(key=lambda record: record[2].log_time)
             yield from chunk
+
+    def _wanted_channels(self) -> set[int] | None:
+        """The summary's channel ids of the wanted topics (``None``: every topic is wanted)."""
+        if self.wanted is None:
+            return None
+        return {id_ for id_, channel in self.channels.items() if channel.topic in self.wanted}
 
     @staticmethod
     def _indexed_chunk(buffer: mmap.mmap, index: ChunkIndex) -> list[McapRecord] | None:

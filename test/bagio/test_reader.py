@@ -5,9 +5,10 @@ import pytest
 import yaml
 
 from lumpbeam_ros.bagio import BagReader, BagWriter, read_load_events, read_tip_poses, reindex
+from lumpbeam_ros.bagio.reader import FileWalk
 from lumpbeam_ros.errors import BagError
 
-from .helpers import write_drop_bag
+from .helpers import T0, write_drop_bag
 
 
 @pytest.fixture
@@ -139,6 +140,31 @@ def test_an_intact_bag_reads_without_a_loss_warning(drop, caplog):
         assert len(read_tip_poses(drop).t) == BagReader(drop).topics['/tip_pose'].count
         assert len(list(BagReader(drop).iter_raw())) == BagReader(drop).info.message_count
     assert 'lost' not in caplog.text
+
+
+def test_a_sparse_topic_is_read_from_its_own_chunks_only(tmp_path, monkeypatch):
+    # A load reading before and after the release, poses throughout: 20 chunks.
+    bag = tmp_path / 'sparse'
+    with BagWriter(bag) as writer:
+        for i in range(720):
+            writer.write_pose('/tip_pose', T0 + i / 180.0, 0.0, -0.05, 0.0)
+            if i in (0, 360):
+                writer.write_float('/tip_load', T0 + i / 180.0, 4.5 if i == 0 else 0.0)
+            if i % 36 == 35:
+                writer.flush()
+    opened = []
+    walk = FileWalk._indexed_chunk
+
+    def counted(buffer, index):
+        opened.append(index.chunk_start_offset)
+        return walk(buffer, index)
+
+    monkeypatch.setattr(FileWalk, '_indexed_chunk', staticmethod(counted))
+    assert len(read_tip_poses(bag).t) == 720
+    assert len(opened) == 20
+    opened.clear()
+    np.testing.assert_array_equal(read_load_events(bag).kg, [4.5, 0.0])
+    assert len(opened) == 2
 
 
 def test_a_damaged_summary_is_not_trusted_and_every_message_is_still_read(drop, caplog):
