@@ -58,7 +58,7 @@ def _set_every_thread(policy: str, priority: int) -> str:
     if setter is None:
         return f'realtime_priority {priority}: no real-time scheduling on this system; ignored'
     try:
-        threads = [int(tid) for tid in os.listdir(f'/proc/{os.getpid()}/task')]
+        threads = [int(tid) for tid in os.listdir('/proc/self/task')]
     except OSError:
         threads = [0]
     param = os.sched_param(priority)

@@ -65,6 +65,8 @@ CONTRACT_EFFECTS = {
 }
 
 TOPIC_NAME = re.compile(r'/[a-z][a-z0-9_]*(?:/[a-z][a-z0-9_]*)*')
+#: Paths of the operating system that look like topic names.
+SYSTEM_PATHS = re.compile(r'/(?:proc|sys|dev|etc|tmp)(?:/.*)?')
 PLANNED = re.compile(r'`([^`]+)` \(planned\)')
 
 
@@ -126,7 +128,8 @@ def code_topics() -> frozenset[str]:
         for node in ast.walk(ast.parse(path.read_text(encoding='utf-8'))):
             value = _string(node)
             if value is not None and TOPIC_NAME.fullmatch(value):
-                topics.add(value)
+                if not SYSTEM_PATHS.fullmatch(value):
+                    topics.add(value)
     return frozenset(topics)
 
 
