@@ -39,6 +39,8 @@ def test_round_trip_through_parameters():
         ('fit.max_modes', 0, r'must be in \[1, 8\], got 0'),
         ('fit.drift', 'yes', 'true or false'),
         ('fit.nonlinear', 'sometimes', 'one of'),
+        ('fit.shift_prior_std', -0.1, 'must be non-negative|must be >= 0|must be in'),
+        ('fit.shift_prior_std', 'a tenth', 'must be a number'),
         ('fit.nonlinear_min_decay', 0.0, 'must be positive'),
         ('fit.min_frequency_hz', 50.0, 'must exceed'),
         ('quality.min_release_confidence', 2.0, r'must be in \(0, 1\]'),

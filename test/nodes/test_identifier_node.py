@@ -19,7 +19,7 @@ from std_msgs.msg import Float64
 from lumpbeam_ros.bagio import read_tip_poses
 from lumpbeam_ros.bagio.convert import pitch_to_quaternion
 from lumpbeam_ros.cli.analyze import read_window
-from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.errors import ConfigError, LumpbeamError
 from lumpbeam_ros.ident.bag_analysis import analyze_bag
 from lumpbeam_ros.ident.identify import identify
 from lumpbeam_ros.ident.settings import IdentifierConfig
@@ -431,3 +431,28 @@ def test_an_arm_ring_down_gives_every_mode_on_beam_params(ros_graph):
         float(values['natural_frequency_hz']),
         float(values['mode_2_natural_frequency_hz']),
     ]
+
+
+@pytest.mark.parametrize('value', [-1, 100, 'high'])
+def test_a_realtime_priority_out_of_range_stops_the_node_in_one_line(ros_graph, value):
+    with pytest.raises(ConfigError, match='realtime_priority: must be') as caught:
+        IdentifierNode(context=ros_graph.context, parameter_overrides={'realtime_priority': value})
+    assert '\n' not in str(caught.value)
+
+
+def test_a_realtime_priority_refused_by_the_system_is_a_warning_and_the_node_runs(
+    ros_graph, monkeypatch, capfd
+):
+    import os
+
+    def refuse(*_: object) -> None:
+        raise PermissionError(1, 'Operation not permitted')
+
+    # As on a machine without CAP_SYS_NICE (and the test runner stays on its scheduler).
+    monkeypatch.setattr(os, 'sched_setscheduler', refuse)
+    node = IdentifierNode(context=ros_graph.context, parameter_overrides={'realtime_priority': 40})
+    try:
+        assert node.updates == 0 and node.window is not None
+    finally:
+        node.destroy_node()
+    assert 'realtime_priority 40: not permitted' in capfd.readouterr().err
