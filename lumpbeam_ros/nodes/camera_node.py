@@ -72,7 +72,6 @@ from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node, spin_events
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
 from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
-from lumpbeam_ros.realtime import set_realtime_priority
 from lumpbeam_ros.vision.bag_frames import bag_frames
 from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
 from lumpbeam_ros.vision.config import camera_config_from_parameters
@@ -116,9 +115,6 @@ class CameraNode(SchemaNode):
             {key: values[key] for key in CONFIG_KEYS}, f'{self.get_name()} parameters'
         )
         self.frame_id = str(self._param('frame_id'))
-        problem = set_realtime_priority(int(self._param('realtime_priority')))
-        if problem:
-            self.get_logger().warning(problem)
         known = self.config.camera_info if self._param('use_config_camera_info') else None
         url = str(self._param('camera_info_url'))
         if url:

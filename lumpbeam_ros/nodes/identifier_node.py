@@ -59,7 +59,6 @@ from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node, spin_live
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
 from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA
-from lumpbeam_ros.realtime import set_realtime_priority
 
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0
@@ -85,9 +84,6 @@ class IdentifierNode(SchemaNode):
         beam_file = str(values['beam_config'])
         self.beam: BeamParameters = load_beam_config(beam_file or None)[0]
         self.hardware_id = str(values['hardware_id'])
-        problem = set_realtime_priority(int(values['realtime_priority']))
-        if problem:
-            self.get_logger().warning(problem)
         self.window = SlidingWindow.from_config(self.config)
         self.joints = RestTracker(self.config.rest_tolerance_rad)
         self.bad_joint_states = 0

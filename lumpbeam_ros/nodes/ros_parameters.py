@@ -31,6 +31,7 @@ from rclpy.parameter import Parameter
 
 from lumpbeam_ros.errors import ConfigError
 from lumpbeam_ros.params.schema import ParameterSchema, ParameterSpec
+from lumpbeam_ros.realtime import REALTIME_PRIORITY, set_realtime_priority
 
 #: Checks (and may apply) changes the schema accepted: ``None``, or why they are refused.
 ChangeHook = Callable[[Mapping[str, Any]], str | None]
@@ -191,6 +192,9 @@ class SchemaNode(Node):
         **options: The node's :class:`NodeOptions` (context, overrides, namespace,
             ``--ros-args``).
 
+    A schema with :data:`~lumpbeam_ros.realtime.REALTIME_PRIORITY` has the node's threads
+    put on that real-time priority (or a warning saying why not).
+
     Attributes:
         parameter_values: The declared values, by name.
 
@@ -218,3 +222,8 @@ class SchemaNode(Node):
             parameter_overrides=overrides,
         )
         self.parameter_values = declare_parameters(self, schema, on_change)
+        if REALTIME_PRIORITY.name in self.parameter_values:
+            # A schema that declares it has it applied here, before the node's own set-up.
+            problem = set_realtime_priority(int(self.parameter_values[REALTIME_PRIORITY.name]))
+            if problem:
+                self.get_logger().warning(problem)
