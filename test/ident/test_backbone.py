@@ -3,11 +3,9 @@
 import math
 from dataclasses import replace
 
-import numpy as np
 import pytest
-from arm.arm_cases import paper_beam_arm
 
-from lumpbeam_lab.mujoco_arm import MujocoArm
+from lumpbeam_lab.mujoco_arm import mujoco_drop_test
 from lumpbeam_ros.errors import LumpbeamError
 from lumpbeam_ros.ident.backbone import AMPLITUDE_OF_LENGTH, PERIODS, beam_backbone
 from lumpbeam_ros.ident.sinusoid import DampedSinusoidFit
@@ -15,23 +13,6 @@ from lumpbeam_ros.model.parameters import BeamParameters
 from lumpbeam_ros.model.statics import static_tip_deflection
 
 BEAM = BeamParameters()
-#: MuJoCo's step and the samples' spacing in steps (a whole number of them, or the stamps
-#: would not be the states' times).
-STEP_S = 2e-4
-STEPS_PER_SAMPLE = 27
-
-
-def _mujoco_drop(beam: BeamParameters, load_kg: float, duration_s: float) -> dict:
-    """MuJoCo's undamped chain released from its equilibrium under ``load_kg`` at the tip."""
-    heavy = MujocoArm(paper_beam_arm(replace(beam, tip_mass_kg=beam.tip_mass_kg + load_kg)))
-    angles = heavy.equilibrium(np.zeros(1))
-    light = MujocoArm(paper_beam_arm(beam), timestep=STEP_S)
-    light.set_absolute(angles, np.zeros_like(angles))
-
-    def held(times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        return np.zeros((times.size, 1)), np.zeros((times.size, 1))
-
-    return light.rollout(held, duration_s, STEPS_PER_SAMPLE * STEP_S)
 
 
 def test_the_backbone_is_mujocos():
@@ -40,14 +21,15 @@ def test_the_backbone_is_mujocos():
     backbone = beam_backbone(BEAM)
     undamped = replace(BEAM, c_total=0.0)
     per_kg = static_tip_deflection(undamped, 1.0) - static_tip_deflection(undamped, 0.0)
+    f0 = backbone.natural_frequency_hz
     measured = []
     for fraction in (0.5, 1.0):
         load = fraction * AMPLITUDE_OF_LENGTH * BEAM.length_m / per_kg
-        run = _mujoco_drop(undamped, load, PERIODS / backbone.natural_frequency_hz)
-        mode = DampedSinusoidFit().fit(run['t'], run['z']).mode(0)
+        run = mujoco_drop_test(undamped, load, 0.0, PERIODS / f0, 60.0 * f0)
+        mode = DampedSinusoidFit().fit(run.t, run.z).mode(0)
         measured.append((mode.natural_frequency_hz, mode.amplitude))
     (f1, a1), (f2, a2) = measured
-    gamma = (f2 - f1) / (backbone.natural_frequency_hz * (a2 * a2 - a1 * a1))
+    gamma = (f2 - f1) / (f0 * (a2 * a2 - a1 * a1))
     assert gamma == pytest.approx(backbone.relative_per_m2, rel=0.003)
     # The shift is the paper beam's: about 7 ppm at the drop's 4 cm.
     assert backbone.relative_per_m2 * 0.04**2 == pytest.approx(7.3e-6, rel=0.05)
