@@ -258,11 +258,10 @@ def _warm_fit(
     if t[-1] - previous.checked_at_s >= config.recheck_every_s:
         return None
     old = previous.params
-    fit = DampedSinusoidFit.like(old)
     first = old.mode(0)
     guess = (first.damped_frequency_hz, first.damping_ratio)
-    if not old.nonlinear and _wants_nonlinear(guess, t[-1] - start, config):
-        fit = DampedSinusoidFit(old.n_modes, old.drift, nonlinear=True, shift_prior=prior)
+    nonlinear = old.nonlinear or _wants_nonlinear(guess, t[-1] - start, config)
+    fit = DampedSinusoidFit(old.n_modes, old.drift, nonlinear=nonlinear, shift_prior=prior)
     try:
         params = fit.fit(t, z, t0=start, start=old)
     except LumpbeamError:
