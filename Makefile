@@ -55,11 +55,11 @@ test-slow: venv
 
 # The fuzz campaign at length: random damage to product-written bags through the readers,
 # doctor, repair, analyze, diagnose and track, spoiled /tip_pose and /tip_load streams through
-# analyze and diagnose (test/bagio/test_fuzz.py), and random messages into the nodes'
+# analyze and diagnose (test/core/bagio/test_fuzz.py), and random messages into the nodes'
 # callbacks (test/nodes/test_fuzz_callbacks.py). make test runs them at 200 cases.
 FUZZ_CASES ?= 5000
 fuzz: venv
-	LUMPBEAM_FUZZ_CASES=$(FUZZ_CASES) $(BIN)/python -m pytest test/bagio/test_fuzz.py \
+	LUMPBEAM_FUZZ_CASES=$(FUZZ_CASES) $(BIN)/python -m pytest test/core/bagio/test_fuzz.py \
 		test/nodes/test_fuzz_callbacks.py -n0 -q -p no:logging -s
 
 lint: venv

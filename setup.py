@@ -9,7 +9,7 @@ PACKAGE = 'lumpbeam_ros'
 #: What the offline commands need (reproduce, synth, analyze, diagnose, compare).
 REQUIRES = ['setuptools', 'numpy', 'scipy', 'pyyaml', 'threadpoolctl', 'rosbags', 'mcap']
 
-#: The rest, by what it serves (lumpbeam_ros/cli/dependencies.py names them when missing).
+#: The rest, by what it serves (lumpbeam_ros/apps/cli/dependencies.py names them when missing).
 EXTRAS = {
     'vision': ['opencv-python-headless'],
     'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
@@ -24,9 +24,9 @@ EXTRAS['all'] = sorted({req for reqs in EXTRAS.values() for req in reqs})
 setup(
     name=PACKAGE,
     version='0.1.0',
-    # Two packages: lumpbeam_ros (the product) and lumpbeam_lab (benchmarks, validation, the
-    # MCAP doctor: what proves it; only `lumpbeam bench` and `lumpbeam doctor` import it).
-    packages=find_packages(exclude=['test', 'test.*']),
+    # The product alone: what proves it (lumpbeam_lab/: benchmarks, validation renderers,
+    # peers) stays in the repository, where `lumpbeam bench` finds it from a checkout.
+    packages=find_packages(include=[PACKAGE, f'{PACKAGE}.*']),
     data_files=[
         ('share/ament_index/resource_index/packages', [f'resource/{PACKAGE}']),
         (f'share/{PACKAGE}', ['package.xml']),
@@ -35,7 +35,7 @@ setup(
             glob('config/*.yaml') + glob('config/*.json') + glob('config/*.rviz'),
         ),
     ],
-    package_data={PACKAGE: ['data/*.csv', 'data/*.xml']},
+    package_data={f'{PACKAGE}.base': ['data/*.csv', 'data/*.xml']},
     install_requires=REQUIRES,
     extras_require=EXTRAS,
     zip_safe=True,
@@ -46,7 +46,7 @@ setup(
     python_requires='>=3.10',
     entry_points={
         'console_scripts': [
-            'lumpbeam = lumpbeam_ros.cli.script:lumpbeam',
+            'lumpbeam = lumpbeam_ros.apps.cli.script:lumpbeam',
             'identifier_node = lumpbeam_ros.nodes.scripts:identifier_node',
             'simulator_node = lumpbeam_ros.nodes.scripts:simulator_node',
             'camera_node = lumpbeam_ros.nodes.scripts:camera_node',

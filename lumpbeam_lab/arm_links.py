@@ -32,8 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lumpbeam_ros.arm.config import ArmConfig, load_arm_config
-from lumpbeam_ros.arm.link_fit import (
+from lumpbeam_ros.core.ident.arm.link_fit import (
     LinkFit,
     LinkParameterFit,
     MeasuredMode,
@@ -41,9 +40,10 @@ from lumpbeam_ros.arm.link_fit import (
     link_stiffness_total,
     scaled_arm,
 )
-from lumpbeam_ros.arm.model import ArmModel
-from lumpbeam_ros.arm.statics import arm_modes
-from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
+from lumpbeam_ros.core.model.arm.config import ArmConfig, load_arm_config
+from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
+from lumpbeam_ros.core.model.arm.model import ArmModel
+from lumpbeam_ros.core.model.arm.statics import arm_modes
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The nominal values' error: every stiffness and damping off by this fraction.
@@ -245,9 +245,9 @@ def run_bag_trials(case: ArmCase, folder: Path, trials: int, seed: int = 0) -> B
 
     Each campaign draws new measurement noise for its bags and a new nominal arm 20 % off.
     """
-    from lumpbeam_ros.arm.bag_modes import bag_observations
-    from lumpbeam_ros.ident.settings import IdentifierConfig
-    from lumpbeam_ros.synthetic.arm_bag import ArmSynthOptions, write_arm_bag
+    from lumpbeam_ros.core.ident.arm.bag_modes import bag_observations
+    from lumpbeam_ros.core.ident.settings import IdentifierConfig
+    from lumpbeam_ros.core.synthetic.arm_bag import ArmSynthOptions, write_arm_bag
 
     truth = load_arm_config(case.config)
     rng = np.random.default_rng(seed)

@@ -26,8 +26,8 @@ import mujoco
 import mujoco.rollout
 import numpy as np
 
-from lumpbeam_ros.arm.config import ArmConfig, arm_from_mapping
-from lumpbeam_ros.model.parameters import BeamParameters
+from lumpbeam_ros.core.model.arm.config import ArmConfig, arm_from_mapping
+from lumpbeam_ros.core.model.parameters import BeamParameters
 
 Drive = Callable[[float], tuple[np.ndarray, np.ndarray]]
 #: ``times -> (q, q')`` for an array of times, one row per time.

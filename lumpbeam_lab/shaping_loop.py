@@ -4,8 +4,8 @@ What the live demo is to do with nodes, done here with the same core calls on sy
 bags, so it runs before the simulator node's arm mode and the multi-mode identifier exist:
 
 1. the arm (an arm file, the truth) moves unshaped and rings: a bag with 20 um of noise;
-2. the modes of its ring-down are identified from the bag (:mod:`lumpbeam_ros.arm.bag_modes`),
-   with their standard deviations;
+2. the modes of its ring-down are identified from the bag
+   (:mod:`lumpbeam_ros.core.ident.arm.bag_modes`), with their standard deviations;
 3. the shaper the shaper node would choose for them (its defaults: ZV, EI when a frequency
    is uncertain by more than 1 %) shapes the move back;
 4. the arm moves back shaped (a second bag, from rest where the first ended);
@@ -26,19 +26,19 @@ from pathlib import Path
 
 import numpy as np
 
-from lumpbeam_ros.arm.bag_modes import bag_observation
-from lumpbeam_ros.arm.config import ArmConfig, load_arm_config
-from lumpbeam_ros.arm.link_fit import MeasuredMode
-from lumpbeam_ros.ident.settings import IdentifierConfig
-from lumpbeam_ros.interface import TIP_POSE_TRUTH
-from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
-from lumpbeam_ros.params.shaper_params import SHAPER_SCHEMA
-from lumpbeam_ros.shaping.apply import shape_trajectory
-from lumpbeam_ros.shaping.estimate import ModeEstimate, choose_shaper
-from lumpbeam_ros.shaping.impulses import Impulses, Mode
-from lumpbeam_ros.shaping.loop import ShapingOutcome, bag_move_residuals
-from lumpbeam_ros.shaping.shapers import design_shaper
-from lumpbeam_ros.synthetic.arm_bag import ArmSynthOptions, write_arm_bag
+from lumpbeam_ros.base.interface import TIP_POSE_TRUTH
+from lumpbeam_ros.core.ident.arm.bag_modes import bag_observation
+from lumpbeam_ros.core.ident.arm.link_fit import MeasuredMode
+from lumpbeam_ros.core.ident.settings import IdentifierConfig
+from lumpbeam_ros.core.model.arm.config import ArmConfig, load_arm_config
+from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
+from lumpbeam_ros.core.shaping.apply import shape_trajectory
+from lumpbeam_ros.core.shaping.estimate import ModeEstimate, choose_shaper
+from lumpbeam_ros.core.shaping.impulses import Impulses, Mode
+from lumpbeam_ros.core.shaping.loop import ShapingOutcome, bag_move_residuals
+from lumpbeam_ros.core.shaping.shapers import design_shaper
+from lumpbeam_ros.core.synthetic.arm_bag import ArmSynthOptions, write_arm_bag
+from lumpbeam_ros.nodes.params.shaper_params import SHAPER_SCHEMA
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Seconds recorded after each move: the identifier's ring-down and the residual's window.
@@ -148,7 +148,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             report, outcome = run_loop(case, Path(folder))
         print(report)
         if args.out:
-            from lumpbeam_ros.plots.shaping import plot_shaping_outcome
+            from lumpbeam_ros.apps.plots.shaping import plot_shaping_outcome
 
             print(f'  wrote {plot_shaping_outcome(outcome, args.out / f"{case.name}_loop.png")}')
     return 0

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from lumpbeam_ros.cli.main import main
+from lumpbeam_ros.apps.cli.main import main
 
 #: The demo's options: 7 s of synthetic drop test (release at 2 s) without camera frames,
 #: with the demo's default hidden effect (a 15 ms camera latency) for the live diagnosis.

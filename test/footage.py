@@ -8,7 +8,7 @@ import cv2
 import numpy as np
 import yaml
 
-from lumpbeam_ros.vision.camera_model import CameraInfo
+from lumpbeam_ros.core.vision.camera_model import CameraInfo
 
 #: ROS Bayer pattern -> the colour of the 2 x 2 block's pixels, row by row.
 PATTERNS = {'bayer_rggb8': 'RGGB', 'bayer_bggr8': 'BGGR', 'bayer_gbrg8': 'GBRG',

@@ -1,11 +1,12 @@
 """Launch-free fixtures for tests that run real ROS 2 nodes in the test process.
 
 Every test gets its own ``rclpy`` Context on its own ROS domain, claimed for the test's
-duration (:mod:`lumpbeam_ros.ros_domain`), so tests never see each other's topics, even when
+duration (:mod:`lumpbeam_ros.nodes.ros_domain`), so tests never see each other's topics, even when
 pytest-xdist runs them in several workers at once, and no ``launch`` or daemon is needed.
 Discovery stays on this machine (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``).
 
-Use it from any test (``test/conftest.py`` registers the fixture)::
+Use it from any test (``test/conftest.py`` registers the fixture, importing this module and
+rclpy only for the tests that take it)::
 
     def test_echo(ros_graph):
         from std_msgs.msg import Float64
@@ -40,7 +41,7 @@ from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, qos_profile_sensor_data
 
-from lumpbeam_ros.ros_domain import PRIVATE_DOMAIN_IDS, DomainClaim, claim_domain_id
+from lumpbeam_ros.nodes.ros_domain import PRIVATE_DOMAIN_IDS, DomainClaim, claim_domain_id
 
 # Fast DDS maps domain ids to UDP ports; 0..101 and 215..232 are valid on Linux for any
 # number of participants. Domain 0 is left to a developer's own ROS graph.
@@ -179,7 +180,7 @@ STOP_BOUND_S = 2.0
 
 
 def start_process(env: dict[str, str], *argv: str) -> subprocess.Popen[str]:
-    """Starts ``python -m ARGV...`` (a node's module or ``lumpbeam_ros.cli.main ...``).
+    """Starts ``python -m ARGV...`` (a node's module or ``lumpbeam_ros.apps.cli.main ...``).
 
     Args:
         env: Its environment (:func:`ros_env`).
@@ -217,9 +218,8 @@ def stop_with(
     return process.returncode, stdout, stderr
 
 
-@pytest.fixture
-def ros_graph(monkeypatch: pytest.MonkeyPatch) -> Iterator[RosGraph]:
-    """A private ROS graph for one test (see the module docstring)."""
+def open_ros_graph(monkeypatch: pytest.MonkeyPatch) -> Iterator[RosGraph]:
+    """A private ROS graph for one test (the ``ros_graph`` fixture, ``test/conftest.py``)."""
     monkeypatch.setenv('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     log_dir = Path.cwd() / '.cache' / 'ros' / 'log'
     log_dir.mkdir(parents=True, exist_ok=True)
@@ -232,8 +232,7 @@ def ros_graph(monkeypatch: pytest.MonkeyPatch) -> Iterator[RosGraph]:
             graph.shutdown()
 
 
-@pytest.fixture
-def ros_domain_id() -> Iterator[int]:
-    """A domain id held for one test, for ROS code the test does not give a context to."""
+def held_domain_id() -> Iterator[int]:
+    """A domain id held for one test (the ``ros_domain_id`` fixture, ``test/conftest.py``)."""
     with claim_test_domain() as claim:
         yield claim.domain_id

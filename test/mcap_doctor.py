@@ -3,7 +3,7 @@
 The mcap CLI's ``doctor`` cannot be installed from the package registries here, so the
 checks it makes (magic, record framing, chunk CRCs and time ranges, log-time order, message
 and chunk indexes, statistics, metadata.yaml counts) are made by
-:mod:`lumpbeam_lab.doctor`, the product's own implementation of them.
+:mod:`lumpbeam_ros.core.bagio.check`, the product's own implementation of them.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from lumpbeam_lab.doctor import examine_bag
+from lumpbeam_ros.core.bagio.check import examine_bag
 
 
 @pytest.fixture(scope='session')

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lumpbeam_ros.bagio import BagWriter
+from lumpbeam_ros.core.bagio import BagWriter
 
 LENGTH_M = 0.419
 MOVE_S = 0.3

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lumpbeam_ros.vision.camera_info_file import read_camera_info_file
+from lumpbeam_ros.core.vision.camera_info_file import read_camera_info_file
 
 ROOT = Path(__file__).resolve().parents[1]
 PHOTOS = ROOT / 'test' / 'data' / 'real_photos'

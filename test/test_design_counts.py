@@ -29,7 +29,9 @@ def test_a_literal_outside_the_interface_is_found(tmp_path):
     tool = _tool()
     package = tmp_path / 'lumpbeam_ros'
     package.mkdir()
-    (package / 'interface.py').write_text((ROOT / 'lumpbeam_ros' / 'interface.py').read_text())
+    (package / 'base').mkdir()
+    interface = ROOT / 'lumpbeam_ros' / 'base' / 'interface.py'
+    (package / 'base' / 'interface.py').write_text(interface.read_text())
     (package / 'node.py').write_text(
         '"""Uses \'/tip_pose\' in a docstring only."""\nX = \'/tip_pose\'\n'
     )
@@ -79,39 +81,42 @@ def test_the_counts_find_what_they_count(tool, tmp_path, monkeypatch):
     repo = _package(
         tmp_path,
         {
-            'vision/config.py': "F = get_float(p, 'camera.focal_length_px', source, 2400.0)\n",
-            'vision/other.py': 'class C:\n    focal_length_px: float = 2400.0\n',
-            'model/table.py': "OFF = {'sensor_scale': 1.0}\n",
-            'viz/markers.py': 'from lumpbeam_lab.camera import accuracy\n',
-            'synthetic/cases.py': "CASES = ({'added_mass': 0.3},)\n",  # example cases
+            'core/vision/config.py': (
+                "F = get_float(p, 'camera.focal_length_px', source, 2400.0)\n"
+            ),
+            'core/vision/other.py': 'class C:\n    focal_length_px: float = 2400.0\n',
+            'core/model/table.py': "OFF = {'sensor_scale': 1.0}\n",
+            'core/viz/markers.py': 'from lumpbeam_lab.camera import accuracy\n',
+            'core/synthetic/cases.py': "CASES = ({'added_mass': 0.3},)\n",  # example cases
         },
     )
     schemas = tool._schemas(ROOT)
     monkeypatch.setattr(tool, '_schemas', lambda repo: schemas)
     assert tool.repeated_parameter_literals(repo) == [
         'camera_node camera.focal_length_px: '
-        'lumpbeam_ros/vision/config.py:1, lumpbeam_ros/vision/other.py:2'
+        'lumpbeam_ros/core/vision/config.py:1, lumpbeam_ros/core/vision/other.py:2'
     ]
-    assert tool.effect_places(repo) == ['lumpbeam_ros/model/table.py:1: a table naming 1']
-    assert tool.lab_imports(repo) == ['lumpbeam_ros/viz/markers.py:1: lumpbeam_lab.camera']
+    assert tool.effect_places(repo) == ['lumpbeam_ros/core/model/table.py:1: a table naming 1']
+    assert tool.lab_imports(repo) == ['lumpbeam_ros/core/viz/markers.py:1: lumpbeam_lab.camera']
 
 
-def test_a_lab_import_by_the_product_is_found_and_the_cli_may_run_the_lab(tmp_path):
+def test_a_lab_import_anywhere_in_the_product_is_found(tmp_path):
     tool = _tool()
-    for folder in ('vision', 'nodes', 'cli'):
+    for folder in ('core/vision', 'nodes', 'apps/cli'):
         (tmp_path / 'lumpbeam_ros' / folder).mkdir(parents=True)
-    (tmp_path / 'lumpbeam_ros' / 'vision' / 'scores.py').write_text(
+    (tmp_path / 'lumpbeam_ros' / 'core' / 'vision' / 'scores.py').write_text(
         'from lumpbeam_lab.camera.accuracy import score\n'
     )
     (tmp_path / 'lumpbeam_ros' / 'nodes' / 'node.py').write_text(
-        'def f():\n    import lumpbeam_lab.doctor\n'
+        'def f():\n    import lumpbeam_lab.mujoco_arm\n'
     )
-    (tmp_path / 'lumpbeam_ros' / 'cli' / 'bench.py').write_text(
+    (tmp_path / 'lumpbeam_ros' / 'apps' / 'cli' / 'bench.py').write_text(
         'from lumpbeam_lab.bench.runner import run_suites\n'
     )
     assert tool.lab_imports(tmp_path) == [
-        'lumpbeam_ros/nodes/node.py:2: lumpbeam_lab.doctor',
-        'lumpbeam_ros/vision/scores.py:1: lumpbeam_lab.camera.accuracy',
+        'lumpbeam_ros/apps/cli/bench.py:1: lumpbeam_lab.bench.runner',
+        'lumpbeam_ros/core/vision/scores.py:1: lumpbeam_lab.camera.accuracy',
+        'lumpbeam_ros/nodes/node.py:2: lumpbeam_lab.mujoco_arm',
     ]
 
 
@@ -123,22 +128,22 @@ def test_a_reader_of_its_own_is_found(tool, tmp_path):
     repo = _package(
         tmp_path,
         {
-            'vision/offline.py': 'from mcap.reader import SeekingReader\n',
-            'bagio/reader.py': (
+            'core/vision/offline.py': 'from mcap.reader import SeekingReader\n',
+            'core/bagio/reader.py': (
                 'from mcap.stream_reader import StreamReader\n'
                 "(length,) = struct.unpack_from('<Q', data, 1)\n"
             ),
-            'bagio/fastscan.py': "(n,) = struct.unpack_from('<I', first, 12)\n",
+            'core/bagio/fastscan.py': "(n,) = struct.unpack_from('<I', first, 12)\n",
         },
     )
     assert tool.bag_readers(repo) == [
-        "lumpbeam_ros/bagio/fastscan.py:1: (n,) = struct.unpack_from('<I', first, 12)",
-        "lumpbeam_ros/bagio/reader.py:2: (length,) = struct.unpack_from('<Q', data, 1)",
-        'lumpbeam_ros/vision/offline.py:1: import mcap.reader',
+        "lumpbeam_ros/core/bagio/fastscan.py:1: (n,) = struct.unpack_from('<I', first, 12)",
+        "lumpbeam_ros/core/bagio/reader.py:2: (length,) = struct.unpack_from('<Q', data, 1)",
+        'lumpbeam_ros/core/vision/offline.py:1: import mcap.reader',
     ]
     # The fast path with its agreement test is the one kept beside the reader.
-    (repo / 'test' / 'bagio').mkdir(parents=True)
-    (repo / 'test' / 'bagio' / 'test_fastscan.py').write_text('')
+    (repo / 'test' / 'core' / 'bagio').mkdir(parents=True)
+    (repo / 'test' / 'core' / 'bagio' / 'test_fastscan.py').write_text('')
     assert len(tool.bag_readers(repo)) == 2
 
 

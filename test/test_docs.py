@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import ast
 import doctest
+import importlib.util
 import os
 import re
 import shutil
@@ -25,17 +26,26 @@ from urllib.parse import unquote
 import pytest
 
 from lumpbeam_lab.bench.bench_result import BenchResult
-from lumpbeam_ros.arm.link_fit import MeasuredMode
-from lumpbeam_ros.campaign.task import ID_COLUMNS
-from lumpbeam_ros.cli.analyze import CONTRACT_KEYS
-from lumpbeam_ros.cli.main import COMMANDS, build_parser
-from lumpbeam_ros.diagnose.gap import Gap
-from lumpbeam_ros.diagnose.signatures import Signatures
-from lumpbeam_ros.ident.identification import Identification, Status
-from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS
-from lumpbeam_ros.model.reproduce import Comparison, TableRow
+from lumpbeam_ros.apps.campaign.task import ID_COLUMNS
+from lumpbeam_ros.apps.cli.analyze import CONTRACT_KEYS
+from lumpbeam_ros.apps.cli.main import COMMANDS, build_parser
+from lumpbeam_ros.core.diagnose.gap import Gap
+from lumpbeam_ros.core.diagnose.signatures import Signatures
+from lumpbeam_ros.core.ident.arm.link_fit import MeasuredMode
+from lumpbeam_ros.core.ident.identification import Identification, Status
+from lumpbeam_ros.core.model.parameters import EFFECT_PARAMETERS
+from lumpbeam_ros.core.model.reproduce import Comparison, TableRow
 
 ROOT = Path(__file__).resolve().parents[1]
+
+
+def _docs_site():
+    spec = importlib.util.spec_from_file_location('docs_site', ROOT / 'tools' / 'docs_site.py')
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 PACKAGE = ROOT / 'lumpbeam_ros'
 DOCS = sorted((ROOT / 'doc').glob('*.md'))
 INTERFACES = ROOT / 'doc' / 'interfaces.md'
@@ -138,11 +148,11 @@ def json_keys() -> dict[str, set[str]]:
     """The keys each output of the product writes, by where they come from."""
     identification = set(Identification(Status.ERROR, '').as_dict())
     return {
-        'reproduce': dict_keys('cli/reproduce.py', 'result_json')
+        'reproduce': dict_keys('apps/cli/reproduce.py', 'result_json')
         | field_names(TableRow)
         | field_names(Comparison)
-        | dict_keys('model/reproduce.py', 'paper_frequencies')
-        | dict_keys('model/reproduce.py', 'static_test'),
+        | dict_keys('core/model/reproduce.py', 'paper_frequencies')
+        | dict_keys('core/model/reproduce.py', 'static_test'),
         'analyze': set(CONTRACT_KEYS)
         | {f'{key}_std' for key in CONTRACT_KEYS}
         | {'release_time_s', 'static_deflection_m'}
@@ -150,22 +160,22 @@ def json_keys() -> dict[str, set[str]]:
         '/beam_params': (identification - {'status', 'message'})
         | pair_keys('nodes/identifier_node.py', 'IdentifierNode.diagnostics'),
         '/diagnostics': dict_keys('nodes/camera_node.py', 'CameraNode.diagnostic_status'),
-        'diagnose': dict_keys('diagnose/workflow.py', 'Diagnosis.as_dict')
-        | dict_keys('diagnose/workflow.py', '_score_details')
+        'diagnose': dict_keys('core/diagnose/workflow.py', 'Diagnosis.as_dict')
+        | dict_keys('core/diagnose/workflow.py', '_score_details')
         | field_names(Gap)
         | field_names(Signatures),
-        'compare': dict_keys('compare/comparison.py', 'Comparison.as_dict'),
-        'track': dict_keys('cli/track.py', 'run'),
-        'bench': dict_keys('cli/bench.py', 'run') | field_names(BenchResult),
-        'demo': dict_keys('demo/steps.py', 'summarize'),
+        'compare': dict_keys('core/compare/comparison.py', 'Comparison.as_dict'),
+        'track': dict_keys('apps/cli/track.py', 'run'),
+        'bench': dict_keys('apps/cli/bench.py', 'run') | field_names(BenchResult),
+        'demo': dict_keys('apps/demo/steps.py', 'summarize'),
         'campaign': set(ID_COLUMNS),
-        'fit-links': dict_keys('arm/link_fit.py', 'LinkEstimate.as_dict')
-        | dict_keys('arm/link_fit.py', 'LinkFit.as_json')
-        | dict_keys('cli/fit_links.py', 'run_fit_links')
+        'fit-links': dict_keys('core/ident/arm/link_fit.py', 'LinkEstimate.as_dict')
+        | dict_keys('core/ident/arm/link_fit.py', 'LinkFit.as_json')
+        | dict_keys('apps/cli/fit_links.py', 'run_fit_links')
         | {f.name for f in fields(MeasuredMode)},
-        'shape': dict_keys('cli/shape.py', 'run')
-        | dict_keys('shaping/vibration.py', 'vibration_summary')
-        | dict_keys('shaping/impulses.py', 'Impulses.as_list'),
+        'shape': dict_keys('apps/cli/shape.py', 'run')
+        | dict_keys('core/shaping/vibration.py', 'vibration_summary')
+        | dict_keys('core/shaping/impulses.py', 'Impulses.as_list'),
     }
 
 
@@ -420,9 +430,9 @@ def test_the_link_check_finds_a_broken_link(site, tmp_path):
 
 def test_every_core_package_has_an_api_page(site):
     # The pages are generated from tools/test_modules.py's core list (tools/docs_site.py).
-    from test_test_modules import _tool
-
-    for name in _tool().CORE_PACKAGES:
+    names = _docs_site().core_packages()
+    assert {'base', 'core.model', 'core.ident', 'nodes.params', 'apps.plots'} <= set(names)
+    for name in names:
         page = site / 'api' / name / 'index.html'
         assert page.is_file(), f'no API page for lumpbeam_ros.{name}'
         assert f'id="lumpbeam_ros.{name}' in page.read_text(encoding='utf-8')
@@ -432,7 +442,7 @@ def test_every_core_package_has_an_api_page(site):
 def test_the_lab_has_its_api_pages(site, name):
     page = site / 'api' / 'lab' / name / 'index.html'
     assert page.is_file(), f'no API page for the lab: {name}'
-    anchor = 'lumpbeam_lab.doctor' if name == 'top_level' else f'lumpbeam_lab.{name}'
+    anchor = 'lumpbeam_lab.mujoco_arm' if name == 'top_level' else f'lumpbeam_lab.{name}'
     assert f'id="{anchor}' in page.read_text(encoding='utf-8')
 
 

@@ -74,6 +74,8 @@ def test_colcon_installs_the_package_index_configs_and_data(install_space):
     shipped = {p.name for p in (share / PACKAGE / 'config').iterdir()}
     assert {p.name for p in (ROOT / 'config').iterdir()} <= shipped
     (site,) = (install_space / 'lib').glob('python3*/site-packages')
-    data = {p.name for p in (site / PACKAGE / 'data').iterdir()}
-    assert {p.name for p in (ROOT / PACKAGE / 'data').iterdir()} <= data
-    assert (site / 'lumpbeam_lab' / '__init__.py').is_file()
+    data = {p.name for p in (site / PACKAGE / 'base' / 'data').iterdir()}
+    assert {p.name for p in (ROOT / PACKAGE / 'base' / 'data').iterdir()} <= data
+    # The product alone: what proves it stays in the repository.
+    assert (site / PACKAGE / 'core' / 'model' / 'arm' / 'simulate.py').is_file()
+    assert not (site / 'lumpbeam_lab').exists()

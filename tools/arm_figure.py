@@ -7,7 +7,7 @@ Usage (from the repository root)::
 It writes a 1 s rest-to-rest cycloidal move of the three joints to a trajectory file,
 simulates it into a synthetic bag as ``lumpbeam synth --arm --trajectory`` does (with
 ``/beam_markers``), and draws snapshots of the markers during and after the move
-(:func:`lumpbeam_ros.plots.arm.plot_arm_snapshots`). Everything but the PNG goes to a
+(:func:`lumpbeam_ros.apps.plots.arm.plot_arm_snapshots`). Everything but the PNG goes to a
 temporary folder.
 """
 
@@ -19,10 +19,10 @@ from pathlib import Path
 
 import numpy as np
 
-from lumpbeam_ros.arm.config import load_arm_config
-from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
-from lumpbeam_ros.plots.arm import plot_arm_snapshots
-from lumpbeam_ros.synthetic.arm_bag import ArmSynthOptions, write_arm_bag
+from lumpbeam_ros.apps.plots.arm import plot_arm_snapshots
+from lumpbeam_ros.core.model.arm.config import load_arm_config
+from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
+from lumpbeam_ros.core.synthetic.arm_bag import ArmSynthOptions, write_arm_bag
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The move: each joint's excursion, rad, over MOVE_S, then the ring-down to RECORD_S.

@@ -3,7 +3,7 @@
 Usage: ``python tools/design_counts.py [REPO]``. Prints, one line each:
 
 - names of the interface (topics, frames, status and node names) written as string literals
-  outside ``lumpbeam_ros/interface.py`` (docstrings and comments do not count; the camera
+  outside ``lumpbeam_ros/base/interface.py`` (docstrings and comments do not count; the camera
   frame's name, the word ``'camera'``, also labels the camera among the sensors and is left
   out);
 - how nodes get their parameters: ``declare_parameter`` calls outside the one schema-driven
@@ -47,8 +47,8 @@ def _load(path: Path, name: str) -> object:
 
 
 def interface_names(repo: Path) -> set[str]:
-    """The string constants ``lumpbeam_ros/interface.py`` declares (names, not types)."""
-    tree = ast.parse((repo / 'lumpbeam_ros' / 'interface.py').read_text())
+    """The string constants ``lumpbeam_ros/base/interface.py`` declares (names, not types)."""
+    tree = ast.parse((repo / 'lumpbeam_ros' / 'base' / 'interface.py').read_text())
     names = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.Assign | ast.AnnAssign) and isinstance(node.value, ast.Constant):
@@ -69,15 +69,27 @@ def _docstring_lines(tree: ast.Module) -> set[int]:
     return lines
 
 
+def _all_lines(tree: ast.Module) -> set[int]:
+    """The lines of a package's ``__all__`` (module names, which may be a node's name)."""
+    lines: set[int] = set()
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and any(
+            isinstance(target, ast.Name) and target.id == '__all__' for target in node.targets
+        ):
+            lines.update(range(node.lineno, (node.end_lineno or node.lineno) + 1))
+    return lines
+
+
 def literal_uses(repo: Path) -> list[str]:
     """``file:line: 'name'`` for each interface name written as a literal outside it."""
     names = interface_names(repo)
     found = []
     for path in sorted((repo / 'lumpbeam_ros').rglob('*.py')):
-        if path.name == 'interface.py' and path.parent.name == 'lumpbeam_ros':
+        if path.name == 'interface.py' and path.parent.name == 'base':
             continue
         text = path.read_text()
-        skip = _docstring_lines(ast.parse(text))
+        tree = ast.parse(text)
+        skip = _docstring_lines(tree) | _all_lines(tree)
         for token in tokenize.generate_tokens(io.StringIO(text).readline):
             if token.type != tokenize.STRING or token.start[0] in skip:
                 continue
@@ -107,22 +119,22 @@ def _grep(repo: Path, pattern: str, exclude: tuple[str, ...] = ()) -> list[str]:
 
 #: Where node parameters are declared and merely carried (not a reader of any of them).
 PLUMBING = (
-    'lumpbeam_ros/params/',
-    'lumpbeam_ros/paramfile.py',
+    'lumpbeam_ros/nodes/params/',
+    'lumpbeam_ros/base/paramfile.py',
     'lumpbeam_ros/nodes/ros_parameters.py',
 )
 
 #: The lab: what proves the product (benchmarks, the validation renderer, accuracy scoring
-#: against truth, the doctor of our own bags), a package of its own beside ``lumpbeam_ros``.
+#: against truth), a package of its own beside ``lumpbeam_ros``, not installed.
 LAB = 'lumpbeam_lab'
 
 #: Example cases of the product's synthetic data and demo (hidden effects to find): left out
 #: of the places that must change to add an effect.
-_EXAMPLES = ('lumpbeam_ros/demo/', 'lumpbeam_ros/synthetic/')
+_EXAMPLES = ('lumpbeam_ros/apps/demo/', 'lumpbeam_ros/core/synthetic/')
 
-#: The one part of the product that imports the lab by design: the commands that run it
-#: (``lumpbeam bench``, ``lumpbeam doctor``).
-_RUNS_THE_LAB = ('lumpbeam_ros/cli/',)
+#: No part of the product imports the lab: ``lumpbeam bench`` finds it in the checkout at run
+#: time (``importlib``), so an installed wheel runs without it.
+_RUNS_THE_LAB: tuple[str, ...] = ()
 
 _NODE_MODULES = {
     'camera_node': 'camera_node',
@@ -141,14 +153,14 @@ def _sources(repo: Path) -> dict[str, ast.Module]:
 
 
 def _schemas(repo: Path) -> list[Any]:
-    """The nodes' parameter schemas (``lumpbeam_ros.params.reference.SCHEMAS``) of ``repo``."""
+    """The nodes' parameter schemas (``nodes.params.reference.SCHEMAS``) of ``repo``."""
     loaded = sys.modules.get('lumpbeam_ros')
     if loaded is None or Path(str(loaded.__file__)).resolve().parents[1] != repo.resolve():
         # Another tree's package (a stash, a worktree) is imported afresh from ``repo``.
         for name in [m for m in sys.modules if m.split('.')[0] == 'lumpbeam_ros']:
             del sys.modules[name]
         sys.path.insert(0, str(repo))
-    reference = importlib.import_module('lumpbeam_ros.params.reference')
+    reference = importlib.import_module('lumpbeam_ros.nodes.params.reference')
     return list(reference.SCHEMAS)
 
 
@@ -488,16 +500,16 @@ def lab_imports(repo: Path) -> list[str]:
 # --- One reader of bags ------------------------------------------------------------------------
 
 #: The one reader of bags: it may import mcap's record-level readers, and parses no bytes itself.
-THE_READER = 'lumpbeam_ros/bagio/reader.py'
+THE_READER = 'lumpbeam_ros/core/bagio/reader.py'
 #: The type system: rosbags' CDR deserializer is called here, and only here.
-_TYPE_SYSTEM = 'lumpbeam_ros/bagio/typestore.py'
+_TYPE_SYSTEM = 'lumpbeam_ros/core/bagio/typestore.py'
 #: The fast path kept beside the reader, and the test that it agrees with the library
 #: message for message (without the test, the fast path counts).
-FAST_PATH = ('lumpbeam_ros/bagio/fastscan.py', 'test/bagio/test_fastscan.py')
+FAST_PATH = ('lumpbeam_ros/core/bagio/fastscan.py', 'test/core/bagio/test_fastscan.py')
 
-#: The lab's check of the record layout our writer makes (the checks of ``mcap doctor``): it
+#: The check of the record layout our writer makes (the checks of ``mcap doctor``): it
 #: looks at records to judge them, and reads no message for anyone.
-_LAYOUT_CHECKER = 'lumpbeam_lab/doctor.py'
+_LAYOUT_CHECKER = 'lumpbeam_ros/core/bagio/check.py'
 
 #: Modules that parse MCAP records, or read bags, on their own: mcap's record-level readers
 #: and rosbags' bag readers and deserializers.
@@ -618,13 +630,13 @@ def main(argv: list[str]) -> int:
     """Prints the counts, each with the places that make it up."""
     repo = Path(argv[1]) if len(argv) > 1 else Path(__file__).resolve().parents[1]
     rows = {
-        'interface names as literals outside lumpbeam_ros/interface.py': literal_uses(repo),
+        'interface names as literals outside lumpbeam_ros/base/interface.py': literal_uses(repo),
         'declare_parameter calls outside nodes/ros_parameters.py': _grep(
             repo, r'\.declare_parameters?\(', ('lumpbeam_ros/nodes/ros_parameters.py',)
         ),
         'tip-series types (classes with their own z column)': _grep(repo, r'^    z: np\.ndarray$'),
         'places decoding /tip_pose (the bag reader; nodes on live messages)': _grep(
-            repo, r'pose_values\(', ('lumpbeam_ros/bagio/convert.py',)
+            repo, r'pose_values\(', ('lumpbeam_ros/core/bagio/convert.py',)
         ),
         'node parameters whose literal default or bound is written in more than one place': (
             repeated_parameter_literals(repo)

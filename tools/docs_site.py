@@ -3,13 +3,15 @@
 Both are derived, never written twice. The home page is README.md with its links into
 ``doc/`` made relative to the site (and the pages' links back to ``../README.md`` pointed at
 it), so the same Markdown reads right on a Git host and on the site. The API pages follow
-the core's package list in ``tools/test_modules.py``: a new core package gets its page
-without an edit here. The lab (``lumpbeam_lab``: benchmarks, validation, the MCAP doctor) gets
-a page per subpackage and one for its top-level modules, under their own heading.
+the ROS-free parts that ``tools/test_modules.py`` lists, each package's page built from its
+``__all__``: a new core package gets its page without an edit here. The lab
+(``lumpbeam_lab``: benchmarks, validation, peers) gets a page per subpackage and one for its
+top-level modules, under their own heading.
 """
 
 from __future__ import annotations
 
+import ast
 import importlib.util
 import re
 from collections.abc import Iterable
@@ -32,19 +34,46 @@ _README_DOC_LINK = re.compile(r'\]\(doc/')
 _PAGE_README_LINK = re.compile(r'\]\(\.\./README\.md')
 
 
-def core_packages() -> tuple[str, ...]:
-    """The core packages, as ``tools/test_modules.py`` declares them."""
+def _load_tool() -> Any:
     path = ROOT / 'tools' / 'test_modules.py'
     spec = importlib.util.spec_from_file_location('test_modules_tool', path)
     if spec is None or spec.loader is None:
         raise RuntimeError(f'cannot load {path}')
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    return tuple(module.CORE_PACKAGES)
+    return module
+
+
+def public_names(package: Path) -> list[str]:
+    """A package's ``__all__``, read from its ``__init__.py`` without importing it."""
+    tree = ast.parse((package / '__init__.py').read_text(encoding='utf-8'))
+    for node in tree.body:
+        if isinstance(node, ast.Assign | ast.AnnAssign):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            if any(isinstance(t, ast.Name) and t.id == '__all__' for t in targets):
+                return [str(name) for name in ast.literal_eval(node.value)]  # type: ignore[arg-type]
+    return []
+
+
+def core_packages() -> tuple[str, ...]:
+    """The documented parts, dotted under the package (one API page each).
+
+    They are the ROS-free parts that ``tools/test_modules.py`` lists; a floor made of
+    packages (``core``) gives one part per package, in the order of its ``__all__``.
+    """
+    parts = []
+    for entry in _load_tool().CORE_PACKAGES:
+        dotted = entry.removesuffix('.py').replace('/', '.')
+        folder = ROOT / PACKAGE / entry
+        inside = (
+            [p for p in public_names(folder) if (folder / p).is_dir()] if folder.is_dir() else []
+        )
+        parts += [f'{dotted}.{name}' for name in inside] if inside else [dotted]
+    return tuple(parts)
 
 
 def top_level_modules(package: str = PACKAGE) -> list[str]:
-    """The modules at the top of a package (errors, paramfile, ...), ``__init__`` aside."""
+    """The modules at the top of a package, ``__init__`` aside."""
     return sorted(p.stem for p in (ROOT / package).glob('*.py') if p.stem != '__init__')
 
 
@@ -54,22 +83,22 @@ def lab_packages() -> list[str]:
 
 
 def _package_pages(package: str, names: Iterable[str], folder: str) -> dict[str, str]:
-    pages = {
+    return {
         f'{folder}/{name}.md': f'# `{package}.{name}`\n\n::: {package}.{name}\n' for name in names
     }
-    modules = '\n'.join(f'::: {package}.{name}\n' for name in top_level_modules(package))
-    pages[f'{folder}/top_level.md'] = f'# Top-level modules of `{package}`\n\n{modules}'
-    return pages
 
 
 def api_pages() -> dict[str, str]:
-    """Site path -> Markdown of each API page: one per core package, one for the top level."""
+    """Site path -> Markdown of each API page: one per documented part of the product."""
     return _package_pages(PACKAGE, core_packages(), 'api')
 
 
 def lab_api_pages() -> dict[str, str]:
-    """Site path -> Markdown of the lab's API pages (``api/lab/``)."""
-    return _package_pages(LAB, lab_packages(), 'api/lab')
+    """Site path -> Markdown of the lab's API pages (``api/lab/``): its packages, its modules."""
+    pages = _package_pages(LAB, lab_packages(), 'api/lab')
+    modules = '\n'.join(f'::: {LAB}.{name}\n' for name in top_level_modules(LAB))
+    pages['api/lab/top_level.md'] = f'# Top-level modules of `{LAB}`\n\n{modules}'
+    return pages
 
 
 def _listed(nav: Any) -> set[str]:

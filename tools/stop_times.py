@@ -3,7 +3,7 @@
 Usage: ``python tools/stop_times.py [--busy N] [--delay S] [--only NAME ...]``.
 
 Every process is started as its console script starts it (``lumpbeam_ros.nodes.scripts``,
-``lumpbeam_ros.cli.script``), given work (the nodes hear a looping ``lumpbeam play`` of a
+``lumpbeam_ros.apps.cli.script``), given work (the nodes hear a looping ``lumpbeam play`` of a
 drop test, the camera node tracks a filmed bag, the commands get inputs that keep them busy
 for longer than ``--delay``), signalled ``--delay`` seconds after its start, and timed from
 the signal to its exit. ``--busy N`` runs N busy loops beside it (a loaded machine). A row
@@ -36,7 +36,7 @@ def _script(kind: str, name: str) -> list[str]:
             f'import sys; from lumpbeam_ros.nodes.scripts import {name}_node as f; sys.exit(f())'
         )
     else:
-        code = 'import sys; from lumpbeam_ros.cli.script import lumpbeam as f; sys.exit(f())'
+        code = 'import sys; from lumpbeam_ros.apps.cli.script import lumpbeam as f; sys.exit(f())'
     return [sys.executable, '-c', code]
 
 

@@ -1,10 +1,12 @@
-"""Lists the core modules that have no test module of their own (test/<pkg>/test_<mod>.py).
+"""Lists the ROS-free modules that have no test module of their own.
 
 Usage: ``python tools/test_modules.py [REPO]``; prints the counts, then one missing module a
-line. The core is every package that imports no ROS (doc/architecture.md); the nodes, the CLI
-and the demo are left out. The lab (``lumpbeam_lab``) is held the same way for its ROS-free
-modules (its top-level modules and :data:`LAB_PACKAGES`), mirrored under ``test/lab/``; its
-benchmarks talk to rclpy and are left out like the nodes.
+line. ``test/`` mirrors the package: ``lumpbeam_ros/core/model/chain.py`` is tested in
+``test/core/model/test_chain.py``. The checked modules are those that import no ROS
+(doc/architecture.md): the ground floor, the core, the nodes' schemas and the ROS-free
+applications; the nodes, the CLI and the demo are left out. The lab (``lumpbeam_lab``) is held
+the same way for its ROS-free modules (its top-level modules and :data:`LAB_PACKAGES`),
+mirrored under ``test/lab/``; its benchmarks talk to rclpy and are left out like the nodes.
 """
 
 from __future__ import annotations
@@ -12,23 +14,18 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-#: The ROS-free core: its packages, and the modules at the top of ``lumpbeam_ros``.
+#: The ROS-free parts of the product: packages and modules, relative to ``lumpbeam_ros/``.
 CORE_PACKAGES = (
-    'arm',
-    'bagio',
-    'campaign',
-    'compare',
-    'diagnose',
-    'ident',
-    'model',
-    'motion',
-    'params',
-    'plots',
-    'report',
-    'shaping',
-    'synthetic',
-    'vision',
-    'viz',
+    'base',
+    'core',
+    'nodes/params',
+    'nodes/foxglove_server.py',
+    'nodes/realtime.py',
+    'nodes/ros_domain.py',
+    'apps/campaign',
+    'apps/json_output.py',
+    'apps/plots',
+    'apps/report',
 )
 
 
@@ -38,7 +35,7 @@ LAB_PACKAGES = ('camera', 'ident')
 PRODUCT = 'lumpbeam_ros'
 LAB = 'lumpbeam_lab'
 
-#: Each package's checked subpackages and the folder under ``test/`` that mirrors it.
+#: Each package's checked parts and the folder under ``test/`` that mirrors it.
 PACKAGES = {PRODUCT: (CORE_PACKAGES, Path('test')), LAB: (LAB_PACKAGES, Path('test', 'lab'))}
 
 
@@ -47,7 +44,8 @@ def core_modules(repo: Path, package: str = PRODUCT) -> list[Path]:
     folder = repo / package
     files = [p for p in folder.glob('*.py')]
     for name in PACKAGES[package][0]:
-        files += (folder / name).rglob('*.py')
+        part = folder / name
+        files += part.rglob('*.py') if part.is_dir() else [part]
     return sorted(p.relative_to(folder) for p in files if p.name != '__init__.py')
 
 

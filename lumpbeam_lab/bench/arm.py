@@ -4,7 +4,8 @@ The case is ``config/arm_3link.yaml`` (10 segments per link, 30 in all): a 2 s r
 cycloidal move of the three joints (0.6, -0.9, 0.7 rad) given as a 1 kHz trajectory, then
 8 s of ring-down, the tip sampled at 200 Hz. Three runs of the same case, side by side:
 
-- ours: :func:`~lumpbeam_ros.arm.simulate.simulate_arm` (the modal method), best of a few;
+- ours: :func:`~lumpbeam_ros.core.model.arm.simulate.simulate_arm` (the modal method), best of a
+  few;
 - the tight reference: the same equations by LSODA at ``rtol`` 1e-11 (it moves by a few
   nanometres from ``rtol`` 1e-9), against which both are scored: the tip's distance, RMS
   and largest over every sample;
@@ -28,11 +29,11 @@ import numpy as np
 import yaml
 
 from lumpbeam_lab.bench.bench_result import BenchResult, best_time
-from lumpbeam_ros.arm.config import ArmConfig, arm_from_mapping
-from lumpbeam_ros.arm.drive import SampledMotion
-from lumpbeam_ros.arm.model import ArmModel
-from lumpbeam_ros.arm.simulate import ArmMotion, simulate_arm
-from lumpbeam_ros.arm.statics import arm_equilibrium, arm_linear_model
+from lumpbeam_ros.core.model.arm.config import ArmConfig, arm_from_mapping
+from lumpbeam_ros.core.model.arm.drive import SampledMotion
+from lumpbeam_ros.core.model.arm.model import ArmModel
+from lumpbeam_ros.core.model.arm.simulate import ArmMotion, simulate_arm
+from lumpbeam_ros.core.model.arm.statics import arm_equilibrium, arm_linear_model
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'arm_3link.yaml'
 MOVE_S = 2.0

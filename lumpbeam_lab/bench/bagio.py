@@ -2,14 +2,14 @@
 
 - ``bag_write_1mp_180fps``: 1024 x 1024 mono8 images (CDR-serialized ``sensor_msgs/Image``,
   as the recorder receives them) plus one ``PoseStamped`` per frame, written through
-  :class:`~lumpbeam_ros.bagio.BagWriter` with its periodic flush. Baseline: a plain buffered
+  :class:`~lumpbeam_ros.core.bagio.BagWriter` with its periodic flush. Baseline: a plain buffered
   file write of the same bytes, in the same run. The recorder keeps up with a 180 fps camera
   when the sustained rate exceeds ``180 * frame size`` (``headroom`` > 1). This measures the
   writer path in-process: a full 180 MB/s stream through DDS loopback on a 2-core machine
   measures the middleware's copy cost more than the recorder's.
 - ``bag_read_tip_poses``: a 180 Hz pose topic read into arrays by
-  :func:`~lumpbeam_ros.bagio.read_tip_poses`, whose CDR decoding is the vectorized fast path
-  (:mod:`~lumpbeam_ros.bagio.fastscan`). Baseline: the same reader with the library's
+  :func:`~lumpbeam_ros.core.bagio.read_tip_poses`, whose CDR decoding is the vectorized fast path
+  (:mod:`~lumpbeam_ros.core.bagio.fastscan`). Baseline: the same reader with the library's
   per-message decoding (rosbags, ``fast=False``), in the same run. The details give the
   reader alone (messages read through mcap, not decoded), which both sides share.
 - ``play_timing_p99``: the player's lateness (publish time minus schedule), 99th percentile,
@@ -27,9 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from lumpbeam_lab.bench.bench_result import BenchResult, best_time
-from lumpbeam_ros.bagio import BagReader, BagWriter, convert, read_tip_poses
-from lumpbeam_ros.bagio.typestore import serialize
-from lumpbeam_ros.interface import (
+from lumpbeam_ros.base.interface import (
     BASE_FRAME,
     CAMERA_FRAME,
     IMAGE,
@@ -37,7 +35,9 @@ from lumpbeam_ros.interface import (
     POSE_STAMPED,
     TIP_POSE,
 )
-from lumpbeam_ros.ros_domain import claim_domain_id
+from lumpbeam_ros.core.bagio import BagReader, BagWriter, convert, read_tip_poses
+from lumpbeam_ros.core.bagio.typestore import serialize
+from lumpbeam_ros.nodes.ros_domain import claim_domain_id
 
 FPS = 180.0
 SIDE = 1024

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lumpbeam_ros.interface import (
+from lumpbeam_ros.base.interface import (
     BASE_FRAME,
     BEAM_PARAMS,
     CAMERA_FRAME,
@@ -39,9 +39,9 @@ from lumpbeam_ros.interface import (
     IMAGE,
     TIP_POSE,
 )
-from lumpbeam_ros.realtime import set_normal_scheduling, set_realtime_priority
-from lumpbeam_ros.resources import large_frames_profile
-from lumpbeam_ros.ros_domain import claim_domain_id
+from lumpbeam_ros.base.resources import large_frames_profile
+from lumpbeam_ros.nodes.realtime import set_normal_scheduling, set_realtime_priority
+from lumpbeam_ros.nodes.ros_domain import claim_domain_id
 
 #: Longest wait for the consumer processes to start and be discovered, s (a node importing
 #: OpenCV and scipy on a busy machine takes a while).
@@ -120,8 +120,8 @@ def drop_test_frames(width: int, height: int, rate_hz: float, duration_s: float)
     from dataclasses import replace
 
     from lumpbeam_lab.camera.accuracy import drop_test_trajectory, render_frames
-    from lumpbeam_ros.model.parameters import load_beam_config
-    from lumpbeam_ros.vision.config import load_camera_config
+    from lumpbeam_ros.core.model.parameters import load_beam_config
+    from lumpbeam_ros.core.vision.config import load_camera_config
 
     start = load_beam_config()[1].release_time_s - BEFORE_RELEASE_S
     trajectory = drop_test_trajectory(rate_hz).between(start, start + duration_s - 0.5 / rate_hz)
@@ -145,11 +145,11 @@ def publish(frames_path: str, rate_hz: float, realtime_priority: int = 0) -> int
     import rclpy
     from sensor_msgs.msg import CameraInfo, Image
 
-    from lumpbeam_ros.bagio import convert
-    from lumpbeam_ros.bagio.typestore import serialize
+    from lumpbeam_ros.core.bagio import convert
+    from lumpbeam_ros.core.bagio.typestore import serialize
+    from lumpbeam_ros.core.vision.config import load_camera_config
+    from lumpbeam_ros.core.vision.messages import camera_info_to_data
     from lumpbeam_ros.nodes.endpoints import publisher
-    from lumpbeam_ros.vision.config import load_camera_config
-    from lumpbeam_ros.vision.messages import camera_info_to_data
 
     frames = np.load(frames_path, mmap_mode='r')
     count, height, width = frames.shape
@@ -206,8 +206,8 @@ def echo(realtime_priority: int = 0) -> int:
     from geometry_msgs.msg import PoseStamped
     from sensor_msgs.msg import Image
 
+    from lumpbeam_ros.core.vision.messages import decode_image, prepare_decoders
     from lumpbeam_ros.nodes.endpoints import publisher, subscription
-    from lumpbeam_ros.vision.messages import decode_image, prepare_decoders
 
     prepare_decoders()  # as the camera node does: the baseline's first frame is no slower
     rclpy.init()
@@ -428,7 +428,7 @@ def camera_node_command(realtime_priority: int = 0) -> list[str]:
 
 def identifier_command(publish_rate_hz: float, realtime_priority: int = 0) -> list[str]:
     """The identifier node as a process, on wall time, publishing at ``publish_rate_hz``."""
-    from lumpbeam_ros.demo.graph import node_command
+    from lumpbeam_ros.apps.demo.graph import node_command
 
     return node_command(
         'lumpbeam_ros.nodes.identifier_node',

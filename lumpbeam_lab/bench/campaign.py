@@ -1,10 +1,10 @@
 """Campaign scaling: the same bags on a Dask LocalCluster of 1 and 2 workers, in bags/s.
 
 - ``campaign_dask_1_worker`` and ``campaign_dask_2_workers``: bags per second through
-  :func:`~lumpbeam_ros.campaign.engine.run_campaign` (cluster start excluded, each run into
+  :func:`~lumpbeam_ros.apps.campaign.engine.run_campaign` (cluster start excluded, each run into
   a fresh results folder so nothing is skipped). Baseline: the same bags through a plain
-  loop in this process (:func:`~lumpbeam_ros.campaign.engine.run_serial`), timed in the same
-  run, after the same imports (:func:`~lumpbeam_ros.campaign.task.warm_up`). A short bag
+  loop in this process (:func:`~lumpbeam_ros.apps.campaign.engine.run_serial`), timed in the same
+  run, after the same imports (:func:`~lumpbeam_ros.apps.campaign.task.warm_up`). A short bag
   is analysed in a fraction of a second, so the per-task overhead of Dask (pickling, the
   scheduler's round trips) weighs on the ratio; on a machine with fewer free cores than
   workers the 2-worker rate cannot double.
@@ -18,13 +18,13 @@ import time
 from pathlib import Path
 
 from lumpbeam_lab.bench.bench_result import BenchResult
-from lumpbeam_ros.campaign.engine import run_campaign, run_serial
-from lumpbeam_ros.campaign.store import ResultsStore
-from lumpbeam_ros.campaign.task import CampaignOptions, warm_up
-from lumpbeam_ros.ident.settings import load_identifier_config
-from lumpbeam_ros.model.parameters import DropTestConfig, load_beam_config
-from lumpbeam_ros.synthetic.campaign_bags import write_campaign
-from lumpbeam_ros.synthetic.drop_test import SynthOptions
+from lumpbeam_ros.apps.campaign.engine import run_campaign, run_serial
+from lumpbeam_ros.apps.campaign.store import ResultsStore
+from lumpbeam_ros.apps.campaign.task import CampaignOptions, warm_up
+from lumpbeam_ros.core.ident.settings import load_identifier_config
+from lumpbeam_ros.core.model.parameters import DropTestConfig, load_beam_config
+from lumpbeam_ros.core.synthetic.campaign_bags import write_campaign
+from lumpbeam_ros.core.synthetic.drop_test import SynthOptions
 
 LOADS = (0.5, 1.0, 2.0, 5.0, 10.0)
 

@@ -3,7 +3,7 @@
 Both run as fresh processes of the same interpreter with the same environment, alternated so
 that a busy moment slows both; the figure is the median wall time of each. What the CLI adds
 over the bare interpreter is its own import cost, which the help must keep small: every
-subcommand's dependencies are imported only when it runs (:mod:`lumpbeam_ros.cli.main`).
+subcommand's dependencies are imported only when it runs (:mod:`lumpbeam_ros.apps.cli.main`).
 
 ``cli_start_analyze_12s_bag`` is a whole ``lumpbeam analyze`` of a synthetic 12 s, 180 Hz
 drop-test bag, as a process: its imports, reading the bag, the identification and the
@@ -22,7 +22,7 @@ from pathlib import Path
 from lumpbeam_lab.bench.bench_result import BenchResult
 
 #: What the ``lumpbeam`` console script runs.
-ENTRY_POINT = 'import sys; from lumpbeam_ros.cli.script import lumpbeam; sys.exit(lumpbeam())'
+ENTRY_POINT = 'import sys; from lumpbeam_ros.apps.cli.script import lumpbeam; sys.exit(lumpbeam())'
 BASELINE = 'python -c pass'
 #: The start-up a user should not notice, s.
 BUDGET_S = 0.3
@@ -88,8 +88,8 @@ def analyze_time(runs: int, duration_s: float = 12.0) -> BenchResult:
     Returns:
         The ``cli_start_analyze_<duration>s_bag`` row.
     """
-    from lumpbeam_ros.model.parameters import DropTestConfig, load_beam_config
-    from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+    from lumpbeam_ros.core.model.parameters import DropTestConfig, load_beam_config
+    from lumpbeam_ros.core.synthetic.drop_test import SynthOptions, write_drop_test_bag
 
     beam, _ = load_beam_config()
     with tempfile.TemporaryDirectory(prefix='lumpbeam-bench-') as tmp:

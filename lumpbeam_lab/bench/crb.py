@@ -16,14 +16,14 @@ diagonal element of the inverse):
   amplitude and phase of a beam released from rest. An unbiased estimator reaches it only
   if the oscillation is linear.
 - *nonlinear*: the same with the first mode's amplitude-dependent level and frequency
-  unknown (:mod:`lumpbeam_ros.ident.sinusoid`, ``nonlinear``): ``+ e exp(-2 zeta w t)`` and
+  unknown (:mod:`lumpbeam_ros.core.ident.sinusoid`, ``nonlinear``): ``+ e exp(-2 zeta w t)`` and
   the phase ``+ 2 pi q (1 - exp(-2 zeta w t)) / (2 zeta w)``, at the identified ``e`` and
   ``q``. The beam's frequency depends on its amplitude (the drop's 4 cm make it about 8 ppm
   fast), so an estimator of the small-amplitude frequency that does not know how much is
   bounded by this one; a linear fit is as precise as the linear bound but biased by the
   amplitude-averaged shift.
 - *backbone*: the nonlinear one with what the identifier knows by default, the beam
-  model's backbone (:mod:`lumpbeam_ros.ident.backbone`) as a prior on the shift,
+  model's backbone (:mod:`lumpbeam_ros.core.ident.backbone`) as a prior on the shift,
   ``q = gamma f A^2`` give or take ``fit.shift_prior_std`` of it (a Bayesian bound: the
   prior's information added to the data's). It lies between the other two.
 
@@ -53,15 +53,15 @@ from lumpbeam_lab.bench.bench_result import BenchResult
 from lumpbeam_lab.bench.ident import model_truth
 from lumpbeam_lab.ident.ssi_cov import ssi_cov_modes
 from lumpbeam_lab.mujoco_arm import mujoco_drop_test
-from lumpbeam_ros.blas import single_threaded_blas
-from lumpbeam_ros.ident.backbone import beam_backbone
-from lumpbeam_ros.ident.identify import identify
-from lumpbeam_ros.ident.samples import PoseWindow, clean_window
-from lumpbeam_ros.ident.settings import IdentifierConfig
-from lumpbeam_ros.ident.sinusoid import ShiftPrior
-from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, load_beam_config
-from lumpbeam_ros.model.simulate import simulate_drop_test
-from lumpbeam_ros.model.statics import static_tip_deflection
+from lumpbeam_ros.base.blas import single_threaded_blas
+from lumpbeam_ros.core.ident.backbone import beam_backbone
+from lumpbeam_ros.core.ident.identify import identify
+from lumpbeam_ros.core.ident.samples import PoseWindow, clean_window
+from lumpbeam_ros.core.ident.settings import IdentifierConfig
+from lumpbeam_ros.core.ident.sinusoid import ShiftPrior
+from lumpbeam_ros.core.model.parameters import BeamParameters, DropTestConfig, load_beam_config
+from lumpbeam_ros.core.model.simulate import simulate_drop_test
+from lumpbeam_ros.core.model.statics import static_tip_deflection
 
 RATE_HZ = 180.0
 LOAD_KG = 4.5
@@ -89,7 +89,7 @@ def damped_sinusoid(t: np.ndarray, theta: np.ndarray) -> np.ndarray:
     ``theta = (c, A, zeta, f, p)``: ``c + A exp(-zeta w t) cos(w sqrt(1 - zeta^2) t + p)``;
     ``theta = (c, A, zeta, f, p, e, q)`` adds the amplitude-dependent level
     ``e exp(-2 zeta w t)`` and frequency (``q`` Hz at ``t = 0``, decaying as
-    ``exp(-2 zeta w t)``) of :mod:`lumpbeam_ros.ident.sinusoid`'s nonlinear model.
+    ``exp(-2 zeta w t)``) of :mod:`lumpbeam_ros.core.ident.sinusoid`'s nonlinear model.
     """
     c, a, zeta, f, p = theta[:5]
     w = 2.0 * math.pi * f

@@ -4,7 +4,7 @@
   fitted, scored, the winner refit) on a synthetic bag with dry friction hidden in it, the
   effect whose simulation is the slowest (the solver steps the stick-slip decision).
   Baseline: the same fits driven by the Radau reference integrator
-  (:func:`~lumpbeam_ros.model.integrate.solve_reference`) instead of the modal solver. A full
+  (:func:`~lumpbeam_ros.core.model.integrate.solve_reference`) instead of the modal solver. A full
   diagnosis that way would take the better part of an hour, so the baseline is extrapolated:
   one Radau simulation of the nominal beam (no effects, its easiest case) is timed on a
   shortened record, scaled linearly to the record's length and multiplied by the number of
@@ -27,15 +27,15 @@ import numpy as np
 
 from lumpbeam_lab.bench.bench_result import BenchResult, best_time
 from lumpbeam_lab.bench.diagnose_pairs import diagnose_bag, found, worst_error
-from lumpbeam_ros.blas import single_threaded_blas
-from lumpbeam_ros.diagnose.measurement import Record, read_record
-from lumpbeam_ros.diagnose.workflow import diagnose, nominal_form
-from lumpbeam_ros.model.chain import LumpedChain
-from lumpbeam_ros.model.integrate import ChainState, solve_reference
-from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig, load_beam_config
-from lumpbeam_ros.model.simulate import simulate_loads
-from lumpbeam_ros.model.statics import static_equilibrium
-from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+from lumpbeam_ros.base.blas import single_threaded_blas
+from lumpbeam_ros.core.diagnose.measurement import Record, read_record
+from lumpbeam_ros.core.diagnose.workflow import diagnose, nominal_form
+from lumpbeam_ros.core.model.chain import LumpedChain
+from lumpbeam_ros.core.model.integrate import ChainState, solve_reference
+from lumpbeam_ros.core.model.parameters import BeamParameters, DropTestConfig, load_beam_config
+from lumpbeam_ros.core.model.simulate import simulate_loads
+from lumpbeam_ros.core.model.statics import static_equilibrium
+from lumpbeam_ros.core.synthetic.drop_test import SynthOptions, write_drop_test_bag
 
 BUDGET_S = 60.0
 HIDDEN = {'coulomb_friction': 1.0}

@@ -22,10 +22,10 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from lumpbeam_lab.bench.bench_result import BenchResult
-from lumpbeam_ros.diagnose.measurement import read_record
-from lumpbeam_ros.diagnose.workflow import Diagnosis, diagnose
-from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, load_beam_config
-from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
+from lumpbeam_ros.core.diagnose.measurement import read_record
+from lumpbeam_ros.core.diagnose.workflow import Diagnosis, diagnose
+from lumpbeam_ros.core.model.parameters import EFFECT_PARAMETERS, load_beam_config
+from lumpbeam_ros.core.synthetic.drop_test import SynthOptions, write_drop_test_bag
 
 #: Hidden effects of each case, with realistic strengths.
 CASES: tuple[dict[str, float], ...] = (

@@ -9,7 +9,7 @@ whole window, on every update. Ours does more per call (release from ``/tip_load
 data, a correlation-robust covariance, the amplitude-dependent terms, cross-checks), so the
 batch ratio shows what that costs; the details show what it buys: the baseline's error in
 units of its own reported std. Live, ours restarts each update from the previous window's
-solution (:func:`~lumpbeam_ros.ident.identify.identify_from`).
+solution (:func:`~lumpbeam_ros.core.ident.identify.identify_from`).
 """
 
 from __future__ import annotations
@@ -25,19 +25,19 @@ import numpy as np
 from scipy.optimize import curve_fit
 
 from lumpbeam_lab.bench.bench_result import BenchResult, best_time
-from lumpbeam_ros.bagio import BagWriter, read_load_events, read_tip_poses
-from lumpbeam_ros.ident.identify import identify, identify_from
-from lumpbeam_ros.ident.samples import PoseWindow, clean_loads, clean_window
-from lumpbeam_ros.ident.settings import IdentifierConfig
-from lumpbeam_ros.ident.window import SlidingWindow
-from lumpbeam_ros.interface import TIP_LOAD, TIP_POSE
-from lumpbeam_ros.model import rules
-from lumpbeam_ros.model.chain import LumpedChain
-from lumpbeam_ros.model.modes import chain_modes
-from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
-from lumpbeam_ros.model.simulate import simulate_drop_test
-from lumpbeam_ros.model.statics import static_tip_deflection
-from lumpbeam_ros.synthetic.drop_test import load_messages
+from lumpbeam_ros.base.interface import TIP_LOAD, TIP_POSE
+from lumpbeam_ros.core.bagio import BagWriter, read_load_events, read_tip_poses
+from lumpbeam_ros.core.ident.identify import identify, identify_from
+from lumpbeam_ros.core.ident.samples import PoseWindow, clean_loads, clean_window
+from lumpbeam_ros.core.ident.settings import IdentifierConfig
+from lumpbeam_ros.core.ident.window import SlidingWindow
+from lumpbeam_ros.core.model import rules
+from lumpbeam_ros.core.model.chain import LumpedChain
+from lumpbeam_ros.core.model.modes import chain_modes
+from lumpbeam_ros.core.model.parameters import BeamParameters, DropTestConfig
+from lumpbeam_ros.core.model.simulate import simulate_drop_test
+from lumpbeam_ros.core.model.statics import static_tip_deflection
+from lumpbeam_ros.core.synthetic.drop_test import load_messages
 
 RATE_HZ = 180.0
 NOISE_M = 20e-6

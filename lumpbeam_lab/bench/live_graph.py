@@ -137,7 +137,9 @@ def row(frames: np.ndarray, busy: int, realtime: bool = True) -> BenchResult:
 
 def realtime_permitted() -> bool:
     """Whether a process started here may take real-time priority (asked of a child)."""
-    probe = 'from lumpbeam_ros.realtime import set_realtime_priority as s; print(s(1) or "ok")'
+    probe = (
+        'from lumpbeam_ros.nodes.realtime import set_realtime_priority as s; print(s(1) or "ok")'
+    )
     run = subprocess.run([sys.executable, '-c', probe], capture_output=True, text=True)
     return run.stdout.strip() == 'ok'
 

@@ -1,6 +1,6 @@
 """Model benchmarks: the drop-test simulation against ``solve_ivp(method='Radau')``.
 
-The baseline integrates the same equations (B.16, :func:`~lumpbeam_ros.model.integrate.
+The baseline integrates the same equations (B.16, :func:`~lumpbeam_ros.core.model.integrate.
 solve_reference`) at ``rtol = 1e-6``: the loosest tolerance whose tip agrees with a
 ``rtol = 1e-10`` run to 0.1 um, i.e. the cheapest Radau run as accurate as the project's.
 """
@@ -12,11 +12,11 @@ from dataclasses import replace
 import numpy as np
 
 from lumpbeam_lab.bench.bench_result import BenchResult, best_time
-from lumpbeam_ros.model.chain import LumpedChain
-from lumpbeam_ros.model.integrate import ChainState, solve_reference
-from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
-from lumpbeam_ros.model.simulate import simulate_drop_test
-from lumpbeam_ros.model.statics import static_equilibrium
+from lumpbeam_ros.core.model.chain import LumpedChain
+from lumpbeam_ros.core.model.integrate import ChainState, solve_reference
+from lumpbeam_ros.core.model.parameters import BeamParameters, DropTestConfig
+from lumpbeam_ros.core.model.simulate import simulate_drop_test
+from lumpbeam_ros.core.model.statics import static_equilibrium
 
 BASELINE_RTOL = 1e-6
 BASELINE = f"solve_ivp(method='Radau', rtol={BASELINE_RTOL:g})"

@@ -1,7 +1,7 @@
 """Input shaping: a 10,000-point trajectory shaped, against ``scipy.signal.fftconvolve``.
 
 Ours sums one linear interpolation of each joint per impulse
-(:func:`~lumpbeam_ros.shaping.apply.shape_trajectory`). The baseline convolves the same 1 kHz
+(:func:`~lumpbeam_ros.core.shaping.apply.shape_trajectory`). The baseline convolves the same 1 kHz
 samples, held at their last value for the shaper's duration, with the impulse train placed
 on the nearest 1 kHz sample (so it differs from ours by the impulses' rounding, reported as
 ``max_difference_rad``). Both are timed per joint, best of several runs.
@@ -13,10 +13,10 @@ import numpy as np
 from scipy.signal import fftconvolve
 
 from lumpbeam_lab.bench.bench_result import BenchResult, best_time
-from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
-from lumpbeam_ros.shaping.apply import shape_trajectory
-from lumpbeam_ros.shaping.impulses import Impulses, Mode
-from lumpbeam_ros.shaping.shapers import design_shaper
+from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
+from lumpbeam_ros.core.shaping.apply import shape_trajectory
+from lumpbeam_ros.core.shaping.impulses import Impulses, Mode
+from lumpbeam_ros.core.shaping.shapers import design_shaper
 
 BASELINE = 'scipy.signal.fftconvolve'
 STEP_S = 1e-3

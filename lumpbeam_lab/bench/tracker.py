@@ -26,10 +26,10 @@ from lumpbeam_lab.camera.accuracy import (
     render_frames,
     tracker_config,
 )
-from lumpbeam_ros.vision.config import CameraConfig, load_camera_config
-from lumpbeam_ros.vision.pose import tip_pose_from_board_pose
-from lumpbeam_ros.vision.synthetic import SyntheticFrame
-from lumpbeam_ros.vision.tracker import TipTracker, TrackResult
+from lumpbeam_ros.core.vision.config import CameraConfig, load_camera_config
+from lumpbeam_ros.core.vision.pose import tip_pose_from_board_pose
+from lumpbeam_ros.core.vision.synthetic import SyntheticFrame
+from lumpbeam_ros.core.vision.tracker import TipTracker, TrackResult
 
 _BASELINE = 'findChessboardCorners + cornerSubPix + solvePnP per frame'
 
@@ -79,7 +79,7 @@ def _baseline_z_rms_um(
     poses: Sequence[np.ndarray | None], frames: Sequence[SyntheticFrame], config: CameraConfig
 ) -> float:
     """z RMS error (bias in) of free PnP, each frame converted with the true rig."""
-    from lumpbeam_ros.vision.geometry import Transform
+    from lumpbeam_ros.core.vision.geometry import Transform
 
     errors = []
     for pose, frame in zip(poses, frames, strict=True):

@@ -14,15 +14,15 @@ from pathlib import Path
 
 import numpy as np
 
-from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.interface import POSE_RATE_HZ
-from lumpbeam_ros.model.parameters import load_beam_config
-from lumpbeam_ros.model.simulate import simulate_drop_test
-from lumpbeam_ros.model.trajectory import TipTrajectory
-from lumpbeam_ros.vision.calibration import adjusted_rig
-from lumpbeam_ros.vision.config import CameraConfig, load_camera_config
-from lumpbeam_ros.vision.synthetic import SyntheticCamera, SyntheticFrame
-from lumpbeam_ros.vision.tracker import TipTracker, TrackResult
+from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.base.interface import POSE_RATE_HZ
+from lumpbeam_ros.core.model.parameters import load_beam_config
+from lumpbeam_ros.core.model.simulate import simulate_drop_test
+from lumpbeam_ros.core.model.trajectory import TipTrajectory
+from lumpbeam_ros.core.vision.calibration import adjusted_rig
+from lumpbeam_ros.core.vision.config import CameraConfig, load_camera_config
+from lumpbeam_ros.core.vision.synthetic import SyntheticCamera, SyntheticFrame
+from lumpbeam_ros.core.vision.tracker import TipTracker, TrackResult
 
 #: Rig errors the tracker starts from in :func:`measure_accuracy`: the board 5 mm further
 #: than configured. The mount's tilt is taken as measured (see ``tracker.tilt_prior_std_rad``:

@@ -1,7 +1,7 @@
 """An independent camera renderer: per-pixel ray casting onto the checkerboard.
 
 It is the second opinion on the tracker, so it shares nothing with the tracker's camera model,
-geometry or board code (nor with :mod:`lumpbeam_ros.vision.synthetic`, which warps a texture):
+geometry or board code (nor with :mod:`lumpbeam_ros.core.vision.synthetic`, which warps a texture):
 
 * each sub-pixel sample's ray is found once, by inverting the lens model here (Newton's
   method on this module's own forward model of plumb_bob, rational_polynomial and
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.base.errors import LumpbeamError
 
 _MODELS = {'plumb_bob': 5, 'rational_polynomial': 8, 'equidistant': 4}
 

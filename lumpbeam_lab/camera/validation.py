@@ -18,10 +18,10 @@ from scipy.interpolate import CubicSpline
 
 from lumpbeam_lab.camera.accuracy import AccuracyReport, score
 from lumpbeam_lab.camera.raycast_camera import Lens, Optics, RaycastCamera, Scene
-from lumpbeam_ros.model.trajectory import TipTrajectory
-from lumpbeam_ros.vision.camera_model import CameraInfo
-from lumpbeam_ros.vision.config import CameraConfig, RigGeometry, load_camera_config
-from lumpbeam_ros.vision.geometry import Transform
+from lumpbeam_ros.core.model.trajectory import TipTrajectory
+from lumpbeam_ros.core.vision.camera_model import CameraInfo
+from lumpbeam_ros.core.vision.config import CameraConfig, RigGeometry, load_camera_config
+from lumpbeam_ros.core.vision.geometry import Transform
 
 #: Targets every case must meet (tip z, pitch: RMS with the bias in it).
 Z_RMS_LIMIT_UM = 10.0
@@ -149,7 +149,7 @@ def run_case(case: ValidationCase, trajectory: TipTrajectory) -> AccuracyReport:
     Returns:
         The report.
     """
-    from lumpbeam_ros.vision.tracker import TipTracker
+    from lumpbeam_ros.core.vision.tracker import TipTracker
 
     info, config, camera = case_setup(case)
     spline = CubicSpline(

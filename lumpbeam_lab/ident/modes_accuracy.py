@@ -5,8 +5,8 @@ clamped beam's drop test, an arm moved along a minimum-jerk trajectory); every t
 20 micrometres of white noise with its own seed to the tip's x and z and identifies the free
 vibration exactly as ``lumpbeam analyze`` (``--arm``) does. The truth is the models' linear
 modes about the final rest, which the identifier never sees: the unloaded beam's
-(:func:`~lumpbeam_ros.model.modes.chain_modes`), the arm's at its final joint angles
-(:func:`~lumpbeam_ros.arm.statics.arm_modes`, ``lumpbeam modes``).
+(:func:`~lumpbeam_ros.core.model.modes.chain_modes`), the arm's at its final joint angles
+(:func:`~lumpbeam_ros.core.model.arm.statics.arm_modes`, ``lumpbeam modes``).
 
 Per scenario and truth mode it prints how often the mode was found, the relative errors of
 frequency and damping ratio over the trials that found it (RMS with the bias in it, bias,
@@ -27,23 +27,23 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from lumpbeam_ros.arm.config import load_arm_config
-from lumpbeam_ros.arm.drive import SampledMotion
-from lumpbeam_ros.arm.model import ArmModel
-from lumpbeam_ros.arm.simulate import simulate_arm
-from lumpbeam_ros.arm.statics import arm_modes
-from lumpbeam_ros.bagio.series import JointSeries
-from lumpbeam_ros.ident.bag_analysis import identify_ring_down
-from lumpbeam_ros.ident.identification import Identification
-from lumpbeam_ros.ident.identify import identify
-from lumpbeam_ros.ident.samples import clean_loads, clean_window
-from lumpbeam_ros.ident.settings import IdentifierConfig
-from lumpbeam_ros.model.chain import LumpedChain
-from lumpbeam_ros.model.modes import chain_modes
-from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
-from lumpbeam_ros.model.simulate import simulate_drop_test
-from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
-from lumpbeam_ros.resources import config_path
+from lumpbeam_ros.base.resources import config_path
+from lumpbeam_ros.core.bagio.series import JointSeries
+from lumpbeam_ros.core.ident.bag_analysis import identify_ring_down
+from lumpbeam_ros.core.ident.identification import Identification
+from lumpbeam_ros.core.ident.identify import identify
+from lumpbeam_ros.core.ident.samples import clean_loads, clean_window
+from lumpbeam_ros.core.ident.settings import IdentifierConfig
+from lumpbeam_ros.core.model.arm.config import load_arm_config
+from lumpbeam_ros.core.model.arm.drive import SampledMotion
+from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
+from lumpbeam_ros.core.model.arm.model import ArmModel
+from lumpbeam_ros.core.model.arm.simulate import simulate_arm
+from lumpbeam_ros.core.model.arm.statics import arm_modes
+from lumpbeam_ros.core.model.chain import LumpedChain
+from lumpbeam_ros.core.model.modes import chain_modes
+from lumpbeam_ros.core.model.parameters import BeamParameters, DropTestConfig
+from lumpbeam_ros.core.model.simulate import simulate_drop_test
 
 RATE_HZ = 180.0
 NOISE_M = 20e-6

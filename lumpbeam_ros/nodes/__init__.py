@@ -1,1 +1,26 @@
-"""ROS 2 nodes: parameters, QoS and message conversion around core calls."""
+"""The ROS 2 adapters: nodes that translate messages into core calls, and what they need.
+
+One module per node (``*_node.py``) and for the recorder and player; :mod:`~.params`: each
+node's declared parameters; :mod:`~.realtime`: real-time scheduling; :mod:`~.ros_domain`:
+private domains; :mod:`~.foxglove_server`: the live view over Foxglove's WebSocket.
+"""
+
+__all__ = [
+    'camera_node',
+    'counts',
+    'diagnosis_node',
+    'endpoints',
+    'foxglove_server',
+    'identifier_node',
+    'lifecycle',
+    'msgtypes',
+    'player',
+    'realtime',
+    'recorder',
+    'ros_domain',
+    'ros_parameters',
+    'scripts',
+    'shaper_node',
+    'simulator_node',
+    'params',
+]

@@ -11,7 +11,7 @@ own stamp:
   by reason and the last reason.
 
 Images are taken as serialized bytes and decoded with the bag code
-(:mod:`lumpbeam_ros.vision.messages`), so a live frame and a recorded one go through the
+(:mod:`lumpbeam_ros.core.vision.messages`), so a live frame and a recorded one go through the
 same lines. A frame that gives no pose (board lost, bad encoding, wrong size, black,
 saturated, corrupt, no camera info yet) gives no message, a throttled warning and a count
 in the diagnostics; never a stale pose, never an exception out of a callback.
@@ -23,7 +23,7 @@ a topic cannot carry): a bag with ``bag_path`` (:meth:`CameraNode.run_bag`; ``Im
 with ``video_device`` (a device index such as ``0``, a device path such as ``/dev/video2``,
 or any file or URL OpenCV opens; each frame is stamped with the node's clock when it
 arrives) (:meth:`CameraNode.run_footage`). The readers are the ROS-free ones of
-:mod:`lumpbeam_ros.vision.sources`, shared with ``lumpbeam track``. A bag or footage is
+:mod:`lumpbeam_ros.core.vision.sources`, shared with ``lumpbeam track``. A bag or footage is
 finite and read faster than real time, so the node first waits (``wait_for_subscriber_s``,
 bounded) until ``/tip_pose`` has a subscriber, as ``lumpbeam play --delay`` does, and before
 exiting until reliable subscribers have every pose: a subscriber started beside the node
@@ -34,7 +34,7 @@ The intrinsics come from ``/camera/camera_info``, or from a ROS camera calibrati
 given as ``camera_info_url`` (``file:///path/camera.yaml``, as camera_info_manager takes it),
 or from the ``camera.*`` parameters with ``use_config_camera_info``.
 
-Parameters: :data:`~lumpbeam_ros.params.camera_params.CAMERA_SCHEMA` (``doc/parameters.md``):
+Parameters: :data:`~lumpbeam_ros.nodes.params.camera_params.CAMERA_SCHEMA` (``doc/parameters.md``):
 the keys of ``config/camera.yaml`` plus the node's own, all read-only. Run it with
 ``camera_node --ros-args --params-file camera.yaml``.
 """
@@ -55,10 +55,8 @@ from rclpy.duration import Duration
 from sensor_msgs.msg import CameraInfo as CameraInfoMsg
 from sensor_msgs.msg import Image
 
-from lumpbeam_ros.bagio import BagReader
-from lumpbeam_ros.bagio.convert import NS_PER_S, pitch_to_quaternion
-from lumpbeam_ros.errors import BagError, LumpbeamError
-from lumpbeam_ros.interface import (
+from lumpbeam_ros.base.errors import BagError, LumpbeamError
+from lumpbeam_ros.base.interface import (
     CAMERA_INFO,
     CAMERA_NODE,
     CAMERA_STATUS,
@@ -68,17 +66,15 @@ from lumpbeam_ros.interface import (
     TIP_POSE,
     TIP_POSE_COVARIANCE,
 )
-from lumpbeam_ros.nodes.endpoints import publisher, subscription
-from lumpbeam_ros.nodes.lifecycle import run_node, spin_events
-from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
-from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
-from lumpbeam_ros.vision.bag_frames import bag_frames
-from lumpbeam_ros.vision.camera_info_file import camera_info_from_url
-from lumpbeam_ros.vision.config import camera_config_from_parameters
-from lumpbeam_ros.vision.free_pose import rpy_quaternion
-from lumpbeam_ros.vision.messages import IMAGE_TYPES, prepare_decoders
-from lumpbeam_ros.vision.session import TrackingSession
-from lumpbeam_ros.vision.sources import (
+from lumpbeam_ros.core.bagio import BagReader
+from lumpbeam_ros.core.bagio.convert import NS_PER_S, pitch_to_quaternion
+from lumpbeam_ros.core.vision.bag_frames import bag_frames
+from lumpbeam_ros.core.vision.camera_info_file import camera_info_from_url
+from lumpbeam_ros.core.vision.config import camera_config_from_parameters
+from lumpbeam_ros.core.vision.free_pose import rpy_quaternion
+from lumpbeam_ros.core.vision.messages import IMAGE_TYPES, prepare_decoders
+from lumpbeam_ros.core.vision.session import TrackingSession
+from lumpbeam_ros.core.vision.sources import (
     DeviceSource,
     FolderSource,
     FootageError,
@@ -86,7 +82,11 @@ from lumpbeam_ros.vision.sources import (
     VideoSource,
     open_footage,
 )
-from lumpbeam_ros.vision.tracker import TrackResult
+from lumpbeam_ros.core.vision.tracker import TrackResult
+from lumpbeam_ros.nodes.endpoints import publisher, subscription
+from lumpbeam_ros.nodes.lifecycle import run_node, spin_events
+from lumpbeam_ros.nodes.params.camera_params import CAMERA_SCHEMA, CONFIG_KEYS
+from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
 
 # PoseWithCovariance is row-major 6 x 6 over (x, y, z, rot x, rot y, rot z); the tracker
 # measures x, z and the rotation about y (the pitch).
@@ -130,7 +130,7 @@ class CameraNode(SchemaNode):
         self._last_stamp_ns: int | None = None
 
         # /tip_pose: reliable, more than a second of poses; images and camera info: best
-        # effort, a third of a second of frames (lumpbeam_ros.bagio.qos).
+        # effort, a third of a second of frames (lumpbeam_ros.core.bagio.qos).
         self.pose_publisher = publisher(self, PoseStamped, TIP_POSE)
         self.covariance_publisher = publisher(self, PoseWithCovarianceStamped, TIP_POSE_COVARIANCE)
         self.diagnostics_publisher = publisher(self, DiagnosticArray, DIAGNOSTICS)

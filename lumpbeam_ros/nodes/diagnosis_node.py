@@ -2,7 +2,7 @@
 
 Subscribes to ``/tip_pose`` (PoseStamped in ``beam_base``), ``/tip_load`` (Float64, kg,
 reliable and transient local) and ``/tip_pose_predicted`` (the simulator's prediction); keeps
-them in a :class:`~lumpbeam_ros.diagnose.live.LiveBuffer`; on each completed ring-down (or
+them in a :class:`~lumpbeam_ros.core.diagnose.live.LiveBuffer`; on each completed ring-down (or
 window) builds the record ``lumpbeam diagnose`` would build from a bag and runs the same
 workflow in a worker (a process by default: a diagnosis takes seconds of CPU and the callbacks
 must stay free). Publishes one DiagnosticStatus ``lumpbeam/diagnosis`` on
@@ -13,7 +13,7 @@ With ``adopt`` it sets the simulator node's effect parameters (``effects.<name>.
 through the standard parameter service, so ``ros2 param get`` shows what was adopted, but
 only when the augmented model's gap is smaller than the gap of the simulator's current
 prediction over the same stretch. Parameters:
-:data:`~lumpbeam_ros.params.diagnosis_params.DIAGNOSIS_SCHEMA` (``doc/parameters.md``)::
+:data:`~lumpbeam_ros.nodes.params.diagnosis_params.DIAGNOSIS_SCHEMA` (``doc/parameters.md``)::
 
     diagnosis_node --ros-args --params-file config/diagnosis.yaml -p use_sim_time:=true
 
@@ -41,18 +41,8 @@ from rclpy.parameter_client import AsyncParameterClient
 from rclpy.task import Future as RclpyFuture
 from std_msgs.msg import Float64
 
-from lumpbeam_ros.bagio.convert import pose_values
-from lumpbeam_ros.diagnose.live import (
-    STALE,
-    LiveBuffer,
-    LiveDiagnosis,
-    LiveDiagnosisConfig,
-    Stretch,
-    diagnose_live,
-    status_values,
-)
-from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.interface import (
+from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.base.interface import (
     BASE_FRAME,
     DIAGNOSIS_STATUS,
     MODEL_DISCREPANCY,
@@ -61,12 +51,22 @@ from lumpbeam_ros.interface import (
     TIP_POSE,
     TIP_POSE_PREDICTED,
 )
-from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
+from lumpbeam_ros.base.schema import settings_from_parameters
+from lumpbeam_ros.core.bagio.convert import pose_values
+from lumpbeam_ros.core.diagnose.live import (
+    STALE,
+    LiveBuffer,
+    LiveDiagnosis,
+    LiveDiagnosisConfig,
+    Stretch,
+    diagnose_live,
+    status_values,
+)
+from lumpbeam_ros.core.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
+from lumpbeam_ros.nodes.params.diagnosis_params import DIAGNOSIS_SCHEMA
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
-from lumpbeam_ros.params.diagnosis_params import DIAGNOSIS_SCHEMA
-from lumpbeam_ros.params.schema import settings_from_parameters
 
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0
@@ -86,7 +86,7 @@ def _start_worker() -> None:
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     os.nice(WORKER_NICENESS)
-    import lumpbeam_ros.diagnose.workflow  # noqa: F401
+    import lumpbeam_ros.core.diagnose.workflow  # noqa: F401
 
 
 class DiagnosisNode(SchemaNode):

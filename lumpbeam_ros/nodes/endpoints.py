@@ -2,7 +2,7 @@
 
 Every node creates its endpoints here, so that each one:
 
-- takes the topic's :func:`~lumpbeam_ros.interface.node_topic` name: relative, so a
+- takes the topic's :func:`~lumpbeam_ros.base.interface.node_topic` name: relative, so a
   namespace (``--ros-args -r __ns:=/beam_a``) or a remap moves it, and exactly the
   interface's name (``/tip_pose``) without one;
 - takes the project's profile of the topic (:func:`~lumpbeam_ros.nodes.msgtypes.topic_qos`),
@@ -12,7 +12,7 @@ Every node creates its endpoints here, so that each one:
   ``qos_overrides.<resolved topic>.<publisher|subscription>.<policy>``, e.g.
   ``qos_overrides./tip_pose.publisher.depth``, set by ``--params-file`` or ``-p``. A value
   rclpy cannot use (a depth below 1, an unknown policy name, the wrong type) is a
-  :class:`~lumpbeam_ros.errors.ConfigError` naming the parameter, so the node stops at start
+  :class:`~lumpbeam_ros.base.errors.ConfigError` naming the parameter, so the node stops at start
   with one line (exit code 2).
 """
 
@@ -29,8 +29,8 @@ from rclpy.qos import HistoryPolicy, QoSProfile
 from rclpy.qos_overriding_options import InvalidQosOverridesError, QoSOverridingOptions
 from rclpy.subscription import Subscription
 
-from lumpbeam_ros.errors import ConfigError
-from lumpbeam_ros.interface import node_topic
+from lumpbeam_ros.base.errors import ConfigError
+from lumpbeam_ros.base.interface import node_topic
 from lumpbeam_ros.nodes.msgtypes import topic_qos
 
 

@@ -1,17 +1,17 @@
 """The identifier node: live frequency, damping and stiffness on ``/beam_params``.
 
 Subscribes to ``/tip_pose`` (PoseStamped in ``beam_base``) and ``/tip_load`` (Float64, kg,
-reliable and transient local as :mod:`lumpbeam_ros.bagio.qos` gives it), keeps the last
-``window.length_s`` of poses in a :class:`~lumpbeam_ros.ident.window.SlidingWindow`, and on
+reliable and transient local as :mod:`lumpbeam_ros.core.bagio.qos` gives it), keeps the last
+``window.length_s`` of poses in a :class:`~lumpbeam_ros.core.ident.window.SlidingWindow`, and on
 a timer at ``publish_rate_hz`` identifies the window
-(:func:`~lumpbeam_ros.ident.identify.identify_from`, warm-started from the last update) and
+(:func:`~lumpbeam_ros.core.ident.identify.identify_from`, warm-started from the last update) and
 publishes one DiagnosticStatus ``lumpbeam/identifier`` (doc/interfaces.md, 'Topics').
 
 On an arm (once ``/joint_states`` arrives) the free vibration is each move's ring-down: it
-starts where the joints stop (:class:`~lumpbeam_ros.ident.ring_down.RestTracker`) in place
+starts where the joints stop (:class:`~lumpbeam_ros.core.ident.ring_down.RestTracker`) in place
 of a load release, and the tip is taken along its swing.
 
-Parameters: :data:`~lumpbeam_ros.params.identifier_params.IDENTIFIER_SCHEMA`
+Parameters: :data:`~lumpbeam_ros.nodes.params.identifier_params.IDENTIFIER_SCHEMA`
 (``doc/parameters.md``). Run it with the package's settings, on sim time when a bag is
 replayed::
 
@@ -35,18 +35,8 @@ from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
-from lumpbeam_ros.bagio.convert import joint_state_values, pose_values
-from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.ident.identification import Identification, Status
-from lumpbeam_ros.ident.identify import FitState, identify_from
-from lumpbeam_ros.ident.ring_down import RestTracker, along_swing, ring_down_release
-from lumpbeam_ros.ident.settings import (
-    IDENTIFIER_SETTINGS,
-    IdentifierConfig,
-    config_from_parameters,
-)
-from lumpbeam_ros.ident.window import SlidingWindow
-from lumpbeam_ros.interface import (
+from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.base.interface import (
     BASE_FRAME,
     BEAM_PARAMS,
     IDENTIFIER_STATUS,
@@ -54,11 +44,21 @@ from lumpbeam_ros.interface import (
     TIP_LOAD,
     TIP_POSE,
 )
-from lumpbeam_ros.model.parameters import BeamParameters, load_beam_config
+from lumpbeam_ros.core.bagio.convert import joint_state_values, pose_values
+from lumpbeam_ros.core.ident.identification import Identification, Status
+from lumpbeam_ros.core.ident.identify import FitState, identify_from
+from lumpbeam_ros.core.ident.ring_down import RestTracker, along_swing, ring_down_release
+from lumpbeam_ros.core.ident.settings import (
+    IDENTIFIER_SETTINGS,
+    IdentifierConfig,
+    config_from_parameters,
+)
+from lumpbeam_ros.core.ident.window import SlidingWindow
+from lumpbeam_ros.core.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node, spin_live
+from lumpbeam_ros.nodes.params.identifier_params import IDENTIFIER_SCHEMA
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
-from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA
 
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0

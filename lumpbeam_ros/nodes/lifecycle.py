@@ -41,8 +41,8 @@ from rclpy.validate_full_topic_name import validate_full_topic_name
 from rclpy.validate_namespace import validate_namespace
 from rclpy.validate_topic_name import validate_topic_name
 
-from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.interrupts import interrupt_on_signals, interrupted, restore_handlers
+from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.base.interrupts import interrupt_on_signals, interrupted, restore_handlers
 from lumpbeam_ros.nodes.counts import write_counts
 
 #: Exit code of a node whose configuration is invalid.

@@ -26,9 +26,9 @@ from rosbags.interfaces import (
     QosTime,
 )
 
-from lumpbeam_ros.bagio.qos import INFINITE, SENSOR_DEPTH, STREAM_DEPTH, default_profile
-from lumpbeam_ros.errors import BagError
-from lumpbeam_ros.interface import TOPIC_TYPES
+from lumpbeam_ros.base.errors import BagError
+from lumpbeam_ros.base.interface import TOPIC_TYPES
+from lumpbeam_ros.core.bagio.qos import INFINITE, SENSOR_DEPTH, STREAM_DEPTH, default_profile
 
 _MAX_SEC = 2**31 - 1
 
@@ -90,14 +90,15 @@ def from_bag_qos(qos: Qos) -> QoSProfile:
 
 
 def topic_qos(topic: str, msgtype: str | None = None) -> QoSProfile:
-    """The project's profile of a topic (:func:`~lumpbeam_ros.bagio.qos.default_profile`).
+    """The project's profile of a topic (:func:`~lumpbeam_ros.core.bagio.qos.default_profile`).
 
     Every node's publishers and subscriptions take their profile from here, so both ends of
     a topic always agree. Each call builds a new profile (a QoS override changes it in place).
 
     Args:
         topic: The interface's (absolute) topic name, e.g. ``'/tip_pose'``.
-        msgtype: Its type; ``None``: the interface's (:data:`~lumpbeam_ros.interface.TOPIC_TYPES`).
+        msgtype: Its type; ``None``: the interface's
+            (:data:`~lumpbeam_ros.base.interface.TOPIC_TYPES`).
 
     Returns:
         The rclpy profile.

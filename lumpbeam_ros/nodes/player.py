@@ -11,11 +11,11 @@ as :data:`MAX_GAP_S` and counted (a bag whose stamps jump by days is not waited 
 ``/clock`` still jumps as the bag does. The player sleeps in slices of at most
 :data:`SLEEP_SLICE_S`, asking between them whether to stop, so a stop request is obeyed
 within one slice whatever the gap. Each topic is published with the QoS its recorder was
-offered, or the project's default (:mod:`lumpbeam_ros.bagio.qos`): best effort for images,
+offered, or the project's default (:mod:`lumpbeam_ros.core.bagio.qos`): best effort for images,
 reliable transient-local for ``/tip_load``, reliable otherwise. Each topic is published by
 its relative name: in a namespace (``/beam_a``) the bag's ``/tip_pose`` goes to
 ``/beam_a/tip_pose``; ``/clock`` stays graph-wide
-(:func:`~lumpbeam_ros.interface.node_topic`).
+(:func:`~lumpbeam_ros.base.interface.node_topic`).
 """
 
 from __future__ import annotations
@@ -31,10 +31,10 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 
-from lumpbeam_ros.bagio import BagReader
-from lumpbeam_ros.bagio.qos import default_profile, from_dict
-from lumpbeam_ros.errors import BagError
-from lumpbeam_ros.interface import CLOCK, PLAYER_NODE, node_topic
+from lumpbeam_ros.base.errors import BagError
+from lumpbeam_ros.base.interface import CLOCK, PLAYER_NODE, node_topic
+from lumpbeam_ros.core.bagio import BagReader
+from lumpbeam_ros.core.bagio.qos import default_profile, from_dict
 from lumpbeam_ros.nodes.msgtypes import from_bag_qos, message_class, topic_qos
 
 #: Longest wait at the end of playback for reliable subscribers' acknowledgements, s.

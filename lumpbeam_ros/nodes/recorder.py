@@ -5,7 +5,7 @@ Topics are discovered from the graph (``get_topic_names_and_types``) and subscri
 deserialized. Each topic's offered QoS (from ``get_publishers_info_by_topic``) goes into the
 bag's metadata; the subscription matches it (best effort if any publisher is, transient local
 only if every publisher is, so a latched ``/tip_load`` is received on joining). The bag is
-flushed at least every ``flush_period_s`` (see :class:`~lumpbeam_ros.bagio.BagWriter`), so a
+flushed at least every ``flush_period_s`` (see :class:`~lumpbeam_ros.core.bagio.BagWriter`), so a
 killed recorder loses at most that much. A message's log time is the time the middleware
 received it (the message info's ``received_timestamp``, wall clock), as rosbag2 records it: the
 time the callback runs would date a message that waited in the queue behind others too late,
@@ -26,16 +26,16 @@ from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from lumpbeam_ros.bagio import BagWriter
-from lumpbeam_ros.bagio.qos import STREAM_DEPTH
-from lumpbeam_ros.bagio.typestore import is_known
-from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.interface import GLOBAL_TOPICS, RECORDER_NODE
+from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.base.interface import GLOBAL_TOPICS, RECORDER_NODE
+from lumpbeam_ros.core.bagio import BagWriter
+from lumpbeam_ros.core.bagio.qos import STREAM_DEPTH
+from lumpbeam_ros.core.bagio.typestore import is_known
 from lumpbeam_ros.nodes.msgtypes import message_class, to_bag_qos
 
 #: Subscription depth of a best-effort topic (images): a 180 fps camera must not overflow it
 #: between two executor turns. Reliable topics take the project's stream depth
-#: (:data:`~lumpbeam_ros.bagio.qos.STREAM_DEPTH`, more than a second of 180 Hz poses).
+#: (:data:`~lumpbeam_ros.core.bagio.qos.STREAM_DEPTH`, more than a second of 180 Hz poses).
 DEPTH = 200
 
 

@@ -1,4 +1,4 @@
-"""Declares a node's parameters from its schema (:mod:`lumpbeam_ros.params.schema`).
+"""Declares a node's parameters from its schema (:mod:`lumpbeam_ros.base.schema`).
 
 The rclpy side of the one parameter mechanism, as generate_parameter_library's generated
 ``ParamListener`` is for C++ nodes: every parameter is declared with a ``ParameterDescriptor``
@@ -29,9 +29,9 @@ from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from lumpbeam_ros.errors import ConfigError
-from lumpbeam_ros.params.schema import ParameterSchema, ParameterSpec
-from lumpbeam_ros.realtime import REALTIME_PRIORITY, set_realtime_priority
+from lumpbeam_ros.base.errors import ConfigError
+from lumpbeam_ros.base.schema import ParameterSchema, ParameterSpec
+from lumpbeam_ros.nodes.realtime import REALTIME_PRIORITY, set_realtime_priority
 
 #: Checks (and may apply) changes the schema accepted: ``None``, or why they are refused.
 ChangeHook = Callable[[Mapping[str, Any]], str | None]
@@ -192,7 +192,7 @@ class SchemaNode(Node):
         **options: The node's :class:`NodeOptions` (context, overrides, namespace,
             ``--ros-args``).
 
-    A schema with :data:`~lumpbeam_ros.realtime.REALTIME_PRIORITY` has the node's threads
+    A schema with :data:`~lumpbeam_ros.nodes.realtime.REALTIME_PRIORITY` has the node's threads
     put on that real-time priority (or a warning saying why not).
 
     Attributes:

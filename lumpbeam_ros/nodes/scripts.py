@@ -2,7 +2,7 @@
 
 A console script imports its target's module before calling it; a node's module imports
 rclpy, numpy and scipy, seconds on a loaded machine. These functions import only the
-standard library, so :func:`~lumpbeam_ros.interrupts.run_script` handles SIGINT and SIGTERM
+standard library, so :func:`~lumpbeam_ros.base.interrupts.run_script` handles SIGINT and SIGTERM
 from the first moment: a signal during the imports ends the node quietly with exit code 0,
 as one during its spin does (:func:`~lumpbeam_ros.nodes.lifecycle.run_node`).
 """
@@ -12,14 +12,14 @@ from __future__ import annotations
 import importlib
 from collections.abc import Callable
 
-from lumpbeam_ros.interface import (
+from lumpbeam_ros.base.interface import (
     CAMERA_NODE,
     DIAGNOSIS_NODE,
     IDENTIFIER_NODE,
     SHAPER_NODE,
     SIMULATOR_NODE,
 )
-from lumpbeam_ros.interrupts import run_script
+from lumpbeam_ros.base.interrupts import run_script
 
 
 def _run(node: str) -> int:

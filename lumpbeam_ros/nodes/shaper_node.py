@@ -1,7 +1,7 @@
 """The shaper node: ``/joint_trajectory`` shaped onto ``/joint_trajectory_shaped``.
 
 Each JointTrajectory received is convolved with an input shaper
-(:mod:`lumpbeam_ros.shaping`) and published with the same header and joint names, its
+(:mod:`lumpbeam_ros.core.shaping`) and published with the same header and joint names, its
 points (positions only) at 1 kHz or the input's rate if finer, ending the shaper's duration
 later. The shaper cancels:
 
@@ -20,7 +20,8 @@ unshaped instead (a first move that rings to be identified). A trajectory that c
 shaped (fewer than 2 points, times that do not increase, positions missing or not finite) is
 dropped with a throttled warning.
 
-Parameters: :data:`~lumpbeam_ros.params.shaper_params.SHAPER_SCHEMA` (``doc/parameters.md``)::
+Parameters: :data:`~lumpbeam_ros.nodes.params.shaper_params.SHAPER_SCHEMA`
+    (``doc/parameters.md``)::
 
     shaper_node --ros-args --params-file config/shaper.yaml
 """
@@ -37,22 +38,22 @@ from diagnostic_msgs.msg import DiagnosticArray
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
 from trajectory_msgs.msg import JointTrajectoryPoint
 
-from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.interface import (
+from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.base.interface import (
     BEAM_PARAMS,
     IDENTIFIER_STATUS,
     JOINT_TRAJECTORY,
     JOINT_TRAJECTORY_SHAPED,
 )
-from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
+from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
+from lumpbeam_ros.core.shaping.apply import shape_trajectory
+from lumpbeam_ros.core.shaping.estimate import choose_shaper, estimate_from_status
+from lumpbeam_ros.core.shaping.impulses import Impulses, Mode
+from lumpbeam_ros.core.shaping.shapers import design_shaper
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
+from lumpbeam_ros.nodes.params.shaper_params import SHAPER_SCHEMA
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
-from lumpbeam_ros.params.shaper_params import SHAPER_SCHEMA
-from lumpbeam_ros.shaping.apply import shape_trajectory
-from lumpbeam_ros.shaping.estimate import choose_shaper, estimate_from_status
-from lumpbeam_ros.shaping.impulses import Impulses, Mode
-from lumpbeam_ros.shaping.shapers import design_shaper
 
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0
@@ -63,7 +64,7 @@ def trajectory_from_msg(msg: JointTrajectoryMsg) -> JointTrajectory:
 
     Raises:
         LumpbeamError: No joint names, a point without one position per joint, or what
-            :class:`~lumpbeam_ros.motion.joint_trajectory.JointTrajectory` refuses.
+            :class:`~lumpbeam_ros.core.model.arm.joint_trajectory.JointTrajectory` refuses.
     """
     names = tuple(msg.joint_names)
     if not names:

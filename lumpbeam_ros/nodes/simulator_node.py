@@ -1,24 +1,24 @@
 """The simulator node: the lumped beam in step with the node's clock, on ``/tip_pose_predicted``.
 
 Subscribes ``/tip_load`` (std_msgs/Float64, kg; reliable, transient local, depth 1 as
-:mod:`lumpbeam_ros.bagio.qos` says) and ``/beam_params`` (diagnostic_msgs/DiagnosticArray);
+:mod:`lumpbeam_ros.core.bagio.qos` says) and ``/beam_params`` (diagnostic_msgs/DiagnosticArray);
 publishes ``/tip_pose_predicted`` (geometry_msgs/PoseStamped in ``beam_base``). A steady
-timer advances a :class:`~lumpbeam_ros.model.stream.PredictionStream` to the node's clock
+timer advances a :class:`~lumpbeam_ros.core.model.stream.PredictionStream` to the node's clock
 (wall time, or ``/clock`` with ``use_sim_time``) and publishes the samples due since the last
 tick, each stamped with its model time. Another, at ``markers_rate_hz``, publishes
-``/beam_markers`` (visualization_msgs/MarkerArray, :mod:`lumpbeam_ros.viz.markers`): the
+``/beam_markers`` (visualization_msgs/MarkerArray, :mod:`lumpbeam_ros.core.viz.markers`): the
 model's latest shape, its tip, the last ``/tip_pose`` it received, the load and the board.
 With ``arm_config`` naming an arm file (doc/arm.md) the node simulates the flexible arm
 instead (:class:`ArmMode`): it follows the JointTrajectory commands of ``arm_commands``
 (``/joint_trajectory`` or ``/joint_trajectory_shaped``) through
-:class:`~lumpbeam_ros.arm.stream.ArmStream` and publishes ``/joint_states`` (the commanded
-angles), ``/tip_pose_predicted`` (the last link's free end) and the whole arm on
+:class:`~lumpbeam_ros.core.model.arm.stream.ArmStream` and publishes ``/joint_states`` (the
+commanded angles), ``/tip_pose_predicted`` (the last link's free end) and the whole arm on
 ``/beam_markers``. A command is refused with a throttled warning, and the prediction left as
 it was, when it names a joint the arm does not have or not every joint once, has a point
 without one position per joint, a position or time that is not finite, times that do not
 increase, or a first point at time 0 away from the joints' angles. A command stamped 0 (or
 in the past) starts at the node's present, one stamped in the future at its stamp.
-Parameters: :data:`~lumpbeam_ros.params.simulator_params.SIMULATOR_SCHEMA`
+Parameters: :data:`~lumpbeam_ros.nodes.params.simulator_params.SIMULATOR_SCHEMA`
 (``doc/parameters.md``); their defaults are the values of ``config/simulator.yaml``, where
 each is documented.
 
@@ -47,20 +47,8 @@ from std_msgs.msg import Float64
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
 from visualization_msgs.msg import MarkerArray
 
-from lumpbeam_ros.arm.config import load_arm_config
-from lumpbeam_ros.arm.model import ArmModel
-from lumpbeam_ros.arm.simulate import ArmMotion
-from lumpbeam_ros.arm.stream import ArmStream
-from lumpbeam_ros.bagio.convert import (
-    NS_PER_S,
-    joint_state,
-    pitch_to_quaternion,
-    seconds_to_ns,
-    time_ns,
-)
-from lumpbeam_ros.bagio.typestore import serialize
-from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.interface import (
+from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.base.interface import (
     BASE_FRAME,
     BEAM_MARKERS,
     BEAM_PARAMS,
@@ -70,25 +58,37 @@ from lumpbeam_ros.interface import (
     TIP_POSE,
     TIP_POSE_PREDICTED,
 )
-from lumpbeam_ros.model.adopt import adopt_identified
-from lumpbeam_ros.model.parameters import EFFECT_PARAMETERS, BeamParameters, load_beam_config
-from lumpbeam_ros.model.statics import static_tip_deflection
-from lumpbeam_ros.model.stream import PredictionStream
-from lumpbeam_ros.model.trajectory import TipTrajectory
-from lumpbeam_ros.nodes.endpoints import publisher, subscription
-from lumpbeam_ros.nodes.lifecycle import run_node
-from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
-from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA, effect_parameter_name
-from lumpbeam_ros.vision.config import load_camera_config
-from lumpbeam_ros.viz.marker_messages import scene_cdr
-from lumpbeam_ros.viz.markers import (
+from lumpbeam_ros.core.bagio.convert import (
+    NS_PER_S,
+    joint_state,
+    pitch_to_quaternion,
+    seconds_to_ns,
+    time_ns,
+)
+from lumpbeam_ros.core.bagio.typestore import serialize
+from lumpbeam_ros.core.model.adopt import adopt_identified
+from lumpbeam_ros.core.model.arm.config import load_arm_config
+from lumpbeam_ros.core.model.arm.model import ArmModel
+from lumpbeam_ros.core.model.arm.simulate import ArmMotion
+from lumpbeam_ros.core.model.arm.stream import ArmStream
+from lumpbeam_ros.core.model.parameters import EFFECT_PARAMETERS, BeamParameters, load_beam_config
+from lumpbeam_ros.core.model.statics import static_tip_deflection
+from lumpbeam_ros.core.model.stream import PredictionStream
+from lumpbeam_ros.core.model.trajectory import TipTrajectory
+from lumpbeam_ros.core.vision.config import load_camera_config
+from lumpbeam_ros.core.vision.placement import board_placement
+from lumpbeam_ros.core.viz.marker_messages import scene_cdr
+from lumpbeam_ros.core.viz.markers import (
     MEASURED_MAX_AGE_S,
     BeamScene,
     BoardPlacement,
     TipPoint,
-    board_placement,
     lifetime_for_rate,
 )
+from lumpbeam_ros.nodes.endpoints import publisher, subscription
+from lumpbeam_ros.nodes.lifecycle import run_node
+from lumpbeam_ros.nodes.params.simulator_params import SIMULATOR_SCHEMA, effect_parameter_name
+from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
 
 #: DiagnosticStatus.OK as a number (rclpy gives levels as one byte).
 OK_LEVEL = 0
@@ -154,7 +154,7 @@ class SimulatorNode(SchemaNode):
         self._with_effect_parameters(self._base_beam, set(self._parameter_overrides))
 
         # A late tick publishes several periods' samples in one burst: the stream profile's
-        # history holds them (lumpbeam_ros.bagio.qos).
+        # history holds them (lumpbeam_ros.core.bagio.qos).
         self._pose_out = publisher(self, PoseStamped, TIP_POSE_PREDICTED)
         subscription(self, Float64, TIP_LOAD, self._on_load)
         subscription(self, DiagnosticArray, BEAM_PARAMS, self._on_beam_params)

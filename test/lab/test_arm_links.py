@@ -20,8 +20,8 @@ from lumpbeam_lab.arm_links import (
     run_trials,
     truth_table,
 )
-from lumpbeam_ros.arm.config import load_arm_config
-from lumpbeam_ros.arm.link_fit import LinkParameterFit
+from lumpbeam_ros.core.ident.arm.link_fit import LinkParameterFit
+from lumpbeam_ros.core.model.arm.config import load_arm_config
 
 ROTARY, THREE = CASES
 

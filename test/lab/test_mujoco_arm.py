@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from arm.arm_cases import small_arm, smooth_move
+from arm_cases import small_arm, smooth_move
 
 from lumpbeam_lab import mujoco_arm
 from lumpbeam_lab.mujoco_arm import MujocoArm, arm_mjcf

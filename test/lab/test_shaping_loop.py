@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 import yaml
-from arm.arm_cases import small_arm_document
+from arm_cases import small_arm_document
 
 from lumpbeam_lab.shaping_loop import LoopCase, minimum_jerk, run_loop, shaper_for
-from lumpbeam_ros.arm.link_fit import MeasuredMode
+from lumpbeam_ros.core.ident.arm.link_fit import MeasuredMode
 
 
 def test_the_shaper_node_would_take_zv_for_a_sure_mode_and_ei_for_an_unsure_one():

@@ -14,13 +14,13 @@ from sensor_msgs.msg import CameraInfo as CameraInfoMsg
 from sensor_msgs.msg import Image
 
 from lumpbeam_lab.camera.accuracy import drop_test_trajectory, render_frames
-from lumpbeam_ros.bagio import BagWriter, convert
-from lumpbeam_ros.bagio.typestore import serialize
-from lumpbeam_ros.errors import ConfigError, LumpbeamError
+from lumpbeam_ros.base.errors import ConfigError, LumpbeamError
+from lumpbeam_ros.core.bagio import BagWriter, convert
+from lumpbeam_ros.core.bagio.typestore import serialize
+from lumpbeam_ros.core.vision.config import load_camera_config
+from lumpbeam_ros.core.vision.messages import camera_info_to_data
+from lumpbeam_ros.core.vision.sources import FootageError
 from lumpbeam_ros.nodes.camera_node import CameraNode
-from lumpbeam_ros.vision.config import load_camera_config
-from lumpbeam_ros.vision.messages import camera_info_to_data
-from lumpbeam_ros.vision.sources import FootageError
 
 WIDTH, HEIGHT = 640, 480
 #: Image stamps far from zero: a float second there cannot carry every nanosecond.
@@ -387,7 +387,7 @@ def test_pose_model_parameter(ros_graph):
 
 
 def test_a_stamp_that_goes_back_is_counted_warned_and_published(ros_graph, node):
-    from lumpbeam_ros.vision.tracker import TrackResult, TrackStatus
+    from lumpbeam_ros.core.vision.tracker import TrackResult, TrackStatus
 
     poses = ros_graph.collect('/tip_pose', PoseStamped, 10)
     result = TrackResult(

@@ -11,14 +11,14 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64
 
-from lumpbeam_ros.bagio.convert import pitch_to_quaternion
-from lumpbeam_ros.diagnose.live import LiveDiagnosis, Stretch
-from lumpbeam_ros.interface import DIAGNOSIS_STATUS as STATUS_NAME
-from lumpbeam_ros.interface import MODEL_DISCREPANCY as TOPIC
-from lumpbeam_ros.model.parameters import load_beam_config
+from lumpbeam_ros.base.interface import DIAGNOSIS_STATUS as STATUS_NAME
+from lumpbeam_ros.base.interface import MODEL_DISCREPANCY as TOPIC
+from lumpbeam_ros.core.bagio.convert import pitch_to_quaternion
+from lumpbeam_ros.core.diagnose.live import LiveDiagnosis, Stretch
+from lumpbeam_ros.core.model.parameters import load_beam_config
+from lumpbeam_ros.core.synthetic.drop_test import SynthOptions, simulate_experiment
 from lumpbeam_ros.nodes.diagnosis_node import DiagnosisNode
 from lumpbeam_ros.nodes.simulator_node import SimulatorNode
-from lumpbeam_ros.synthetic.drop_test import SynthOptions, simulate_experiment
 
 LATCHED = QoSProfile(
     depth=1, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL

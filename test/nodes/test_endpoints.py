@@ -6,9 +6,9 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64
 
-from lumpbeam_ros.errors import ConfigError
-from lumpbeam_ros.interface import TIP_LOAD, TIP_POSE_PREDICTED, in_namespace
-from lumpbeam_ros.model.statics import static_tip_deflection
+from lumpbeam_ros.base.errors import ConfigError
+from lumpbeam_ros.base.interface import TIP_LOAD, TIP_POSE_PREDICTED, in_namespace
+from lumpbeam_ros.core.model.statics import static_tip_deflection
 from lumpbeam_ros.nodes import simulator_node
 from lumpbeam_ros.nodes.identifier_node import IdentifierNode
 from lumpbeam_ros.nodes.simulator_node import SimulatorNode

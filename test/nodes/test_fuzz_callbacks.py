@@ -24,21 +24,21 @@ import os
 
 import numpy as np
 import pytest
-from bagio.helpers import mutate_stream, stream_rows
 from builtin_interfaces.msg import Duration
+from core.bagio.helpers import mutate_stream, stream_rows
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
 from rclpy.parameter import Parameter
 from std_msgs.msg import Float64
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from lumpbeam_ros.interface import BASE_FRAME, IDENTIFIER_STATUS
-from lumpbeam_ros.model.parameters import load_beam_config
+from lumpbeam_ros.base.interface import BASE_FRAME, IDENTIFIER_STATUS
+from lumpbeam_ros.core.model.parameters import load_beam_config
+from lumpbeam_ros.core.synthetic.drop_test import SynthOptions, write_drop_test_bag
 from lumpbeam_ros.nodes.diagnosis_node import DiagnosisNode
 from lumpbeam_ros.nodes.identifier_node import IdentifierNode
 from lumpbeam_ros.nodes.shaper_node import ShaperNode
 from lumpbeam_ros.nodes.simulator_node import SimulatorNode
-from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 
 CASES = int(os.environ.get('LUMPBEAM_FUZZ_CASES', '200'))
 NS = 1_000_000_000

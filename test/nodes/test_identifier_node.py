@@ -16,24 +16,24 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
-from lumpbeam_ros.bagio import read_tip_poses
-from lumpbeam_ros.bagio.convert import pitch_to_quaternion
-from lumpbeam_ros.cli.analyze import read_window
-from lumpbeam_ros.errors import ConfigError, LumpbeamError
-from lumpbeam_ros.ident.bag_analysis import analyze_bag
-from lumpbeam_ros.ident.identify import identify
-from lumpbeam_ros.ident.settings import IdentifierConfig
-from lumpbeam_ros.interface import IDENTIFIER_STATUS as STATUS_NAME
-from lumpbeam_ros.model import rules
-from lumpbeam_ros.model.chain import LumpedChain
-from lumpbeam_ros.model.modes import chain_modes
-from lumpbeam_ros.model.parameters import BeamParameters, DropTestConfig
-from lumpbeam_ros.model.statics import static_tip_deflection
+from lumpbeam_ros.apps.cli.analyze import read_window
+from lumpbeam_ros.base.errors import ConfigError, LumpbeamError
+from lumpbeam_ros.base.interface import IDENTIFIER_STATUS as STATUS_NAME
+from lumpbeam_ros.base.resources import config_path
+from lumpbeam_ros.core.bagio import read_tip_poses
+from lumpbeam_ros.core.bagio.convert import pitch_to_quaternion
+from lumpbeam_ros.core.ident.bag_analysis import analyze_bag
+from lumpbeam_ros.core.ident.identify import identify
+from lumpbeam_ros.core.ident.settings import IdentifierConfig
+from lumpbeam_ros.core.model import rules
+from lumpbeam_ros.core.model.chain import LumpedChain
+from lumpbeam_ros.core.model.modes import chain_modes
+from lumpbeam_ros.core.model.parameters import BeamParameters, DropTestConfig
+from lumpbeam_ros.core.model.statics import static_tip_deflection
+from lumpbeam_ros.core.shaping.estimate import estimate_from_status
+from lumpbeam_ros.core.synthetic.drop_test import SynthOptions, write_drop_test_bag
 from lumpbeam_ros.nodes.identifier_node import IdentifierNode
 from lumpbeam_ros.nodes.lifecycle import live_spinner, spin_events
-from lumpbeam_ros.resources import config_path
-from lumpbeam_ros.shaping.estimate import estimate_from_status
-from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -16,20 +16,20 @@ from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from std_msgs.msg import Float64
 
-from lumpbeam_ros import interrupts
-from lumpbeam_ros.errors import ConfigError, LumpbeamError
-from lumpbeam_ros.interface import (
+from lumpbeam_ros.base import interrupts
+from lumpbeam_ros.base.errors import ConfigError, LumpbeamError
+from lumpbeam_ros.base.interface import (
     BEAM_PARAMS,
     DIAGNOSTICS,
     MODEL_DISCREPANCY,
     TIP_POSE,
     TIP_POSE_PREDICTED,
 )
-from lumpbeam_ros.model.parameters import load_beam_config
+from lumpbeam_ros.core.model.parameters import load_beam_config
+from lumpbeam_ros.core.synthetic.drop_test import SynthOptions, write_drop_test_bag
+from lumpbeam_ros.core.synthetic.images import ImageOptions
 from lumpbeam_ros.nodes.counts import COUNTS_DIR_ENV, read_counts
 from lumpbeam_ros.nodes.lifecycle import CONFIG_ERROR, run_node, spin_events
-from lumpbeam_ros.synthetic.drop_test import SynthOptions, write_drop_test_bag
-from lumpbeam_ros.synthetic.images import ImageOptions
 
 ROOT = Path(__file__).resolve().parents[2]
 SIGNALS = [signal.SIGINT, signal.SIGTERM]

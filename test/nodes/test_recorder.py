@@ -6,7 +6,7 @@ import pytest
 from mcap.reader import make_reader
 from std_msgs.msg import Float64
 
-from lumpbeam_ros.bagio import BagWriter
+from lumpbeam_ros.core.bagio import BagWriter
 from lumpbeam_ros.nodes.recorder import Recorder
 
 

@@ -8,17 +8,17 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 
-from lumpbeam_ros.errors import ConfigError
+from lumpbeam_ros.base.errors import ConfigError
+from lumpbeam_ros.base.resources import config_path
+from lumpbeam_ros.base.schema import Bounds, ParameterSchema, ParameterSpec
 from lumpbeam_ros.nodes.camera_node import CameraNode
 from lumpbeam_ros.nodes.identifier_node import IdentifierNode
+from lumpbeam_ros.nodes.params.camera_params import CAMERA_SCHEMA
+from lumpbeam_ros.nodes.params.identifier_params import IDENTIFIER_SCHEMA
+from lumpbeam_ros.nodes.params.reference import SCHEMAS
+from lumpbeam_ros.nodes.params.simulator_params import SIMULATOR_SCHEMA
 from lumpbeam_ros.nodes.ros_parameters import declare_parameters, describe, undeclared_in_schema
 from lumpbeam_ros.nodes.simulator_node import SimulatorNode
-from lumpbeam_ros.params.camera_params import CAMERA_SCHEMA
-from lumpbeam_ros.params.identifier_params import IDENTIFIER_SCHEMA
-from lumpbeam_ros.params.reference import SCHEMAS
-from lumpbeam_ros.params.schema import Bounds, ParameterSchema, ParameterSpec
-from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA
-from lumpbeam_ros.resources import config_path
 
 PROBE = ParameterSchema(
     'probe_node',

@@ -9,15 +9,15 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
 from trajectory_msgs.msg import JointTrajectoryPoint
 
-from lumpbeam_ros.errors import ConfigError, LumpbeamError
-from lumpbeam_ros.interface import BEAM_PARAMS, IDENTIFIER_STATUS
-from lumpbeam_ros.interface import JOINT_TRAJECTORY as IN
-from lumpbeam_ros.interface import JOINT_TRAJECTORY_SHAPED as OUT
-from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
+from lumpbeam_ros.base.errors import ConfigError, LumpbeamError
+from lumpbeam_ros.base.interface import BEAM_PARAMS, IDENTIFIER_STATUS
+from lumpbeam_ros.base.interface import JOINT_TRAJECTORY as IN
+from lumpbeam_ros.base.interface import JOINT_TRAJECTORY_SHAPED as OUT
+from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
+from lumpbeam_ros.core.shaping.apply import shape_trajectory
+from lumpbeam_ros.core.shaping.impulses import Mode
+from lumpbeam_ros.core.shaping.shapers import design_shaper
 from lumpbeam_ros.nodes.shaper_node import ShaperNode, trajectory_from_msg
-from lumpbeam_ros.shaping.apply import shape_trajectory
-from lumpbeam_ros.shaping.impulses import Mode
-from lumpbeam_ros.shaping.shapers import design_shaper
 
 OK, ERROR = 0, 2
 

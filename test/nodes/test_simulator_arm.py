@@ -11,12 +11,12 @@ from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
 from trajectory_msgs.msg import JointTrajectoryPoint
 from visualization_msgs.msg import MarkerArray
 
-from lumpbeam_ros.arm.config import load_arm_config
-from lumpbeam_ros.arm.drive import SampledMotion
-from lumpbeam_ros.arm.model import ArmModel
-from lumpbeam_ros.arm.simulate import simulate_arm
-from lumpbeam_ros.bagio.convert import quaternion_to_pitch
-from lumpbeam_ros.motion.joint_trajectory import JointTrajectory
+from lumpbeam_ros.core.bagio.convert import quaternion_to_pitch
+from lumpbeam_ros.core.model.arm.config import load_arm_config
+from lumpbeam_ros.core.model.arm.drive import SampledMotion
+from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
+from lumpbeam_ros.core.model.arm.model import ArmModel
+from lumpbeam_ros.core.model.arm.simulate import simulate_arm
 from lumpbeam_ros.nodes.simulator_node import SimulatorNode
 
 #: A light two-link arm (7 segments): quick to simulate.

@@ -10,15 +10,15 @@ from rclpy.qos import DurabilityPolicy, QoSProfile
 from scipy.optimize import curve_fit
 from std_msgs.msg import Float64
 
-from lumpbeam_ros.bagio.convert import quaternion_to_pitch
-from lumpbeam_ros.errors import ConfigError, LumpbeamError
-from lumpbeam_ros.model.adopt import first_mode
-from lumpbeam_ros.model.simulate import simulate_loads
+from lumpbeam_ros.base.errors import ConfigError, LumpbeamError
+from lumpbeam_ros.base.paramfile import read_parameter_file
+from lumpbeam_ros.base.resources import config_path
+from lumpbeam_ros.core.bagio.convert import quaternion_to_pitch
+from lumpbeam_ros.core.model.adopt import first_mode
+from lumpbeam_ros.core.model.simulate import simulate_loads
 from lumpbeam_ros.nodes import simulator_node
+from lumpbeam_ros.nodes.params.simulator_params import SIMULATOR_SCHEMA
 from lumpbeam_ros.nodes.simulator_node import SimulatorNode
-from lumpbeam_ros.paramfile import read_parameter_file
-from lumpbeam_ros.params.simulator_params import SIMULATOR_SCHEMA
-from lumpbeam_ros.resources import config_path
 
 LATCHED = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
@@ -47,7 +47,7 @@ def test_publishes_at_the_rate_from_the_loaded_equilibrium(ros_graph):
     t, z, pitch = _columns(got)
     assert got[0].header.frame_id == 'beam_base'
     # On the 180 Hz grid, none twice. That the stream yields every stamp once is
-    # test/model/test_stream.py's; here the middleware delivers them, and on a machine loaded
+    # test/core/model/test_stream.py's; here the middleware delivers them, and on a machine loaded
     # far beyond its cores (load 10 on 2) one burst of 3 of 182 went missing once.
     steps = np.diff(t) * 180
     np.testing.assert_allclose(steps, np.round(steps), atol=2e-4)
@@ -271,7 +271,7 @@ def test_effect_parameters_start_from_the_beam_file_and_switch_the_running_beam(
 ):
     from dataclasses import replace
 
-    from lumpbeam_ros.model.parameters import load_beam_config, write_beam_config
+    from lumpbeam_ros.core.model.parameters import load_beam_config, write_beam_config
 
     beam, drop = load_beam_config()
     path = tmp_path / 'late.yaml'

@@ -5,8 +5,8 @@ import pytest
 
 from lumpbeam_lab.bench.arm import RATE_HZ, _rk4_steps, arm_config, move, run
 from lumpbeam_lab.bench.runner import available_suites
-from lumpbeam_ros.arm.model import ArmModel
-from lumpbeam_ros.arm.statics import arm_linear_model
+from lumpbeam_ros.core.model.arm.model import ArmModel
+from lumpbeam_ros.core.model.arm.statics import arm_linear_model
 
 
 def test_the_case_is_the_config_arm_with_its_taper_resampled():

@@ -2,7 +2,7 @@ import pytest
 
 from lumpbeam_lab.bench import cli
 from lumpbeam_lab.bench.runner import available_suites
-from lumpbeam_ros.cli.main import main
+from lumpbeam_ros.apps.cli.main import main
 
 
 def test_quick_run_times_the_help_against_the_bare_interpreter():

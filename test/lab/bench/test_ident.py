@@ -2,7 +2,7 @@ import pytest
 
 from lumpbeam_lab.bench import ident
 from lumpbeam_lab.bench.runner import available_suites
-from lumpbeam_ros.model.parameters import BeamParameters
+from lumpbeam_ros.core.model.parameters import BeamParameters
 
 
 def test_quick_run_reports_both_figures_with_baselines():

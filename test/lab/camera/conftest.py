@@ -1,3 +1,3 @@
-"""The vision tests' camera set-up (test/vision/conftest.py), shared with the lab's tests."""
+"""The vision tests' camera set-up (test/core/vision/conftest.py), shared with the lab's tests."""
 
-from vision.conftest import config, drop_test, no_calibration, rest_pose  # noqa: F401
+from core.vision.conftest import config, drop_test, no_calibration, rest_pose  # noqa: F401

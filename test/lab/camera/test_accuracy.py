@@ -8,8 +8,8 @@ from lumpbeam_lab.camera.accuracy import (
     measure_accuracy,
     score,
 )
-from lumpbeam_ros.errors import LumpbeamError
-from lumpbeam_ros.vision.tracker import TrackResult, TrackStatus
+from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.core.vision.tracker import TrackResult, TrackStatus
 
 
 def test_drop_test_is_the_models(drop_test):

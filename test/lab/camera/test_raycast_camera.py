@@ -16,7 +16,7 @@ from lumpbeam_lab.camera.raycast_camera import (
     lens_distort,
     lens_rays,
 )
-from lumpbeam_ros.errors import LumpbeamError
+from lumpbeam_ros.base.errors import LumpbeamError
 
 SCENE = Scene(
     9, 7, 0.06, 1.0, (0.0, 0.05, 0.0), (-np.pi / 2 + 0.02, 0.0, -0.03),
@@ -133,7 +133,7 @@ def test_bad_lens_and_board_behind_the_camera():
 def test_shares_no_code_with_the_tracker():
     code = (
         'import sys, lumpbeam_lab.camera.raycast_camera; '
-        'print(sorted(m for m in sys.modules if m.startswith("lumpbeam_ros.vision")))'
+        'print(sorted(m for m in sys.modules if m.startswith("lumpbeam_ros.core.vision")))'
     )
     out = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == '[]'

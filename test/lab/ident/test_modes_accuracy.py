@@ -2,7 +2,7 @@ import numpy as np
 
 from lumpbeam_lab.ident import modes_accuracy
 from lumpbeam_lab.ident.modes_accuracy import Record, minimum_jerk, score
-from lumpbeam_ros.ident.identification import Estimate, Identification, IdentifiedMode, Status
+from lumpbeam_ros.core.ident.identification import Estimate, Identification, IdentifiedMode, Status
 
 
 def test_score_counts_found_modes_errors_and_coverage():

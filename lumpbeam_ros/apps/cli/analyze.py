@@ -1,0 +1,96 @@
+"""``lumpbeam analyze BAG``: identification of a drop test or an arm move (doc/interfaces.md)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from lumpbeam_ros.apps.cli.output import write_json
+from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.base.progress import Progress
+from lumpbeam_ros.core.ident.bag_analysis import (
+    CONTRACT_KEYS,
+    POSE_TOPIC,
+    BagAnalysis,
+    analyze_bag,
+    read_window,
+    result_json,
+)
+from lumpbeam_ros.core.ident.settings import load_identifier_config, with_max_modes
+from lumpbeam_ros.core.model.parameters import load_beam_config
+
+if TYPE_CHECKING:
+    from lumpbeam_ros.core.model.arm.config import ArmConfig
+
+__all__ = ['CONTRACT_KEYS', 'Progress', 'read_window', 'result_json', 'run']
+
+
+def run(args: argparse.Namespace) -> int:
+    """Reads the bag, identifies the whole record, prints a summary, writes JSON and plots."""
+    if args.fit_links:
+        from lumpbeam_ros.apps.cli.fit_links import run_fit_links
+
+        return run_fit_links(args)
+    if len(args.bag) > 1:
+        raise LumpbeamError(f'{len(args.bag)} bags given: several bags only with --fit-links')
+    args.bag = args.bag[0]
+    beam, _ = load_beam_config(args.config)
+    config = load_identifier_config(args.identifier_config)
+    if args.max_modes is not None:
+        config = with_max_modes(config, args.max_modes)
+    arm = None
+    if args.arm is not None:
+        from lumpbeam_ros.core.model.arm.config import load_arm_config
+
+        arm = load_arm_config(args.arm)
+    analysis = analyze_bag(
+        args.bag, beam, config, arm_joints=None if arm is None else arm.n_joints
+    )
+    window, result = analysis.window, analysis.result
+    for note in analysis.notes:
+        print(f'lumpbeam analyze: warning: {args.bag}: {POSE_TOPIC}: {note}', file=sys.stderr)
+    print(f'{args.bag}: {len(window)} poses over {window.end_s - window.start_s:.2f} s')
+    print(result.summary())
+    _print_modes(analysis, arm)
+    if args.json:
+        write_json(args.json, result_json(result, analysis.rest))
+    if args.plots:
+        from lumpbeam_ros.apps.plots.analysis import write_analysis_plots
+
+        for path in write_analysis_plots(window, result, Path(args.plots)):
+            print(f'wrote {path}')
+    if args.report:
+        from lumpbeam_ros.apps.report.analysis import write_analysis_report
+
+        print(f'wrote {write_analysis_report(analysis, args.report)}')
+    return 0 if result.ok else 1
+
+
+def _print_modes(analysis: BagAnalysis, arm: ArmConfig | None) -> None:
+    """One line per mode; for an arm, the model's nearest mode at the rest angles beside it."""
+    model: list[dict[str, float]] = []
+    rest = analysis.rest
+    if rest is not None and arm is not None:
+        import numpy as np
+
+        from lumpbeam_ros.core.model.arm.model import ArmModel
+        from lumpbeam_ros.core.model.arm.statics import arm_modes, modes_table
+
+        angles = ', '.join(f'{q:.4g}' for q in rest.angles_rad)
+        print(f'joints at rest from {rest.start_s:.3f} s at q = {angles} rad')
+        model = modes_table(arm_modes(ArmModel.from_config(arm), np.array(rest.angles_rad)))
+    for k, mode in enumerate(analysis.modes, start=1):
+        f, zeta = mode.natural_frequency_hz, mode.damping_ratio
+        line = (
+            f'mode {k}: {f.value:.5g} +- {f.std:.2g} Hz, damping ratio {zeta.value:.4g} +- '
+            f'{zeta.std:.2g}, amplitude {mode.amplitude_m:.3g} m'
+        )
+        if model:
+            near = min(model, key=lambda m: abs(m['natural_frequency_hz'] - f.value))
+            line += (
+                f' (arm model: {near["natural_frequency_hz"]:.5g} Hz, '
+                f'damping ratio {near["damping_ratio"]:.4g})'
+            )
+        print(line)

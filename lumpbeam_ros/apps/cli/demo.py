@@ -1,0 +1,91 @@
+"""``lumpbeam demo [--out DIR] [--arm [FILE]]``: the pipeline on the built-in experiment.
+
+Without ``--arm`` the synthetic drop test; with it the input-shaping loop on an arm.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from lumpbeam_ros.apps.cli.output import write_json
+
+
+def run(args: argparse.Namespace) -> int:
+    """Runs the demo.
+
+    Returns:
+        0 when every step ran.
+
+    Raises:
+        LumpbeamError: A bad option or a failed step (one line, see the logs it names).
+    """
+    from lumpbeam_ros.apps.demo.graph import DOMAIN_IDS
+    from lumpbeam_ros.apps.demo.steps import DemoOptions, run_demo
+    from lumpbeam_ros.base.errors import LumpbeamError
+
+    if args.domain_id is not None and args.domain_id not in DOMAIN_IDS:
+        raise LumpbeamError(
+            f'--domain-id must be in {DOMAIN_IDS.start}..{DOMAIN_IDS.stop - 1}, '
+            f'got {args.domain_id}'
+        )
+    if args.out.exists() and not args.out.is_dir():
+        raise LumpbeamError(f'--out {args.out} is a file, not a folder')
+    if args.arm is not None:
+        return _run_arm(args)
+    from lumpbeam_ros.apps.demo.steps import HIDDEN_EFFECT
+    from lumpbeam_ros.core.synthetic.drop_test import parse_effect
+    from lumpbeam_ros.core.synthetic.images import parse_image_size
+
+    if args.effect is None:
+        effects = dict(HIDDEN_EFFECT)
+    elif args.effect == ['none']:
+        effects = {}
+    else:
+        effects = dict(parse_effect(text) for text in args.effect)
+    size = None if args.no_images else parse_image_size(args.image_size)
+    options = DemoOptions(
+        out=args.out,
+        duration_s=args.duration,
+        seed=args.seed,
+        adopt_identified=args.adopt,
+        domain_id=args.domain_id,
+        beam_config=args.config,
+        image_size=size,
+        effects=effects,
+    )
+    result = run_demo(options, echo=lambda line: print(line, flush=True))
+    if args.json is not None:
+        write_json(args.json, result.summary)
+    return 0
+
+
+#: The options of the drop test that the arm demo has no use for, with their defaults.
+BEAM_ONLY = {
+    'duration': 12.0,
+    'seed': 0,
+    'adopt': False,
+    'config': None,
+    'effect': None,
+    'image_size': '640x480',
+    'no_images': False,
+}
+
+
+def _run_arm(args: argparse.Namespace) -> int:
+    """Runs the arm demo (``--arm``); refuses the drop test's options beside it."""
+    from pathlib import Path
+
+    from lumpbeam_ros.apps.demo.arm_loop import ArmDemoOptions, run_arm_demo
+    from lumpbeam_ros.base.errors import LumpbeamError
+    from lumpbeam_ros.base.resources import config_path
+
+    given = [name for name, default in BEAM_ONLY.items() if getattr(args, name) != default]
+    if given:
+        option = '--' + given[0].replace('_', '-')
+        raise LumpbeamError(f'{option} is an option of the drop-test demo, not of --arm')
+    arm = Path(args.arm) if args.arm else config_path('arm_rotary.yaml')
+    options = ArmDemoOptions(arm_config=arm, out=args.out, domain_id=args.domain_id)
+    result = run_arm_demo(options, echo=lambda line: print(line, flush=True))
+    if args.json is not None:
+        write_json(args.json, result.summary)
+    return 0

@@ -1,1 +1,0 @@
-"""The flexible arm: links of lumped segments joined by prescribed revolute joints."""

@@ -1,0 +1,56 @@
+"""Where the package's own files (the default ``config/`` YAMLs) are found.
+
+The same lookup serves a colcon install (the ament share directory), a pip install (the
+``share/`` data_files under the interpreter prefix) and a source checkout (editable install).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+PACKAGE = 'lumpbeam_ros'
+
+
+def _candidate_share_dirs() -> list[Path]:
+    candidates = [Path(__file__).resolve().parents[2]]  # a source checkout
+    try:
+        from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
+    except ImportError:
+        pass
+    else:
+        try:
+            candidates.append(Path(get_package_share_directory(PACKAGE)))
+        except (PackageNotFoundError, LookupError, OSError, ValueError):
+            pass  # not in an ament workspace, or AMENT_PREFIX_PATH is unset
+    candidates.append(Path(sys.prefix) / 'share' / PACKAGE)
+    return candidates
+
+
+def config_path(name: str) -> Path:
+    """Returns the path of a default configuration file.
+
+    Args:
+        name: File name under ``config/``, e.g. ``'paper_beam.yaml'``.
+
+    Returns:
+        The first existing candidate.
+
+    Raises:
+        FileNotFoundError: The package is installed without its ``config/`` files.
+    """
+    for share in _candidate_share_dirs():
+        path = share / 'config' / name
+        if path.is_file():
+            return path
+    raise FileNotFoundError(f'{PACKAGE}: default config {name!r} is not installed')
+
+
+def large_frames_profile() -> Path:
+    """The Fast DDS profile for camera frames of a megabyte and more.
+
+    Point ``FASTRTPS_DEFAULT_PROFILES_FILE`` at it: it gives the shared-memory transport a
+    segment large enough for whole frames; with the default transport most 1 MB frames at
+    180 fps are lost between processes.
+    """
+    return Path(__file__).resolve().parent / 'data' / 'fastdds_large_frames.xml'

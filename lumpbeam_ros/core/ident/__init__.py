@@ -1,0 +1,25 @@
+"""Identification of stiffness, frequency and damping from tip oscillations."""
+
+__all__ = [
+    'backbone',
+    'bag_analysis',
+    'covariance',
+    'identification',
+    'identify',
+    'logdec',
+    'mode_estimate',
+    'modes',
+    'onset',
+    'optimize',
+    'peaks',
+    'pencil',
+    'release',
+    'ring_down',
+    'samples',
+    'segments',
+    'settings',
+    'sinusoid',
+    'stiffness',
+    'window',
+    'arm',
+]

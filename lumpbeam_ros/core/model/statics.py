@@ -1,0 +1,67 @@
+"""Static equilibrium of the chain under gravity and tip loads (nonlinear, any n_s)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lumpbeam_ros.core.model.chain import LumpedChain
+from lumpbeam_ros.core.model.parameters import BeamParameters
+
+
+def static_equilibrium(
+    chain: LumpedChain,
+    tol: float = 1e-13,
+    max_iter: int = 50,
+    offsets: np.ndarray | None = None,
+) -> np.ndarray:
+    """Solves ``K phi + k3 phi_1^3 e_1 = g G cos(phi + tilt) + D^T k o`` (B.16 at rest) by Newton.
+
+    The deflections are small against the springs, so Newton from the undeflected chain (the
+    straight beam, or an arm's links straight at its joint offsets ``o``) converges in a few
+    steps; large rotations converge too, only slower.
+
+    Args:
+        chain: The chain, with its tip masses.
+        tol: Convergence threshold on the angle update, rad.
+        max_iter: Iteration limit.
+        offsets: Prescribed spring offsets (an arm's joint angles at its links' first
+            springs, see :meth:`LumpedChain.drive_forces`); ``None``: none.
+
+    Returns:
+        The segment angles at rest, shape (n,).
+
+    Raises:
+        RuntimeError: No convergence (the beam is too soft to carry its load).
+    """
+    k = chain.stiffness_matrix
+    k3 = chain.cubic_stiffness
+    if offsets is None:
+        phi = np.zeros(chain.n)
+        drive = np.zeros(chain.n)
+    else:
+        phi = np.cumsum(offsets)
+        drive = chain.drive_forces(offsets, np.zeros(chain.n))
+    for _ in range(max_iter):
+        residual = k @ phi - chain.gravity_forces(phi) - drive
+        residual[0] += k3 * phi[0] ** 3
+        jacobian = k + np.diag(chain.gravity_stiffness(phi))
+        jacobian[0, 0] += chain.cubic_tangent(phi)
+        step = np.linalg.solve(jacobian, residual)
+        phi -= step
+        if np.max(np.abs(step)) < tol:
+            return phi
+    raise RuntimeError('static equilibrium did not converge: the beam cannot carry its load')
+
+
+def static_tip_deflection(beam: BeamParameters, load_kg: float = 0.0) -> float:
+    """Downward static deflection of the free end, m (positive when it sags).
+
+    Args:
+        beam: The beam (its mounted tip mass included).
+        load_kg: Extra mass hanging at the tip.
+
+    Returns:
+        ``-z`` of the free end at rest.
+    """
+    chain = LumpedChain.from_beam(beam, load_kg)
+    return float(-chain.tip_pose(static_equilibrium(chain))[1])

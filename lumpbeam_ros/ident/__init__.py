@@ -1,1 +1,0 @@
-"""Identification of stiffness, frequency and damping from tip oscillations."""

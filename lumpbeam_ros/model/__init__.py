@@ -1,1 +1,0 @@
-"""The lumped-parameter beam: parameters, statics, dynamics, modes, scenarios."""

@@ -1,1 +1,0 @@
-"""Joint motion commanded to an arm: the joint trajectory and its file."""

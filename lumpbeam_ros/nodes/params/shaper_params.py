@@ -1,0 +1,81 @@
+"""The shaper node's parameters (values in ``config/shaper.yaml``, documented there)."""
+
+from __future__ import annotations
+
+from lumpbeam_ros.base.interface import SHAPER_NODE
+from lumpbeam_ros.base.schema import Bounds, ParameterSchema, ParameterSpec
+
+SHAPER_SCHEMA = ParameterSchema(
+    node=SHAPER_NODE,
+    summary=(
+        'Input shaping live: each /joint_trajectory convolved with a shaper (ZV, ZVD, EI, '
+        'several modes) and published on /joint_trajectory_shaped, its modes taken from '
+        '/beam_params or fixed by parameters.'
+    ),
+    config_file='shaper.yaml',
+    parameters=(
+        ParameterSpec(
+            'source',
+            'string',
+            'beam_params',
+            'beam_params: the modes identified live on /beam_params; parameters: one mode '
+            'fixed by frequency_hz and damping_ratio',
+            choices=('beam_params', 'parameters'),
+        ),
+        ParameterSpec(
+            'frequency_hz',
+            'double',
+            1.0,
+            'natural frequency of the mode to cancel (source parameters)',
+            'Hz',
+            Bounds(0.0, low_open=True),
+        ),
+        ParameterSpec(
+            'damping_ratio',
+            'double',
+            0.0,
+            'damping ratio of the mode to cancel (source parameters)',
+            '',
+            Bounds(0.0, 1.0, high_open=True),
+        ),
+        ParameterSpec(
+            'shaper',
+            'string',
+            'zv',
+            'the shaper for well-known frequencies (and for source parameters)',
+            choices=('zv', 'zvd', 'ei'),
+        ),
+        ParameterSpec(
+            'robust_shaper',
+            'string',
+            'ei',
+            'the shaper when an identified frequency is uncertain (see robust_above)',
+            choices=('zvd', 'ei'),
+        ),
+        ParameterSpec(
+            'robust_above',
+            'double',
+            0.01,
+            'relative standard deviation of an identified frequency (std / value) above which '
+            'robust_shaper replaces shaper; ZV leaves at most 5 % within about 3 % of its '
+            'frequency, so 0.01 keeps a 3-sigma error in that band; 0: always robust',
+            '',
+            Bounds(0.0, 1.0),
+        ),
+        ParameterSpec(
+            'max_modes',
+            'int',
+            2,
+            'cancel at most this many identified modes (the first ones, by frequency)',
+            '',
+            Bounds(1, 8),
+        ),
+        ParameterSpec(
+            'unshaped_until_estimate',
+            'bool',
+            False,
+            'until the first valid estimate, publish each trajectory unshaped (with a '
+            'warning) instead of nothing',
+        ),
+    ),
+)

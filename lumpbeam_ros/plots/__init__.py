@@ -1,1 +1,0 @@
-"""Figures, drawn with matplotlib on the Agg backend (no display needed)."""

@@ -1,1 +1,0 @@
-"""Input shaping: impulse sequences that cancel a flexible arm's modes, applied to commands."""

@@ -1,1 +1,0 @@
-"""Synthetic experiments: the paper's drop test simulated and written as a bag."""

@@ -1,1 +1,0 @@
-"""Camera side: the checkerboard, the synthetic camera, and the tip tracker."""

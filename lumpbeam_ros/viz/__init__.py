@@ -1,1 +1,0 @@
-"""What a viewer draws: the beam as markers, their messages and the live view to Foxglove."""

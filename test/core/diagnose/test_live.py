@@ -1,0 +1,202 @@
+"""The live workflow's core: stretches from a stream, the record, the published status."""
+
+import dataclasses
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.core.bagio.tipseries import SampleCounts
+from lumpbeam_ros.core.diagnose.live import (
+    ERROR,
+    OK,
+    WARN,
+    LiveBuffer,
+    LiveDiagnosis,
+    LiveDiagnosisConfig,
+    Stretch,
+    diagnose_live,
+    named_effects,
+    status_values,
+)
+from lumpbeam_ros.core.diagnose.measurement import make_record
+from lumpbeam_ros.core.model.parameters import load_beam_config
+from lumpbeam_ros.core.synthetic.drop_test import SynthOptions, simulate_experiment
+
+RELEASE_S = 2.0
+
+
+def _stream(duration_s=4.5, effects=None, seed=0):
+    beam, drop = load_beam_config()
+    measured, _ = simulate_experiment(
+        beam, drop, SynthOptions(duration_s=duration_s, effects=effects or {})
+    )
+    rng = np.random.default_rng(seed)
+    noise = 20e-6 * rng.standard_normal((2, len(measured)))
+    return beam, drop, measured.t, measured.z + noise[0], measured.pitch + noise[1]
+
+
+def _filled(settings, t, z, pitch, loads=((0.0, 4.5), (RELEASE_S, 0.0)), found=None):
+    buffer = LiveBuffer(settings)
+    pending = list(loads)
+    for ti, zi, pi in zip(t, z, pitch, strict=True):
+        while pending and pending[0][0] <= ti:
+            buffer.push_load(*pending.pop(0))
+        buffer.push_measured(float(ti), float(zi), float(pi))
+        if found is not None:  # polled after every pose, as the node's timer does
+            stretch = buffer.next_stretch()
+            if stretch is not None:
+                found.append(stretch)
+    return buffer
+
+
+def test_a_ring_down_is_complete_after_decay_s_and_handed_out_once():
+    _, drop, t, z, pitch = _stream()
+    settings = LiveDiagnosisConfig(pre_release_s=1.0, decay_s=2.3)
+    early = t < RELEASE_S + 2.0
+    buffer = _filled(settings, t[early], z[early], pitch[early])
+    assert buffer.next_stretch() is None  # the decay has lasted 2 s only
+    buffer = _filled(settings, t, z, pitch)
+    stretch = buffer.next_stretch()
+    assert stretch == Stretch(RELEASE_S - 1.0, RELEASE_S + 2.3, RELEASE_S)
+    assert buffer.next_stretch() is None
+    record = buffer.record(stretch)
+    keep = (t >= 1.0) & (t <= RELEASE_S + 2.3)
+    expected = make_record(t[keep], z[keep], pitch[keep], drop.load_kg, [(RELEASE_S, 0.0)])
+    assert np.array_equal(record.t, expected.t) and np.array_equal(record.z, expected.z)
+    assert record.initial_load_kg == 4.5 and record.load_events == ((RELEASE_S, 0.0),)
+
+
+def test_a_ring_down_ends_early_once_the_swing_is_small():
+    _, _, t, z, pitch = _stream(duration_s=6.0)
+    # Above the whole swing: complete as soon as enough poses follow the release.
+    found = []
+    _filled(LiveDiagnosisConfig(decay_s=60.0, min_amplitude_m=0.5), t, z, pitch, found=found)
+    assert len(found) == 1 and 2.0 <= found[0].end_s - RELEASE_S < 2.1
+    never = []
+    _filled(LiveDiagnosisConfig(decay_s=60.0, min_amplitude_m=1e-6), t, z, pitch, found=never)
+    assert never == []
+
+
+def test_a_window_without_a_release_is_refused_with_a_reason():
+    _, _, t, z, pitch = _stream()
+    buffer = _filled(LiveDiagnosisConfig(trigger='window', window_s=1.5), t, z, pitch)
+    stretch = buffer.next_stretch()
+    assert stretch.start_s == t[0] and math.isnan(stretch.release_s)
+    with pytest.raises(LumpbeamError, match='no load change between'):
+        buffer.record(stretch)
+    second = buffer.next_stretch()  # the next window holds the release
+    assert second.start_s == stretch.end_s and second.release_s == RELEASE_S
+
+
+def test_missing_input_names_what_is_missing():
+    buffer = LiveBuffer(LiveDiagnosisConfig())
+    assert buffer.missing_input().startswith('/tip_pose: no measured pose received yet')
+    buffer.push_predicted(1.0, 0.0, 0.0)
+    assert 'only /tip_pose_predicted arrives' in buffer.missing_input()
+    buffer.push_measured(1.0, 0.0, 0.0)
+    assert buffer.missing_input().startswith('/tip_load')
+    buffer.push_load(0.5, 4.5)
+    assert buffer.missing_input() is None
+
+
+def test_prediction_gap_is_the_rms_of_measured_minus_predicted():
+    buffer = LiveBuffer(LiveDiagnosisConfig())
+    t = np.arange(0.0, 3.0, 1 / 180)
+    for ti in t:
+        buffer.push_measured(ti, 1e-3 * math.sin(10 * ti), 0.0)
+        buffer.push_predicted(ti, 1e-3 * math.sin(10 * ti) + 2e-4, 0.0)
+    assert buffer.prediction_gap(0.5, 2.5) == pytest.approx(2e-4, rel=1e-9)
+    assert math.isnan(buffer.prediction_gap(5.0, 6.0))  # no prediction there
+
+
+def _result(name, effects=(), before=3e-3, after=2e-5):
+    return LiveDiagnosis(name, tuple(effects), before, after, 'why', Stretch(1.0, 4.3, 2.0))
+
+
+@pytest.mark.parametrize(
+    ('result', 'level', 'names'),
+    [
+        (_result('none'), OK, 'none'),
+        (_result('sensor_latency', [('sensor_latency', {'latency_s': 0.015})]), WARN,
+         'sensor_latency'),
+        (_result('base_compliance', [('base_compliance', {'k_base_nm_per_rad': 2e4}),
+                                     ('quadratic_drag', {'c_q': 0.5})]), WARN,
+         'base_compliance,quadratic_drag'),
+        (_result('unexplained', before=3e-3, after=3e-3), ERROR, 'unexplained'),
+    ],
+)  # fmt: skip
+def test_status_levels_and_keys(result, level, names):
+    got, message, pairs = status_values(result)
+    values = dict(pairs)
+    assert got == level and values['missing_effects'] == names
+    assert values['missing_effect'] == result.missing_effect
+    assert float(values['gap_before_rms_m']) == result.gap_before_rms_m
+    assert values['gap_after_rms_m'] == repr(result.gap_after_rms_m)
+    for key, value in result.effect_parameters.items():
+        assert values[key] == repr(value) and key in message
+
+
+def test_simulator_parameters_are_the_effects_contract_names():
+    result = _result(
+        'sensor_latency',
+        [
+            ('sensor_latency', {'latency_s': 0.015}),
+            ('base_compliance', {'k_base_nm_per_rad': math.inf}),
+        ],
+    )
+    assert result.simulator_parameters() == {'effects.sensor_latency.latency_s': 0.015}
+
+
+def test_named_effects_reads_a_list_or_the_single_effect():
+    single = SimpleNamespace(missing_effect='added_mass', effect_parameters={'mass_kg': 0.3})
+    assert named_effects(single) == (('added_mass', {'mass_kg': 0.3}),)
+    assert named_effects(SimpleNamespace(missing_effect='none', effect_parameters={})) == ()
+    listed = SimpleNamespace(
+        missing_effect='added_mass',
+        effect_parameters={'mass_kg': 0.3},
+        missing_effects=[
+            {'name': 'added_mass', 'parameters': {'mass_kg': 0.3}, 'gap_reduction': 0.9},
+            SimpleNamespace(name='sensor_scale', parameters={'scale': 1.05}),
+        ],
+    )
+    assert named_effects(listed) == (
+        ('added_mass', {'mass_kg': 0.3}),
+        ('sensor_scale', {'scale': 1.05}),
+    )
+
+
+def test_diagnose_live_names_a_hidden_latency_on_a_short_ring_down():
+    beam, _, t, z, pitch = _stream(effects={'sensor_latency': 0.015})
+    buffer = _filled(LiveDiagnosisConfig(decay_s=2.3), t, z, pitch)
+    stretch = buffer.next_stretch()
+    result = diagnose_live(buffer.record(stretch), beam, stretch)
+    assert result.missing_effect == 'sensor_latency'
+    assert result.effect_parameters['latency_s'] == pytest.approx(0.015, rel=0.05)
+    assert result.gap_after_rms_m < 0.05 * result.gap_before_rms_m
+
+
+@pytest.mark.parametrize(('name', 'level'), [('none', WARN), ('unexplained', ERROR)])
+def test_a_stretch_with_many_poses_dropped_is_never_ok(name, level):
+    dropped = SampleCounts(received=2000, duplicates=900)
+    result = dataclasses.replace(_result(name), samples=dropped)
+    got, message, _ = status_values(result)
+    assert got == level
+    assert message.endswith('; /tip_pose: dropped 900 of 2000 poses (900 with a repeated or '
+                            'out-of-order stamp) in the stretch')  # fmt: skip
+
+
+def test_late_and_repeated_poses_are_counted_in_the_stretch_record():
+    _, _, t, z, pitch = _stream()
+    buffer = LiveBuffer(LiveDiagnosisConfig(pre_release_s=1.0, decay_s=2.3))
+    buffer.push_load(0.0, 4.5)
+    for ti, zi, pi in zip(t, z, pitch, strict=True):
+        if ti >= RELEASE_S and buffer.loads[-1][1] != 0.0:
+            buffer.push_load(float(ti), 0.0)
+        assert buffer.push_measured(float(ti), float(zi), float(pi))
+        assert not buffer.push_measured(float(ti) - 0.1, float(zi), float(pi))  # a late stream
+    record = buffer.record(buffer.next_stretch())
+    assert record.counts.duplicates == len(record) and record.counts.untrusted
+    assert buffer.measured.counts.out_of_order == t.size
