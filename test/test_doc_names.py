@@ -27,7 +27,6 @@ PAGES = sorted([ROOT / 'README.md', *(ROOT / 'doc').glob('*.md')])
 BASES = (ROOT, PACKAGE, PACKAGE / 'core', PACKAGE / 'apps', ROOT / 'lumpbeam_lab')
 
 
-
 def _file_keys() -> set[str]:
     """The dotted keys of the shipped files (``synthetic.seed``), ROS 2 parameter files or not."""
     keys = set()
