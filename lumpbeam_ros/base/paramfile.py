@@ -15,6 +15,7 @@ from typing import Any
 import yaml
 
 from lumpbeam_ros.base.errors import ConfigError
+from lumpbeam_ros.base.resources import config_path
 
 #: libyaml's loader when PyYAML was built with it: the same safe subset of YAML, parsed ten
 #: times faster than the pure-Python one (a command reads two or three files as it starts).
@@ -108,6 +109,23 @@ def read_parameter_file(path: str | Path) -> dict[str, Any]:
             raise ConfigError(path, str(node), 'expected a ros__parameters mapping')
         merged.update(flatten(section['ros__parameters']))
     return merged
+
+
+def parameter_file(path: str | Path | None, default: str) -> tuple[Path, dict[str, Any]]:
+    """Reads a parameter file, or the package's own when none is given: the one loader.
+
+    Args:
+        path: The YAML file, or ``None``.
+        default: The package's file used for ``None``, a name under ``config/``.
+
+    Returns:
+        The file read and its flat parameters (:func:`read_parameter_file`).
+
+    Raises:
+        ConfigError: The file is missing or malformed.
+    """
+    chosen = config_path(default) if path is None else Path(path)
+    return chosen, read_parameter_file(chosen)
 
 
 def check_known_keys(

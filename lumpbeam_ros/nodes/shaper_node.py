@@ -32,11 +32,8 @@ import sys
 from collections.abc import Sequence
 from typing import Unpack
 
-import numpy as np
-from builtin_interfaces.msg import Duration
 from diagnostic_msgs.msg import DiagnosticArray
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
-from trajectory_msgs.msg import JointTrajectoryPoint
 
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.base.interface import (
@@ -45,7 +42,6 @@ from lumpbeam_ros.base.interface import (
     JOINT_TRAJECTORY,
     JOINT_TRAJECTORY_SHAPED,
 )
-from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
 from lumpbeam_ros.core.shaping.apply import shape_trajectory
 from lumpbeam_ros.core.shaping.estimate import choose_shaper, estimate_from_status
 from lumpbeam_ros.core.shaping.impulses import Impulses, Mode
@@ -54,43 +50,10 @@ from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
 from lumpbeam_ros.nodes.params.shaper_params import SHAPER_SCHEMA
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
+from lumpbeam_ros.nodes.trajectory_messages import trajectory_from_msg, trajectory_msg
 
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0
-
-
-def trajectory_from_msg(msg: JointTrajectoryMsg) -> JointTrajectory:
-    """The positions of a JointTrajectory message against ``time_from_start``.
-
-    Raises:
-        LumpbeamError: No joint names, a point without one position per joint, or what
-            :class:`~lumpbeam_ros.core.model.arm.joint_trajectory.JointTrajectory` refuses.
-    """
-    names = tuple(msg.joint_names)
-    if not names:
-        raise LumpbeamError('no joint names')
-    for i, point in enumerate(msg.points):
-        if len(point.positions) != len(names):
-            raise LumpbeamError(
-                f'point {i} has {len(point.positions)} positions for {len(names)} joints'
-            )
-    time = [p.time_from_start.sec + p.time_from_start.nanosec * 1e-9 for p in msg.points]
-    angles = np.array([list(p.positions) for p in msg.points], dtype=float)
-    return JointTrajectory(np.array(time), angles.reshape(len(time), len(names)), names)
-
-
-def trajectory_msg(trajectory: JointTrajectory, like: JointTrajectoryMsg) -> JointTrajectoryMsg:
-    """A JointTrajectory message of positions, with the header of ``like``."""
-    msg = JointTrajectoryMsg(header=like.header, joint_names=list(trajectory.joint_names))
-    nanoseconds = np.rint(trajectory.time_s * 1e9).astype(np.int64)
-    seconds, remainder = np.divmod(nanoseconds, 1_000_000_000)
-    msg.points = [
-        JointTrajectoryPoint(
-            positions=row.tolist(), time_from_start=Duration(sec=int(s), nanosec=int(r))
-        )
-        for row, s, r in zip(trajectory.angles_rad, seconds, remainder, strict=True)
-    ]
-    return msg
 
 
 class ShaperNode(SchemaNode):

@@ -89,6 +89,7 @@ from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
 from lumpbeam_ros.nodes.params.simulator_params import SIMULATOR_SCHEMA, effect_parameter_name
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
+from lumpbeam_ros.nodes.trajectory_messages import command_from_msg
 
 #: DiagnosticStatus.OK as a number (rclpy gives levels as one byte).
 OK_LEVEL = 0
@@ -489,18 +490,10 @@ class ArmMode:
 
     def _on_command(self, msg: JointTrajectoryMsg) -> None:
         now = self._now()
-        stamp = time_ns(msg.header.stamp) / NS_PER_S
-        start = max(stamp, now) if stamp > 0.0 else now
-        names = list(msg.joint_names)
         try:
-            for i, point in enumerate(msg.points):
-                if len(point.positions) != len(names):
-                    raise LumpbeamError(
-                        f'point {i} has {len(point.positions)} positions for {len(names)} joints'
-                    )
-            times = [time_ns(p.time_from_start) / NS_PER_S for p in msg.points]
-            positions = np.array([list(p.positions) for p in msg.points], dtype=float)
-            self.stream.command(names, times, positions.reshape(len(times), len(names)), start)
+            command = command_from_msg(msg)
+            start = max(command.stamp_s, now) if command.stamp_s > 0.0 else now
+            self.stream.command(command.joint_names, command.time_s, command.positions_rad, start)
         except LumpbeamError as exc:
             self.refused += 1
             self.last_refusal = str(exc)
@@ -511,8 +504,8 @@ class ArmMode:
             return
         self.accepted += 1
         self.node.get_logger().info(
-            f'following a command of {len(times)} points from {start:.3f} s '
-            f'({times[-1]:.3f} s long)'
+            f'following a command of {command.time_s.size} points from {start:.3f} s '
+            f'({command.time_s[-1]:.3f} s long)'
         )
 
     def _on_measured(self, msg: PoseStamped) -> None:

@@ -160,3 +160,16 @@ def test_safe_load_parses_as_yaml_safe_load_and_refuses_python_objects():
     assert safe_load(text) == yaml.safe_load(text)
     with pytest.raises(yaml.YAMLError):
         safe_load('!!python/object/apply:os.system ["true"]')
+
+
+def test_the_one_loader_reads_the_given_file_or_the_packages_own(tmp_path):
+    from lumpbeam_ros.base.paramfile import parameter_file
+    from lumpbeam_ros.base.resources import config_path
+
+    source, params = parameter_file(None, 'identifier.yaml')
+    assert source == config_path('identifier.yaml') and 'window.length_s' in params
+    given = tmp_path / 'mine.yaml'
+    given.write_text('/**:\n  ros__parameters:\n    window:\n      length_s: 3.0\n')
+    assert parameter_file(given, 'identifier.yaml') == (given, {'window.length_s': 3.0})
+    with pytest.raises(ConfigError, match='no_such.yaml'):
+        parameter_file(tmp_path / 'no_such.yaml', 'identifier.yaml')

@@ -13,11 +13,11 @@ from lumpbeam_ros.base.errors import ConfigError, LumpbeamError
 from lumpbeam_ros.base.interface import BEAM_PARAMS, IDENTIFIER_STATUS
 from lumpbeam_ros.base.interface import JOINT_TRAJECTORY as IN
 from lumpbeam_ros.base.interface import JOINT_TRAJECTORY_SHAPED as OUT
-from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
 from lumpbeam_ros.core.shaping.apply import shape_trajectory
 from lumpbeam_ros.core.shaping.impulses import Mode
 from lumpbeam_ros.core.shaping.shapers import design_shaper
-from lumpbeam_ros.nodes.shaper_node import ShaperNode, trajectory_from_msg
+from lumpbeam_ros.nodes.shaper_node import ShaperNode
+from lumpbeam_ros.nodes.trajectory_messages import trajectory_from_msg
 
 OK, ERROR = 0, 2
 
@@ -183,15 +183,3 @@ def test_bad_parameters_stop_the_node_in_one_line(ros_graph, overrides, error, p
     with pytest.raises(error) as caught:
         ShaperNode(context=ros_graph.context, parameter_overrides=overrides)
     assert problem in str(caught.value) and '\n' not in str(caught.value)
-
-
-def test_message_conversion_round_trips():
-    trajectory = JointTrajectory(np.array([0.0, 0.5, 1.25]), np.array([[0.1], [0.2], [0.3]]))
-    from lumpbeam_ros.nodes.shaper_node import trajectory_msg
-
-    msg = trajectory_msg(trajectory, JointTrajectoryMsg())
-    assert msg.points[2].time_from_start.sec == 1
-    assert msg.points[2].time_from_start.nanosec == 250_000_000
-    back = trajectory_from_msg(msg)
-    assert np.array_equal(back.time_s, trajectory.time_s)
-    assert np.array_equal(back.angles_rad, trajectory.angles_rad)

@@ -269,7 +269,7 @@ def _drive(graph: ProcessGraph, run: ArmDemoRun) -> None:
     from lumpbeam_ros.core.bagio.typestore import serialize
     from lumpbeam_ros.core.shaping.estimate import estimate_from_status
     from lumpbeam_ros.nodes.msgtypes import topic_qos
-    from lumpbeam_ros.nodes.shaper_node import trajectory_from_msg, trajectory_msg
+    from lumpbeam_ros.nodes.trajectory_messages import trajectory_from_msg, trajectory_msg
 
     move_out, move_back = the_moves(run.arm)
     seen: dict[str, Any] = {'tip_s': -math.inf, 'ok': None, 'shaped': []}

@@ -13,8 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from lumpbeam_ros.base.errors import LumpbeamError
-from lumpbeam_ros.base.paramfile import check_known_keys, read_parameter_file
-from lumpbeam_ros.base.resources import config_path
+from lumpbeam_ros.base.paramfile import check_known_keys, parameter_file
 from lumpbeam_ros.base.schema import (
     Bounds,
     setting,
@@ -317,5 +316,5 @@ def load_identifier_config(path: str | Path | None = None) -> IdentifierConfig:
     Raises:
         ConfigError: The file is missing or malformed, or a value is invalid.
     """
-    path = config_path('identifier.yaml') if path is None else Path(path)
-    return config_from_parameters(read_parameter_file(path), path)
+    source, params = parameter_file(path, 'identifier.yaml')
+    return config_from_parameters(params, source)

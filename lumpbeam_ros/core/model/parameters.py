@@ -11,8 +11,7 @@ from typing import Any, Literal, get_args
 import numpy as np
 import yaml
 
-from lumpbeam_ros.base.paramfile import check_known_keys, read_parameter_file
-from lumpbeam_ros.base.resources import config_path
+from lumpbeam_ros.base.paramfile import check_known_keys, parameter_file
 from lumpbeam_ros.base.schema import (
     Bounds,
     ParameterSpec,
@@ -475,9 +474,8 @@ def load_beam_config(path: str | Path | None = None) -> tuple[BeamParameters, Dr
     Raises:
         ConfigError: The file is missing or malformed, or a value is invalid.
     """
-    path = config_path('paper_beam.yaml') if path is None else Path(path)
-    params = read_parameter_file(path)
-    return beam_from_parameters(params, path), drop_test_from_parameters(params, path)
+    source, params = parameter_file(path, 'paper_beam.yaml')
+    return beam_from_parameters(params, source), drop_test_from_parameters(params, source)
 
 
 def beam_to_parameters(beam: BeamParameters, drop: DropTestConfig | None = None) -> dict[str, Any]:

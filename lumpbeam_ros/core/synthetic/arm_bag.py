@@ -35,8 +35,7 @@ from lumpbeam_ros.base.interface import (
     TIP_POSE,
     TIP_POSE_TRUTH,
 )
-from lumpbeam_ros.base.paramfile import read_parameter_file
-from lumpbeam_ros.base.resources import config_path
+from lumpbeam_ros.base.paramfile import parameter_file
 from lumpbeam_ros.core.bagio import BagWriter
 from lumpbeam_ros.core.model.arm.config import ArmConfig
 from lumpbeam_ros.core.model.arm.drive import SampledMotion
@@ -134,8 +133,7 @@ def board_at_rest(
     Raises:
         ConfigError: A bad camera file.
     """
-    path = config_path('camera.yaml') if source is None else Path(source)
-    params = read_parameter_file(path)
+    path, params = parameter_file(source, 'camera.yaml')
     x, z, pitch = tip
     placed = camera_config_from_parameters(params, path)
     rotation = rotation_y(pitch) @ placed.rig.base_board.rotation

@@ -15,8 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from lumpbeam_ros.base.errors import LumpbeamError
-from lumpbeam_ros.base.paramfile import check_known_keys, read_parameter_file
-from lumpbeam_ros.base.resources import config_path
+from lumpbeam_ros.base.paramfile import check_known_keys, parameter_file
 from lumpbeam_ros.base.schema import Bounds, setting, settings_from_parameters, settings_specs
 from lumpbeam_ros.core.vision.board import Checkerboard
 from lumpbeam_ros.core.vision.camera_model import CameraInfo
@@ -352,8 +351,8 @@ def load_camera_config(path: str | Path | None = None) -> CameraConfig:
     Raises:
         ConfigError: The file is missing or malformed, or a value is invalid.
     """
-    path = config_path('camera.yaml') if path is None else Path(path)
-    return camera_config_from_parameters(read_parameter_file(path), path)
+    source, params = parameter_file(path, 'camera.yaml')
+    return camera_config_from_parameters(params, source)
 
 
 def parse_board(text: str) -> tuple[int, int]:
