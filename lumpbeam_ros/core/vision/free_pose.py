@@ -15,14 +15,12 @@ certain than the plane-constrained fit's three numbers; the covariance says by h
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
-
 import numpy as np
 
 from lumpbeam_ros.core.vision.camera_model import CameraInfo
 from lumpbeam_ros.core.vision.config import RigGeometry
 from lumpbeam_ros.core.vision.geometry import Transform, rotation_rpy
+from lumpbeam_ros.core.vision.reprojection import PoseFit, fit_pose
 
 #: The pose models a tracker fits: ``plane`` (x, z, pitch in the plane of bending) or
 #: ``free`` (the full 6-DoF pose).
@@ -31,27 +29,6 @@ POSE_MODELS = ('plane', 'free')
 # Central-difference steps for the Jacobian, m and rad: at ~1 m and 1e-6 the truncation
 # error (~1e-12 relative) and round-off (~1e-10 relative) are both far below the noise.
 _STEP = 1e-6
-
-
-@dataclass(frozen=True)
-class FreeFit:
-    """The result of a 6-DoF pose fit.
-
-    Attributes:
-        pose: ``(x, y, z, roll, pitch, yaw)`` of the tip in ``beam_base``, m and rad.
-        covariance: 6x6 covariance of ``pose`` (PoseWithCovariance order).
-        rms_px: RMS reprojection error per corner, px.
-        max_px: The largest reprojection error of a corner, px.
-        converged: Whether Gauss-Newton met its step tolerance.
-        median_px: The median reprojection error of a corner, px.
-    """
-
-    pose: np.ndarray
-    covariance: np.ndarray
-    rms_px: float
-    max_px: float
-    converged: bool
-    median_px: float = math.nan
 
 
 def rpy_from_rotation(rotation: np.ndarray) -> np.ndarray:
@@ -119,6 +96,10 @@ class FreeModel:
             undistorted before they are fitted).
     """
 
+    #: Gauss-Newton converges quadratically: a 1e-9 step (m, rad) leaves nothing measurable.
+    step_tolerance = 1e-9
+    max_iterations = 20
+
     def __init__(self, rig: RigGeometry, camera_info: CameraInfo):
         self.rig = rig
         self._points = rig.base_board.apply(rig.board.object_points())
@@ -145,54 +126,23 @@ class FreeModel:
             columns.append((self.project(pose + step) - self.project(pose - step)) / (2 * _STEP))
         return np.stack(columns, axis=2)
 
-    def fit(self, pixels: np.ndarray, initial: np.ndarray, max_iterations: int = 20) -> FreeFit:
-        """Fits the 6-DoF pose to measured corners by Gauss-Newton on reprojection error.
+    def project_with_jacobian(self, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Returns the projected corners (N x 2) and d(pixels)/d(pose) (N x 2 x 6)."""
+        return self.project(pose), self.jacobian(pose)
+
+    def fit(self, pixels: np.ndarray, initial: np.ndarray) -> PoseFit:
+        """Fits the 6-DoF pose to measured corners (:func:`~.reprojection.fit_pose`).
 
         Args:
             pixels: Undistorted corner positions (N x 2) in board order; NaN rows (corners
                 not seen) are left out.
             initial: Starting pose ``(x, y, z, roll, pitch, yaw)``.
-            max_iterations: Iterations at most.
 
         Returns:
-            The fitted pose with its covariance ``sigma^2 (J^T J)^-1``, ``sigma^2`` the
-            residual variance with ``2N - 6`` degrees of freedom; a fit with fewer than 4
-            corners, or a singular one, is not converged.
+            The fitted pose with its covariance in PoseWithCovariance order; a fit with
+            fewer than 4 corners, or a singular one, is not converged.
         """
-        pixels = np.asarray(pixels, dtype=float)
-        seen = np.all(np.isfinite(pixels), axis=1)
-        pose = np.asarray(initial, dtype=float).copy()
-        nan = np.full((6, 6), np.nan)
-        if np.count_nonzero(seen) < 4 or pose.shape != (6,) or not np.all(np.isfinite(pose)):
-            return FreeFit(pose, nan, np.nan, np.nan, False)
-        converged = False
-        for _ in range(max_iterations):
-            r = (self.project(pose)[seen] - pixels[seen]).ravel()
-            j = self.jacobian(pose)[seen].reshape(-1, 6)
-            jtj = j.T @ j
-            try:
-                step = np.linalg.solve(jtj, -(j.T @ r))
-            except np.linalg.LinAlgError:
-                return FreeFit(pose, nan, np.nan, np.nan, False)
-            pose += step
-            if not np.all(np.isfinite(pose)):
-                return FreeFit(pose, nan, np.nan, np.nan, False)
-            # Quadratic convergence: a 1e-9 step (m, rad) leaves nothing measurable behind.
-            if np.max(np.abs(step)) < 1e-9:
-                converged = True
-                break
-        residual = (self.project(pose)[seen] - pixels[seen]).reshape(-1, 2)
-        ssr = float(np.sum(residual * residual))
-        dof = max(residual.size - 6, 1)
-        try:
-            covariance = np.linalg.inv(jtj) * (ssr / dof)
-        except np.linalg.LinAlgError:
-            covariance = np.full((6, 6), np.inf)
-        rms = float(np.sqrt(ssr / residual.shape[0]))
-        distances = np.sqrt(np.sum(residual * residual, axis=1))
-        worst = float(np.max(distances))
-        ok = converged and bool(np.isfinite(rms))
-        return FreeFit(pose, covariance, rms, worst, ok, float(np.median(distances)))
+        return fit_pose(self, pixels, initial)
 
 
 def free_pose_from_board_pose(rig: RigGeometry, camera_board: Transform) -> np.ndarray:

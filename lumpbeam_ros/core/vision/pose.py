@@ -9,7 +9,6 @@ whose depth and out-of-plane tilt trade off against the in-plane translation fra
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -17,7 +16,7 @@ import numpy as np
 from lumpbeam_ros.core.vision.camera_model import CameraInfo
 from lumpbeam_ros.core.vision.config import RigGeometry
 from lumpbeam_ros.core.vision.geometry import Transform, tip_pose_from_transform, tip_transform
-from lumpbeam_ros.core.vision.partial import sorted_median
+from lumpbeam_ros.core.vision.reprojection import PoseFit, fit_pose
 
 #: Gauss-Newton stops after a step below this, m or rad. The tip moves parallel to the image
 #: plane (constant depth) and the pitch turns the image about the optical axis, so the
@@ -28,35 +27,21 @@ from lumpbeam_ros.core.vision.partial import sorted_median
 _STEP_TOLERANCE = 5e-4
 
 
-@dataclass(frozen=True)
-class PlaneFit:
-    """The result of a plane-constrained pose fit.
-
-    Attributes:
-        pose: ``(x, z, pitch)`` of the tip in ``beam_base``, m, m, rad.
-        covariance: 3x3 covariance of ``pose`` from the reprojection residuals.
-        rms_px: RMS reprojection error per corner, px.
-        max_px: The largest reprojection error of a corner, px.
-        converged: Whether Gauss-Newton met its step tolerance.
-        median_px: The median reprojection error of a corner, px.
-    """
-
-    pose: np.ndarray
-    covariance: np.ndarray
-    rms_px: float
-    max_px: float
-    converged: bool
-    median_px: float = math.nan
-
-
 class PlaneModel:
     """Projects the board's corners for an in-plane tip pose, with the Jacobian.
+
+    Attributes:
+        step_tolerance: Gauss-Newton's stop (:data:`_STEP_TOLERANCE`), m or rad.
+        max_iterations: Gauss-Newton iterations at most.
 
     Args:
         rig: Camera mount and board pose.
         camera_info: Intrinsics; only the pinhole part is used (measured corners are
             undistorted before they are fitted).
     """
+
+    step_tolerance = _STEP_TOLERANCE
+    max_iterations = 10
 
     def __init__(self, rig: RigGeometry, camera_info: CameraInfo):
         self.rig = rig
@@ -119,74 +104,18 @@ class PlaneModel:
         jac *= inv_z[:, None, None] * self._f[None, :, None]
         return uv * self._f + self._c, jac
 
-    def fit(self, pixels: np.ndarray, initial: np.ndarray, max_iterations: int = 10) -> PlaneFit:
-        """Fits ``(x, z, pitch)`` to measured corners by Gauss-Newton on reprojection error.
+    def fit(self, pixels: np.ndarray, initial: np.ndarray) -> PoseFit:
+        """Fits ``(x, z, pitch)`` to measured corners (:func:`~.reprojection.fit_pose`).
 
         Args:
             pixels: Undistorted corner positions (N x 2), in the board's corner order; NaN
                 rows (corners not seen: a partial view) are left out.
             initial: Starting pose ``(x, z, pitch)``.
-            max_iterations: Gauss-Newton iterations at most.
 
         Returns:
-            The fitted pose with its covariance ``sigma^2 (J^T J)^-1``, where ``sigma^2`` is
-            the residual variance with 2N - 3 degrees of freedom (N corners seen).
-
-        Raises:
-            numpy.linalg.LinAlgError: The corners do not fix the pose (``J^T J`` singular).
+            The fitted pose with its covariance.
         """
-        pose = np.asarray(initial, dtype=float).copy()
-        seen = np.all(np.isfinite(pixels), axis=1)
-        if not np.all(seen):
-            pixels = pixels[seen]
-        converged = False
-        for _ in range(max_iterations):
-            proj, jac = self.project_with_jacobian(pose)
-            if pixels.shape[0] != proj.shape[0]:
-                proj, jac = proj[seen], jac[seen]
-            r = (proj - pixels).ravel()
-            j = jac.reshape(-1, 3)
-            # The inverse serves the step and, from the last step, the covariance.
-            inverse = _symmetric_inverse(j.T @ j)
-            step = -(inverse @ (j.T @ r))
-            pose += step
-            if np.max(np.abs(step)) < _STEP_TOLERANCE:
-                converged = True
-                break
-        residual = (r + j @ step).reshape(-1, 2)
-        squares = np.einsum('ij,ij->i', residual, residual)
-        ssr = float(squares.sum())
-        dof = max(residual.size - 3, 1)
-        covariance = inverse * (ssr / dof)
-        rms = float(np.sqrt(ssr / residual.shape[0]))
-        worst = float(np.sqrt(squares.max()))
-        median = sorted_median(np.sqrt(squares))
-        ok = converged and bool(np.isfinite(rms))
-        return PlaneFit(pose, covariance, rms, worst, ok, median)
-
-
-def _symmetric_inverse(a: np.ndarray) -> np.ndarray:
-    """The inverse of a symmetric 3 x 3 matrix by its cofactors.
-
-    ``J^T J`` of every Gauss-Newton step: some 5 times faster than ``np.linalg.inv`` on so
-    small a matrix, and as accurate (both lose the matrix's condition number times the
-    round-off).
-
-    Raises:
-        numpy.linalg.LinAlgError: The matrix is singular (or not finite).
-    """
-    (m00, m01, m02), (_, m11, m12), (_, _, m22) = a.tolist()
-    c00 = m11 * m22 - m12 * m12
-    c01 = m02 * m12 - m01 * m22
-    c02 = m01 * m12 - m02 * m11
-    c11 = m00 * m22 - m02 * m02
-    c12 = m01 * m02 - m00 * m12
-    c22 = m00 * m11 - m01 * m01
-    det = m00 * c00 + m01 * c01 + m02 * c02
-    if det == 0.0 or not math.isfinite(det):
-        raise np.linalg.LinAlgError('singular matrix')
-    inverse: np.ndarray = np.array([[c00, c01, c02], [c01, c11, c12], [c02, c12, c22]]) / det
-    return inverse
+        return fit_pose(self, pixels, initial)
 
 
 def solve_board_pnp(

@@ -35,7 +35,6 @@ from lumpbeam_ros.core.vision.corners import (
 from lumpbeam_ros.core.vision.detect import detect_board
 from lumpbeam_ros.core.vision.free_pose import (
     POSE_MODELS,
-    FreeFit,
     FreeModel,
     free_pose_from_board_pose,
     planar_part,
@@ -52,12 +51,12 @@ from lumpbeam_ros.core.vision.partial import (
     sorted_median,
 )
 from lumpbeam_ros.core.vision.pose import (
-    PlaneFit,
     PlaneModel,
     camera_board_transform,
     solve_board_pnp,
     tip_pose_from_board_pose,
 )
+from lumpbeam_ros.core.vision.reprojection import PoseFit
 
 #: Image encodings :meth:`TipTracker.process` takes (those of doc/interfaces.md, 'Topics').
 ENCODINGS = ('mono8', 'bgr8', 'rgb8')
@@ -310,9 +309,7 @@ class TipTracker:
             return None, f'corners miss a homography by {residual:.2f} px'
         return ideal, ''
 
-    def _fit(
-        self, ideal: np.ndarray, initial: np.ndarray
-    ) -> tuple[PlaneFit | FreeFit | None, str]:
+    def _fit(self, ideal: np.ndarray, initial: np.ndarray) -> tuple[PoseFit | None, str]:
         model = self._free if self.pose_model == 'free' else self._model
         fit = model.fit(ideal, initial)
         if not fit.converged or not np.all(np.isfinite(fit.pose)):
@@ -374,7 +371,7 @@ class TipTracker:
 
     def _clean_fit(
         self, gray: np.ndarray, corners: np.ndarray, guess: np.ndarray, pose_guess: np.ndarray
-    ) -> tuple[np.ndarray, PlaneFit | FreeFit] | None:
+    ) -> tuple[np.ndarray, PoseFit] | None:
         """The fit of every corner when the frame is clean, else ``None`` (the checks decide).
 
         Most frames show the whole board untouched, and the saddle check and the homography
@@ -420,7 +417,7 @@ class TipTracker:
 
     def _fit_within_outlier_floor(
         self, ideal: np.ndarray, mask: np.ndarray, pose_guess: np.ndarray
-    ) -> PlaneFit | FreeFit | None:
+    ) -> PoseFit | None:
         """The fit of the selected corners when none of them can be an outlier, else ``None``.
 
         Once the rig is calibrated, the pose model is a homography with fewer degrees of
@@ -546,7 +543,7 @@ class TipTracker:
         stamp: float,
         corners: np.ndarray,
         ideal: np.ndarray,
-        fit: PlaneFit | FreeFit,
+        fit: PoseFit,
         detected: bool,
     ) -> TrackResult:
         calibrated = self._is_calibrated()
@@ -562,7 +559,7 @@ class TipTracker:
             self._pending.append((ideal, fit.pose))
             if len(self._pending) >= self.settings.calibration_frames:
                 self._calibrate()
-            elif len(self._pending) == 1 and isinstance(fit, PlaneFit):
+            elif len(self._pending) == 1 and self.pose_model == 'plane':
                 fit = self._calibrate_depth(ideal, fit)
         pose, covariance, pose6, covariance6 = fit.pose, fit.covariance, None, None
         if self.pose_model == 'free':
@@ -595,7 +592,7 @@ class TipTracker:
             or self.pose_model == 'free'
         )
 
-    def _calibrate_depth(self, ideal: np.ndarray, fit: PlaneFit) -> PlaneFit:
+    def _calibrate_depth(self, ideal: np.ndarray, fit: PoseFit) -> PoseFit:
         """Corrects the board's distance from the first frame, before the full calibration.
 
         The board's known squares fix the distance in a single frame, and a configured
