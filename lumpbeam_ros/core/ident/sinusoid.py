@@ -36,7 +36,7 @@ import numpy as np
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.core.ident.covariance import Covariance, sandwich_covariance
 from lumpbeam_ros.core.ident.mode_estimate import TWO_PI, ModeEstimate
-from lumpbeam_ros.core.ident.optimize import levenberg_marquardt
+from lumpbeam_ros.core.ident.optimize import least_squares
 
 #: A mode's starting point: (damped frequency in Hz, damping ratio).
 ModeGuess = tuple[float, float]
@@ -333,46 +333,10 @@ class _Problem:
         """The least-squares solution from ``x0`` and the evaluations it took.
 
         Gauss-Newton first when ``x0`` is next to the solution (``warm``), else (or when it
-        fails) Levenberg-Marquardt.
+        fails) Levenberg-Marquardt (:func:`~.optimize.least_squares`).
         """
-        found = _gauss_newton(self, x0) if warm else None
-        if found is None:
-            solution = levenberg_marquardt(self.residuals, self.jacobian, x0)
-            found = solution.x, solution.n_evaluations
-        return found
-
-
-def _gauss_newton(
-    problem: _Problem, x0: np.ndarray, max_steps: int = 6
-) -> tuple[np.ndarray, int] | None:
-    """Plain Gauss-Newton from a start next to the solution (a live window's last fit).
-
-    Near the minimum it converges quadratically, and a step costs one Jacobian and one
-    small least-squares solve, without the trust-region bookkeeping of a general solver.
-    It stops when the next step would lower the linearised residual sum of squares by less
-    than a millionth of the noise variance: far less than the data can tell.
-
-    Returns:
-        The solution and the evaluations used, or ``None`` when a step does not lower the
-        residuals or it does not converge (the caller then runs the robust solver).
-    """
-    x = x0
-    residual = problem.residuals(x)
-    rss = float(residual @ residual)
-    tolerance = 1e-6 * rss / max(problem.y.size - x.size, 1)
-    for step in range(1, max_steps + 1):
-        jac = problem.jacobian(x)
-        delta, *_ = np.linalg.lstsq(jac, -residual, rcond=None)
-        linearised = residual + jac @ delta
-        if rss - float(linearised @ linearised) < tolerance:
-            return x, step
-        trial = x + delta
-        trial_residual = problem.residuals(trial)
-        trial_rss = float(trial_residual @ trial_residual)
-        if not trial_rss < rss:
-            return None
-        x, residual, rss = trial, trial_residual, trial_rss
-    return None
+        solution = least_squares(self.residuals, self.jacobian, x0, warm, self.y.size)
+        return solution.x, solution.n_evaluations
 
 
 def _sweep(sigma: float, tau: np.ndarray) -> np.ndarray:

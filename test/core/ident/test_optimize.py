@@ -7,6 +7,7 @@ import pytest
 from scipy.optimize import least_squares, minimize_scalar
 
 from lumpbeam_ros.base.blas import single_threaded_blas
+from lumpbeam_ros.core.ident import optimize
 from lumpbeam_ros.core.ident.covariance import sandwich_covariance
 from lumpbeam_ros.core.ident.onset import _residual
 from lumpbeam_ros.core.ident.optimize import bounded_scalar_minimum, levenberg_marquardt
@@ -138,3 +139,36 @@ def test_bounded_scalar_minimum_refuses_bad_bounds_and_reports_its_budget():
         bounded_scalar_minimum(math.cos, 0.0, math.inf)
     short = bounded_scalar_minimum(math.cos, 2.0, 5.0, xatol=1e-12, max_evaluations=4)
     assert (short.n_evaluations, short.converged) == (4, False)
+
+
+def _exponential(t, y):
+    def residuals(x):
+        return x[0] * np.exp(-x[1] * t) - y
+
+    def jacobian(x):
+        e = np.exp(-x[1] * t)
+        return np.column_stack([e, -x[0] * t * e])
+
+    return residuals, jacobian
+
+
+def test_gauss_newton_from_a_warm_start_reaches_the_solution_in_few_steps():
+    t = np.linspace(0.0, 2.0, 50)
+    y = 2.0 * np.exp(-1.3 * t) + np.random.default_rng(1).normal(0.0, 1e-3, t.size)
+    residuals, jacobian = _exponential(t, y)
+    cold = levenberg_marquardt(residuals, jacobian, np.array([1.0, 1.0]))
+    warm = optimize.gauss_newton(residuals, jacobian, cold.x + [1e-3, -1e-3], t.size)
+    assert warm is not None and warm.n_evaluations <= 3
+    np.testing.assert_allclose(warm.x, cold.x, rtol=1e-6)
+
+
+def test_least_squares_falls_back_when_the_warm_start_is_not_near():
+    t = np.linspace(0.0, 2.0, 50)
+    residuals, jacobian = _exponential(t, 2.0 * np.exp(-1.3 * t))
+    far = np.array([0.01, 9.0])  # Gauss-Newton's full step overshoots from here
+    with np.errstate(over='ignore'):  # the trial's exponential; the solver refuses it
+        assert optimize.gauss_newton(residuals, jacobian, far, t.size) is None
+        solution = optimize.least_squares(residuals, jacobian, far, warm=True, n_data=t.size)
+    np.testing.assert_allclose(solution.x, [2.0, 1.3], rtol=1e-6)
+    cold = optimize.least_squares(residuals, jacobian, far, warm=False, n_data=t.size)
+    np.testing.assert_array_equal(cold.x, solution.x)
