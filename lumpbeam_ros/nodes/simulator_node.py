@@ -22,6 +22,12 @@ Parameters: :data:`~lumpbeam_ros.nodes.params.simulator_params.SIMULATOR_SCHEMA`
 (``doc/parameters.md``); their defaults are the values of ``config/simulator.yaml``, where
 each is documented.
 
+One node, one way of running a model: a steady timer advances the model to the node's clock
+and publishes what it predicts, a clock that jumps back (a bag that loops) or far ahead
+restarts the model at rest, ``/tip_pose`` is drawn beside the model's tip on
+``/beam_markers``. Behind it is the clamped beam (:class:`BeamSimulation`) or the arm
+(:class:`ArmSimulation`), each with its own inputs.
+
 Run it::
 
     simulator_node --ros-args --params-file config/simulator.yaml -p use_sim_time:=true
@@ -35,7 +41,7 @@ import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, Unpack
+from typing import Any, NamedTuple, Unpack
 
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
@@ -117,48 +123,40 @@ def load_board(path: str) -> BoardPlacement:
 
 
 class SimulatorNode(SchemaNode):
-    """Publishes the predicted tip pose of the lumped beam under the live tip load.
+    """Publishes the predicted tip pose of the lumped beam, or of the arm, as time passes.
 
     Args:
         **options: See :class:`~lumpbeam_ros.nodes.ros_parameters.NodeOptions`.
 
+    Attributes:
+        model: The model behind the node: the beam, or the arm (``arm_config`` given).
+        arm: The arm, or ``None`` for the beam.
+        published: Poses published on ``/tip_pose_predicted``.
+        markers_published: Marker arrays published on ``/beam_markers``.
+
     Raises:
-        ConfigError: The beam file is missing or malformed, or a parameter is of the wrong
-            type or out of range.
+        ConfigError: The beam, arm or camera file is missing or malformed, or a parameter is
+            of the wrong type or out of range.
     """
 
     def __init__(self, **options: Unpack[NodeOptions]):
         super().__init__(SIMULATOR_SCHEMA, self._on_change, **options)
         values = self.parameter_values
         self._settings = values
-        #: The arm being simulated (``arm_config`` given), else ``None``: the clamped beam.
-        self.arm: ArmMode | None = None
         self.published = 0
         self.markers_published = 0
-        if values['arm_config']:
-            self.arm = ArmMode(self, values)
-            return
-        self._base_beam = load_beam(values['beam_config'])
-        self._stream: PredictionStream | None = None
-        self._load_kg = float(values['initial_load_kg'])
-        self._load_seen = False
-        self._adopted: tuple[float, float] | None = None
-        self._adopted_beam: BeamParameters | None = None
-        self._board = load_board(values['camera_config'])
-        self._latest: TipTrajectory | None = None  # the last samples published
         self._measured: tuple[float, TipPoint] | None = None  # stamp, tip of /tip_pose
         self._markers_stamp = -math.inf
-        #: Poses published on ``/tip_pose_predicted``, marker arrays on ``/beam_markers``.
-        self.published = 0
-        self.markers_published = 0
-        # Parameters from --params-file, -p and the overrides.
-        self._with_effect_parameters(self._base_beam, set(self._parameter_overrides))
-
+        self._clock_s = -math.inf  # the clock at the last tick
+        self.arm: ArmSimulation | None = None
+        self.model: BeamSimulation | ArmSimulation
+        if values['arm_config']:
+            self.model = self.arm = ArmSimulation(self, values)
+        else:
+            self.model = BeamSimulation(self, values, set(self._parameter_overrides))
         # A late tick publishes several periods' samples in one burst: the stream profile's
         # history holds them (lumpbeam_ros.core.bagio.qos).
         self._pose_out = publisher(self, PoseStamped, TIP_POSE_PREDICTED)
-        subscription(self, Float64, TIP_LOAD, self._on_load)
-        subscription(self, DiagnosticArray, BEAM_PARAMS, self._on_beam_params)
         self._markers_out = publisher(self, MarkerArray, BEAM_MARKERS)
         subscription(self, PoseStamped, TIP_POSE, self._on_measured)
         # A steady timer: under use_sim_time the node must notice a stalled or jumping /clock,
@@ -168,71 +166,64 @@ class SimulatorNode(SchemaNode):
         self._markers_timer = self._make_markers_timer(values['markers_rate_hz'])
         sim = self.get_parameter('use_sim_time').value
         self.get_logger().info(
-            f'simulator ready: n_s={self._base_beam.n_segments}, '
-            f'{values["rate_hz"]:g} Hz, {"sim" if sim else "wall"} time'
+            f'simulator ready: {self.model.description}, {values["rate_hz"]:g} Hz, '
+            f'{"sim" if sim else "wall"} time'
         )
 
-    # -- public state, for tests and tools ----------------------------------------------------
+    # -- the beam's state, for tests and tools ------------------------------------------------
 
     @property
     def beam(self) -> BeamParameters:
-        """The beam being simulated now (the adopted one when adopting)."""
-        return self._adopted_beam or self._base_beam
+        """The beam being simulated now (the adopted one when adopting).
+
+        Raises:
+            AttributeError: The node simulates an arm.
+        """
+        return self._beam().beam
 
     @property
     def stream(self) -> PredictionStream | None:
-        """The running simulation; ``None`` until the clock has started."""
-        return self._stream
+        """The beam's running simulation; ``None`` until the clock has started."""
+        return self._beam().stream
 
-    # -- callbacks ----------------------------------------------------------------------------
+    def _beam(self) -> BeamSimulation:
+        if not isinstance(self.model, BeamSimulation):
+            raise AttributeError('the simulator runs an arm, not the clamped beam')
+        return self.model
+
+    # -- the one loop -------------------------------------------------------------------------
 
     def _tick(self) -> None:
-        now = self._now()
-        stream = self._stream
-        if stream is None:
-            if now > 0.0:  # zero: under use_sim_time, no /clock yet
-                self._start(now)
-            return
-        if now < stream.time - self._settings['reset_jump_back_s']:
+        now = self.now()
+        if now <= 0.0:
+            return  # under use_sim_time, no /clock yet
+        last, self._clock_s = self._clock_s, now
+        jumped_back = now < last - self._settings['reset_jump_back_s']
+        jumped_ahead = now - last > self._settings['max_catch_up_s']
+        if math.isfinite(last) and (jumped_back or jumped_ahead) and self.model.restart_at(now):
             self.get_logger().info(
-                f'clock jumped back from {stream.time:.3f} s to {now:.3f} s: '
-                f'restarting at rest with {stream.load_kg:g} kg'
+                f'clock jumped from {last:.3f} s to {now:.3f} s: '
+                f'the {self.model.name} restarts at rest'
             )
-            stream.reset(now)
-            return
-        if now - stream.time > self._settings['max_catch_up_s']:
+        try:
+            predicted = self.model.advance_to(now)
+        except LumpbeamError as exc:
             self.get_logger().warning(
-                f'clock jumped ahead by {now - stream.time:.3f} s: restarting at rest'
-            )
-            stream.reset(now)
-            return
-        self._publish(stream.advance_to(now))
-
-    def _on_load(self, msg: Float64) -> None:
-        kg = float(msg.data)
-        if not math.isfinite(kg) or kg < 0.0:
-            self.get_logger().warning(
-                f'ignoring /tip_load of {kg!r} kg: not a mass', throttle_duration_sec=WARN_PERIOD_S
+                f'{self.model.name} simulation failed: {exc}', throttle_duration_sec=WARN_PERIOD_S
             )
             return
-        if not _carries(self.beam, kg):
-            self.get_logger().warning(
-                f'ignoring /tip_load of {kg:g} kg: the beam has no static equilibrium under it '
-                f'(cannot carry it); keeping {self._load_kg:g} kg',
-                throttle_duration_sec=WARN_PERIOD_S,
-            )
-            return
-        first = not self._load_seen
-        self._load_seen = True
-        changed = kg != self._load_kg
-        self._load_kg = kg
-        if self._stream is None:
-            return  # the stream starts with it
-        if first:
-            # The first reading says what has been hanging there all along, not a change.
-            self._stream.reset(max(self._now(), self._stream.time), kg)
-        elif changed:
-            self._stream.set_load(self._now(), kg)
+        for i in range(predicted.t.size):
+            stamp_ns = seconds_to_ns(float(predicted.t[i]))
+            msg = PoseStamped()
+            msg.header.frame_id = BASE_FRAME
+            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp_ns, NS_PER_S)
+            msg.pose.position.x = float(predicted.x[i])
+            msg.pose.position.z = float(predicted.z[i])
+            q = msg.pose.orientation
+            q.x, q.y, q.z, q.w = pitch_to_quaternion(float(predicted.pitch[i]))
+            self._pose_out.publish(msg)
+            self.published += 1
+            self.model.published(stamp_ns, i)
 
     def _on_measured(self, msg: PoseStamped) -> None:
         p = msg.pose.position
@@ -243,31 +234,179 @@ class SimulatorNode(SchemaNode):
                 throttle_duration_sec=WARN_PERIOD_S,
             )
             return
-        self._measured = (msg.header.stamp.sec + msg.header.stamp.nanosec / NS_PER_S, tip)
+        self._measured = (time_ns(msg.header.stamp) / NS_PER_S, tip)
 
     def _publish_markers(self) -> None:
-        latest = self._latest
-        if latest is None or self._stream is None or latest.t[-1] == self._markers_stamp:
+        stamp = self.model.latest_stamp()
+        if stamp is None or stamp == self._markers_stamp:
             return  # nothing simulated yet, or nothing new since the last array
-        stamp = float(latest.t[-1])
         measured = None
         if self._measured is not None and abs(self._measured[0] - stamp) <= MEASURED_MAX_AGE_S:
             measured = self._measured[1]
-        scene = BeamScene(
-            self._stream.beam.segment_length_m,
+        lifetime = lifetime_for_rate(self._settings['markers_rate_hz'])
+        scene = self.model.scene(measured)
+        self._markers_out.publish(scene_cdr(scene, seconds_to_ns(stamp), lifetime))
+        self.markers_published += 1
+        self._markers_stamp = stamp
+
+    # -- parameters ---------------------------------------------------------------------------
+
+    def _on_change(self, changes: Mapping[str, Any]) -> str | None:
+        """Applies parameter changes the schema accepted; refuses a beam file that fails."""
+        if not hasattr(self, 'model'):
+            return None  # still in __init__: the model is built with them
+        problem = self.model.on_change(changes)
+        if problem is not None:
+            return problem
+        self._settings.update(changes)
+        if 'tick_rate_hz' in changes:
+            self.destroy_timer(self._timer)
+            self._timer = self._make_timer(changes['tick_rate_hz'])
+        if 'markers_rate_hz' in changes:
+            if self._markers_timer is not None:
+                self.destroy_timer(self._markers_timer)
+            self._markers_timer = self._make_markers_timer(changes['markers_rate_hz'])
+        return None
+
+    def _make_timer(self, tick_rate_hz: float) -> Any:
+        return self.create_timer(1.0 / tick_rate_hz, self._tick, clock=self._steady)
+
+    def _make_markers_timer(self, rate_hz: float) -> Any:
+        if rate_hz <= 0.0:
+            return None
+        return self.create_timer(1.0 / rate_hz, self._publish_markers, clock=self._steady)
+
+    def now(self) -> float:
+        """The node's clock, s (wall time, or ``/clock`` under ``use_sim_time``)."""
+        return float(self.get_clock().now().nanoseconds / NS_PER_S)
+
+    def warn(self, text: str) -> None:
+        """A warning, throttled."""
+        self.get_logger().warning(text, throttle_duration_sec=WARN_PERIOD_S)
+
+
+class Predicted(NamedTuple):
+    """The tip a model predicts at each new sample (beam_base; s, m, m, rad)."""
+
+    t: np.ndarray
+    x: np.ndarray
+    z: np.ndarray
+    pitch: np.ndarray
+
+
+_NOTHING = Predicted(*(np.empty(0),) * 4)
+
+
+class BeamSimulation:
+    """The clamped beam behind the simulator node: ``/tip_load`` and ``/beam_params`` in.
+
+    Args:
+        node: The node (its clock, logger, endpoints, parameters).
+        values: Its parameter values.
+        given: The parameters set by ``--params-file``, ``-p`` or the overrides.
+
+    Raises:
+        ConfigError: The beam or camera file is missing or malformed.
+    """
+
+    name = 'beam'
+
+    def __init__(self, node: SimulatorNode, values: Mapping[str, Any], given: set[str]):
+        self.node = node
+        self.values = values
+        self._base_beam = load_beam(values['beam_config'])
+        self.stream: PredictionStream | None = None
+        self._load_kg = float(values['initial_load_kg'])
+        self._load_seen = False
+        self._adopted: tuple[float, float] | None = None
+        self._adopted_beam: BeamParameters | None = None
+        self._board = load_board(values['camera_config'])
+        self._latest: TipTrajectory | None = None  # the last samples published
+        self._with_effect_parameters(given)
+        subscription(node, Float64, TIP_LOAD, self._on_load)
+        subscription(node, DiagnosticArray, BEAM_PARAMS, self._on_beam_params)
+
+    @property
+    def description(self) -> str:
+        """What the node simulates, for its ready line."""
+        return f'n_s={self._base_beam.n_segments}'
+
+    @property
+    def beam(self) -> BeamParameters:
+        """The beam being simulated now (the adopted one when adopting)."""
+        return self._adopted_beam or self._base_beam
+
+    # -- the model's side of the loop ---------------------------------------------------------
+
+    def advance_to(self, now: float) -> Predicted:
+        """The samples due up to ``now``; the first call starts the simulation at rest."""
+        if self.stream is None:
+            self.stream = PredictionStream(self.beam, self._load_kg, now, self.values['rate_hz'])
+            self.node.get_logger().info(
+                f'simulation started at {now:.3f} s with {self._load_kg:g} kg'
+            )
+            return _NOTHING
+        samples = self.stream.advance_to(now)
+        if len(samples):
+            self._latest = samples
+        return Predicted(samples.t, samples.x, samples.z, samples.pitch)
+
+    def restart_at(self, now: float) -> bool:
+        """Restarts at rest under the current load (False: nothing was running)."""
+        if self.stream is None:
+            return False
+        self.stream.reset(now)
+        return True
+
+    def published(self, stamp_ns: int, index: int) -> None:
+        """Nothing besides the pose is published for a sample of the beam."""
+
+    def latest_stamp(self) -> float | None:
+        """The stamp of the last sample published (``None``: none yet)."""
+        if self._latest is None or self.stream is None:
+            return None
+        return float(self._latest.t[-1])
+
+    def scene(self, measured: TipPoint | None) -> BeamScene:
+        """The beam's last published sample, drawn."""
+        latest = self._latest
+        assert latest is not None and self.stream is not None
+        return BeamScene(
+            self.stream.beam.segment_length_m,
             phi=None if latest.q is None else latest.q[-1],
             measured=measured,
             predicted=TipPoint(float(latest.x[-1]), float(latest.z[-1])),
             load_kg=float(latest.load_kg[-1]),
             board=self._board,
         )
-        lifetime = lifetime_for_rate(self._settings['markers_rate_hz'])
-        self._markers_out.publish(scene_cdr(scene, seconds_to_ns(stamp), lifetime))
-        self.markers_published += 1
-        self._markers_stamp = stamp
+
+    # -- its inputs ---------------------------------------------------------------------------
+
+    def _on_load(self, msg: Float64) -> None:
+        kg = float(msg.data)
+        if not math.isfinite(kg) or kg < 0.0:
+            self.node.warn(f'ignoring /tip_load of {kg!r} kg: not a mass')
+            return
+        if not _carries(self.beam, kg):
+            self.node.warn(
+                f'ignoring /tip_load of {kg:g} kg: the beam has no static equilibrium under it '
+                f'(cannot carry it); keeping {self._load_kg:g} kg'
+            )
+            return
+        first = not self._load_seen
+        self._load_seen = True
+        changed = kg != self._load_kg
+        self._load_kg = kg
+        if self.stream is None:
+            return  # the stream starts with it
+        if first:
+            # The first reading says what has been hanging there all along, not a change.
+            self.stream.reset(max(self.node.now(), self.stream.time), kg)
+        elif changed:
+            self.stream.set_load(self.node.now(), kg)
 
     def _on_beam_params(self, msg: DiagnosticArray) -> None:
-        if not self._settings['adopt_identified']:
+        if not self.values['adopt_identified']:
             return
         for status in msg.status:
             if status.name != IDENTIFIER_STATUS or _level(status) != OK_LEVEL:
@@ -277,56 +416,44 @@ class SimulatorNode(SchemaNode):
                 k_total = float(values['stiffness_total_nm_per_rad'])
                 zeta = float(values['damping_ratio'])
             except (KeyError, ValueError) as exc:
-                self.get_logger().warning(
-                    f'ignoring /beam_params: bad or missing {exc}',
-                    throttle_duration_sec=WARN_PERIOD_S,
-                )
+                self.node.warn(f'ignoring /beam_params: bad or missing {exc}')
                 return
             if (k_total, zeta) == self._adopted:
                 return
             try:
                 beam = adopt_identified(self._base_beam, k_total, zeta)
             except LumpbeamError as exc:
-                self.get_logger().warning(
-                    f'ignoring /beam_params: {exc}', throttle_duration_sec=WARN_PERIOD_S
-                )
+                self.node.warn(f'ignoring /beam_params: {exc}')
                 return
             self._adopted, self._adopted_beam = (k_total, zeta), beam
-            if self._stream is not None:
-                self._stream.set_beam(beam)
-            self.get_logger().info(
+            if self.stream is not None:
+                self.stream.set_beam(beam)
+            self.node.get_logger().info(
                 f'adopted k_tE={k_total:.1f} N m/rad, zeta={zeta:.5f} (c_tE={beam.c_total:.4f})'
             )
 
-    def _with_effect_parameters(self, beam: BeamParameters, given: set[str]) -> BeamParameters:
+    # -- parameters ---------------------------------------------------------------------------
+
+    def _with_effect_parameters(self, given: set[str]) -> None:
         """The beam with the effect parameters given at start; the others take its values.
 
         Args:
-            beam: The beam file's beam.
             given: Parameter names set by ``--params-file``, ``-p`` or the overrides.
-
-        Returns:
-            The beam the node runs with.
         """
-        effects = beam.effects
+        effects = self._base_beam.effects
         from_file = []
         for effect in EFFECT_PARAMETERS:
             name = effect_parameter_name(effect)
             if name in given:
-                effects = effects.with_effect(effect, self._settings[name])
+                effects = effects.with_effect(effect, self.values[name])
             else:
                 from_file.append(Parameter(name, value=float(effects.value(effect))))
-        beam = replace(beam, effects=effects)
-        self._base_beam = beam
+        self._base_beam = replace(self._base_beam, effects=effects)
         # So that `ros2 param get` shows the effect the beam runs with.
-        self.set_parameters(from_file)
-        return beam
+        self.node.set_parameters(from_file)
 
-    def _on_change(self, changes: Mapping[str, Any]) -> str | None:
-        """Applies parameter changes the schema accepted; refuses a beam file that fails."""
-        if self.arm is not None:
-            return 'the arm mode takes its parameters at start only'
-        new_beam = None
+    def on_change(self, changes: Mapping[str, Any]) -> str | None:
+        """Applies parameter changes to the beam, or says why not (the beam unchanged)."""
         effects = {
             effect: float(changes[effect_parameter_name(effect)])
             for effect in EFFECT_PARAMETERS
@@ -336,6 +463,7 @@ class SimulatorNode(SchemaNode):
             problem = self._apply_effects(effects)
             if problem is not None:
                 return problem
+        new_beam = None
         try:
             if 'beam_config' in changes:
                 new_beam = load_beam(changes['beam_config'])
@@ -347,44 +475,32 @@ class SimulatorNode(SchemaNode):
         self._apply(changes, new_beam)
         return None
 
-    # -- helpers ------------------------------------------------------------------------------
-
     def _apply_effects(self, values: Mapping[str, float]) -> str | None:
         """Switches effects on the running beam, keeping its motion; or says why not."""
-        if not hasattr(self, '_markers_stamp'):
-            return None  # still in __init__: the beam is built with them
         effects = before = self._base_beam.effects
         for effect, value in values.items():
             effects = effects.with_effect(effect, value)
         self._base_beam = replace(self._base_beam, effects=effects)
         if self._adopted_beam is not None:
             self._adopted_beam = replace(self._adopted_beam, effects=effects)
-        if self._stream is not None:
+        if self.stream is not None:
             try:
-                self._stream.set_beam(self.beam)
+                self.stream.set_beam(self.beam)
             except ValueError as exc:
                 return str(exc)
         shown = ', '.join(f'{k}={v:g}' for k, v in values.items() if v != before.value(k))
         if shown:
-            self.get_logger().info(f'effects set: {shown}')
+            self.node.get_logger().info(f'effects set: {shown}')
         return None
 
     def _apply(self, changes: Mapping[str, Any], new_beam: BeamParameters | None) -> None:
-        self._settings.update(changes)
-        if 'tick_rate_hz' in changes:
-            self.destroy_timer(self._timer)
-            self._timer = self._make_timer(changes['tick_rate_hz'])
-        if 'markers_rate_hz' in changes:
-            if self._markers_timer is not None:
-                self.destroy_timer(self._markers_timer)
-            self._markers_timer = self._make_markers_timer(changes['markers_rate_hz'])
         if 'adopt_identified' in changes and not changes['adopt_identified']:
             self._adopted, self._adopted_beam = None, None
             new_beam = new_beam or self._base_beam
         if new_beam is not None:
             self._base_beam = new_beam
             self._adopted, self._adopted_beam = None, None
-        stream = self._stream
+        stream = self.stream
         if stream is None:
             return
         if 'rate_hz' in changes:
@@ -393,45 +509,15 @@ class SimulatorNode(SchemaNode):
             if new_beam.n_segments == stream.beam.n_segments:
                 stream.set_beam(new_beam)
             else:
-                self._stream = None  # restarts at rest on the next tick with the new chain
+                self.stream = None  # restarts at rest on the next tick with the new chain
         if not self._load_seen and 'initial_load_kg' in changes:
             self._load_kg = float(changes['initial_load_kg'])
-            if self._stream is not None:
-                self._stream.reset(max(self._now(), self._stream.time), self._load_kg)
-
-    def _start(self, now: float) -> None:
-        self._stream = PredictionStream(self.beam, self._load_kg, now, self._settings['rate_hz'])
-        self.get_logger().info(f'simulation started at {now:.3f} s with {self._load_kg:g} kg')
-
-    def _make_timer(self, tick_rate_hz: float) -> Any:
-        return self.create_timer(1.0 / tick_rate_hz, self._tick, clock=self._steady)
-
-    def _make_markers_timer(self, rate_hz: float) -> Any:
-        if rate_hz <= 0.0:
-            return None
-        return self.create_timer(1.0 / rate_hz, self._publish_markers, clock=self._steady)
-
-    def _now(self) -> float:
-        return self.get_clock().now().nanoseconds / NS_PER_S
-
-    def _publish(self, samples: TipTrajectory) -> None:
-        if len(samples):
-            self._latest = samples
-        for i in range(len(samples)):
-            msg = PoseStamped()
-            msg.header.frame_id = BASE_FRAME
-            sec, nanosec = divmod(seconds_to_ns(float(samples.t[i])), NS_PER_S)
-            msg.header.stamp.sec, msg.header.stamp.nanosec = sec, nanosec
-            msg.pose.position.x = float(samples.x[i])
-            msg.pose.position.z = float(samples.z[i])
-            q = msg.pose.orientation
-            q.x, q.y, q.z, q.w = pitch_to_quaternion(float(samples.pitch[i]))
-            self._pose_out.publish(msg)
-            self.published += 1
+            if self.stream is not None:
+                self.stream.reset(max(self.node.now(), self.stream.time), self._load_kg)
 
 
-class ArmMode:
-    """The simulator node's arm mode: commands in, the arm's prediction out.
+class ArmSimulation:
+    """The arm behind the simulator node: JointTrajectory commands in, ``/joint_states`` out.
 
     Args:
         node: The node (its clock, logger, endpoints).
@@ -442,10 +528,13 @@ class ArmMode:
         accepted: Commands followed.
         refused: Commands refused.
         last_refusal: Why the last one was refused.
+        joint_states_published: Messages published on ``/joint_states``.
 
     Raises:
-        ConfigError: The arm file is missing or malformed.
+        ConfigError: The arm or camera file is missing or malformed.
     """
+
+    name = 'arm'
 
     def __init__(self, node: SimulatorNode, values: Mapping[str, Any]):
         self.node = node
@@ -461,35 +550,67 @@ class ArmMode:
         self.joint_states_published = 0
         self._lengths = self.model.chain.segment_lengths
         self._link_starts = tuple(int(k) for k in self.model.link_starts)
+        # The beam rig's board hangs at a beam's tip: an arm draws one only when given.
         self._board = load_board(values['camera_config']) if values['camera_config'] else None
         self._latest: ArmMotion | None = None
-        self._measured: tuple[float, TipPoint] | None = None
-        self._markers_stamp = -math.inf
-        self._time = -math.inf  # the clock at the last tick
-        self._pose_out = publisher(node, PoseStamped, TIP_POSE_PREDICTED)
+        self._samples: ArmMotion | None = None  # the samples being published
         self._joints_out = publisher(node, JointState, JOINT_STATES)
-        self._markers_out = publisher(node, MarkerArray, BEAM_MARKERS)
-        topic = values['arm_commands']
-        subscription(node, JointTrajectoryMsg, topic, self._on_command)
-        subscription(node, PoseStamped, TIP_POSE, self._on_measured)
-        steady = Clock(clock_type=ClockType.STEADY_TIME)
-        node.create_timer(1.0 / values['tick_rate_hz'], self._tick, clock=steady)
-        if values['markers_rate_hz'] > 0.0:
-            period = 1.0 / values['markers_rate_hz']
-            node.create_timer(period, self._publish_markers, clock=steady)
-        node.get_logger().info(
-            f'simulator ready: {config.n_joints}-link arm ({self.model.chain.n} segments) from '
-            f'{values["arm_config"]}, following {topic}, {values["rate_hz"]:g} Hz'
+        subscription(node, JointTrajectoryMsg, values['arm_commands'], self._on_command)
+        self.description = (
+            f'{config.n_joints}-link arm ({self.model.chain.n} segments) from '
+            f'{values["arm_config"]}, following {values["arm_commands"]}'
         )
 
-    def _now(self) -> float:
-        return float(self.node.get_clock().now().nanoseconds / NS_PER_S)
+    # -- the model's side of the loop ---------------------------------------------------------
 
-    def _warn(self, text: str) -> None:
-        self.node.get_logger().warning(text, throttle_duration_sec=WARN_PERIOD_S)
+    def advance_to(self, now: float) -> Predicted:
+        """The samples due up to ``now`` (none before the first command)."""
+        samples = self.stream.advance_to(now)
+        self._samples = samples
+        if samples.t.size:
+            self._latest = samples
+        return Predicted(samples.t, samples.tip_x, samples.tip_z, samples.tip_pitch)
+
+    def restart_at(self, now: float) -> bool:
+        """Restarts at rest at the held angles (False: no command followed yet)."""
+        if not self.stream.started:
+            return False
+        self.stream.restart_at(now)
+        return True
+
+    def published(self, stamp_ns: int, index: int) -> None:
+        """Publishes the commanded angles of the sample just published."""
+        assert self._samples is not None
+        self._joints_out.publish(
+            serialize(joint_state(stamp_ns, self.stream.joint_names, self._samples.q[index]))
+        )
+        self.joint_states_published += 1
+
+    def latest_stamp(self) -> float | None:
+        """The stamp of the last sample published (``None``: none yet)."""
+        return None if self._latest is None else float(self._latest.t[-1])
+
+    def scene(self, measured: TipPoint | None) -> BeamScene:
+        """The arm's last published sample, drawn link by link."""
+        latest = self._latest
+        assert latest is not None
+        return BeamScene(
+            self._lengths,
+            phi=latest.phi[-1],
+            measured=measured,
+            predicted=TipPoint(float(latest.tip_x[-1]), float(latest.tip_z[-1])),
+            board=self._board,
+            link_starts=self._link_starts,
+        )
+
+    def on_change(self, changes: Mapping[str, Any]) -> str | None:
+        """The arm takes its parameters at start only."""
+        return 'the arm mode takes its parameters at start only'
+
+    # -- its input ----------------------------------------------------------------------------
 
     def _on_command(self, msg: JointTrajectoryMsg) -> None:
-        now = self._now()
+        now = self.node.now()
         try:
             command = command_from_msg(msg)
             start = max(command.stamp_s, now) if command.stamp_s > 0.0 else now
@@ -497,7 +618,7 @@ class ArmMode:
         except LumpbeamError as exc:
             self.refused += 1
             self.last_refusal = str(exc)
-            self._warn(
+            self.node.warn(
                 f'{self.values["arm_commands"]}: command refused ({exc}); '
                 f'{self.refused} refused so far'
             )
@@ -507,73 +628,6 @@ class ArmMode:
             f'following a command of {command.time_s.size} points from {start:.3f} s '
             f'({command.time_s[-1]:.3f} s long)'
         )
-
-    def _on_measured(self, msg: PoseStamped) -> None:
-        p = msg.pose.position
-        tip = TipPoint(float(p.x), float(p.z))
-        if msg.header.frame_id != BASE_FRAME or not tip.is_finite():
-            self._warn(f'ignoring /tip_pose in frame {msg.header.frame_id!r} at {tip}')
-            return
-        self._measured = (time_ns(msg.header.stamp) / NS_PER_S, tip)
-
-    def _tick(self) -> None:
-        now = self._now()
-        if now <= 0.0:
-            return  # under use_sim_time, no /clock yet
-        jumped_back = now < self._time - self.values['reset_jump_back_s']
-        jumped_ahead = now - self._time > self.values['max_catch_up_s']
-        if self.stream.started and self._time > 0.0 and (jumped_back or jumped_ahead):
-            self.node.get_logger().info(
-                f'clock jumped from {self._time:.3f} s to {now:.3f} s: the arm restarts at rest'
-            )
-            self.stream.restart_at(now)
-        self._time = now
-        try:
-            samples = self.stream.advance_to(now)
-        except LumpbeamError as exc:
-            self._warn(f'arm simulation failed: {exc}')
-            return
-        if samples.t.size:
-            self._latest = samples
-        for i in range(samples.t.size):
-            self._publish(samples, i)
-
-    def _publish(self, samples: ArmMotion, i: int) -> None:
-        stamp_ns = seconds_to_ns(float(samples.t[i]))
-        msg = PoseStamped()
-        msg.header.frame_id = BASE_FRAME
-        msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp_ns, NS_PER_S)
-        msg.pose.position.x = float(samples.tip_x[i])
-        msg.pose.position.z = float(samples.tip_z[i])
-        q = msg.pose.orientation
-        q.x, q.y, q.z, q.w = pitch_to_quaternion(float(samples.tip_pitch[i]))
-        self._pose_out.publish(msg)
-        self.node.published += 1
-        self._joints_out.publish(
-            serialize(joint_state(stamp_ns, self.stream.joint_names, samples.q[i]))
-        )
-        self.joint_states_published += 1
-
-    def _publish_markers(self) -> None:
-        latest = self._latest
-        if latest is None or latest.t[-1] == self._markers_stamp:
-            return
-        stamp = float(latest.t[-1])
-        measured = None
-        if self._measured is not None and abs(self._measured[0] - stamp) <= MEASURED_MAX_AGE_S:
-            measured = self._measured[1]
-        scene = BeamScene(
-            self._lengths,
-            phi=latest.phi[-1],
-            measured=measured,
-            predicted=TipPoint(float(latest.tip_x[-1]), float(latest.tip_z[-1])),
-            board=self._board,
-            link_starts=self._link_starts,
-        )
-        lifetime = lifetime_for_rate(self.values['markers_rate_hz'])
-        self._markers_out.publish(scene_cdr(scene, seconds_to_ns(stamp), lifetime))
-        self.node.markers_published += 1
-        self._markers_stamp = stamp
 
 
 def _carries(beam: BeamParameters, load_kg: float) -> bool:

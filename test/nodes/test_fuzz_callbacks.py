@@ -175,14 +175,14 @@ def test_simulator_callbacks(ros_graph, clean_rows):
         for row in poses[::20]:
             node._on_measured(_pose(row))
         for kg in (math.nan, math.inf, -1.0, 1e308, 0.2, 0.0, float(rng.uniform(0, 1))):
-            node._on_load(Float64(data=kg))
-            assert math.isfinite(node._load_kg) and node._load_kg >= 0.0
+            node.model._on_load(Float64(data=kg))
+            assert math.isfinite(node.model._load_kg) and node.model._load_kg >= 0.0
         status = DiagnosticStatus(level=bytes([OK]), name=IDENTIFIER_STATUS)
         for value in ('nan', 'inf', '-5', '1e308', 'x', ''):
             status.values = [
                 KeyValue(key='stiffness_total_nm_per_rad', value=value),
                 KeyValue(key='damping_ratio', value=value),
             ]
-            node._on_beam_params(DiagnosticArray(status=[status]))
+            node.model._on_beam_params(DiagnosticArray(status=[status]))
     finally:
         node.destroy_node()
