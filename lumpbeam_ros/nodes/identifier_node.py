@@ -45,8 +45,9 @@ from lumpbeam_ros.base.interface import (
     TIP_POSE,
 )
 from lumpbeam_ros.core.bagio.convert import joint_state_values, pose_values
+from lumpbeam_ros.core.ident.assembly import FitState
 from lumpbeam_ros.core.ident.identification import Identification, Status
-from lumpbeam_ros.core.ident.identify import FitState, identify_from
+from lumpbeam_ros.core.ident.identify import identify_from
 from lumpbeam_ros.core.ident.ring_down import RestTracker, along_swing, ring_down_release
 from lumpbeam_ros.core.ident.settings import (
     IDENTIFIER_SETTINGS,

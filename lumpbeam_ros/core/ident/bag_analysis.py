@@ -26,8 +26,9 @@ from lumpbeam_ros.base.progress import Progress
 from lumpbeam_ros.core.bagio import BagReader, read_load_events, read_tip_poses
 from lumpbeam_ros.core.bagio.series import JointSeries, read_joint_states
 from lumpbeam_ros.core.bagio.tipseries import LoadSeries
+from lumpbeam_ros.core.ident.assembly import FitState
 from lumpbeam_ros.core.ident.identification import Identification, IdentifiedMode
-from lumpbeam_ros.core.ident.identify import FitState, identify_from
+from lumpbeam_ros.core.ident.identify import identify_from
 from lumpbeam_ros.core.ident.ring_down import (
     JointRest,
     along_swing,

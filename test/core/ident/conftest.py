@@ -16,7 +16,7 @@ from functools import lru_cache
 import numpy as np
 import pytest
 
-from lumpbeam_ros.core.ident.samples import PoseWindow
+from lumpbeam_ros.core.ident.samples import PoseWindow, clean_loads, clean_window
 from lumpbeam_ros.core.ident.window import SlidingWindow
 from lumpbeam_ros.core.model import rules
 from lumpbeam_ros.core.model.chain import LumpedChain
@@ -171,3 +171,9 @@ def replay_window(
             pending = None
         window.push(float(t), float(z), float(pitch))
     return window.snapshot()
+
+
+def pose_window(trajectory: TipTrajectory, with_loads: bool) -> PoseWindow:
+    """A simulated record as the identifier takes it, with its ``/tip_load`` readings or not."""
+    loads = clean_loads(trajectory.t, trajectory.load_kg) if with_loads else None
+    return clean_window(trajectory.t, trajectory.z, trajectory.pitch, loads)

@@ -169,6 +169,6 @@ def test_least_squares_falls_back_when_the_warm_start_is_not_near():
     with np.errstate(over='ignore'):  # the trial's exponential; the solver refuses it
         assert optimize.gauss_newton(residuals, jacobian, far, t.size) is None
         solution = optimize.least_squares(residuals, jacobian, far, warm=True, n_data=t.size)
+        cold = optimize.least_squares(residuals, jacobian, far, warm=False, n_data=t.size)
     np.testing.assert_allclose(solution.x, [2.0, 1.3], rtol=1e-6)
-    cold = optimize.least_squares(residuals, jacobian, far, warm=False, n_data=t.size)
     np.testing.assert_array_equal(cold.x, solution.x)
