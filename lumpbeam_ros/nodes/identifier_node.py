@@ -29,7 +29,6 @@ import sys
 from collections.abc import Sequence
 from typing import Unpack
 
-import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import JointState
@@ -46,9 +45,9 @@ from lumpbeam_ros.base.interface import (
 )
 from lumpbeam_ros.core.bagio.convert import joint_state_values, pose_values
 from lumpbeam_ros.core.ident.assembly import FitState
-from lumpbeam_ros.core.ident.identification import Identification, Status
-from lumpbeam_ros.core.ident.identify import identify_from
-from lumpbeam_ros.core.ident.ring_down import RestTracker, along_swing, ring_down_release
+from lumpbeam_ros.core.ident.identification import Identification
+from lumpbeam_ros.core.ident.identify import identify_live
+from lumpbeam_ros.core.ident.ring_down import RestTracker
 from lumpbeam_ros.core.ident.settings import (
     IDENTIFIER_SETTINGS,
     IdentifierConfig,
@@ -147,31 +146,9 @@ class IdentifierNode(SchemaNode):
 
     def _on_timer(self) -> None:
         self.updates += 1
-        snapshot = self.window.snapshot()
-        release = None
-        if self.joints.current is not None:
-            # The rest must hold for as many poses as an identification needs.
-            step = float(np.median(np.diff(snapshot.t))) if len(snapshot) > 1 else math.inf
-            rest = self.joints.ring_down(self.config.min_samples * step)
-            if rest is None:
-                self._state = None
-                tolerance = self.config.rest_tolerance_rad
-                message = (
-                    'no ring-down yet: the joints have not stopped after a move (at rest: '
-                    f'within ring_down.rest_tolerance_rad = {tolerance:g} rad)'
-                )
-                self._output.publish(self.diagnostics(Identification(Status.ERROR, message)))
-                return
-            snapshot = along_swing(snapshot, rest.start_s, rest.end_s)
-            release = ring_down_release(rest)
-        try:
-            result, self._state = identify_from(
-                snapshot, self.beam, self.config, previous=self._state, release=release
-            )
-        except (LumpbeamError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-            # Numerically hopeless windows (e.g. a constant signal) give no estimate.
-            self._state = None
-            result = Identification(Status.ERROR, f'identification failed: {exc}')
+        result, self._state = identify_live(
+            self.window.snapshot(), self.beam, self.config, self._state, self.joints
+        )
         self._output.publish(self.diagnostics(result))
 
     def diagnostics(self, result: Identification) -> DiagnosticArray:

@@ -18,8 +18,6 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from lumpbeam_ros.base.errors import BagError, LumpbeamError
 from lumpbeam_ros.base.interface import BASE_FRAME, JOINT_STATES, TIP_LOAD, TIP_POSE
 from lumpbeam_ros.base.progress import Progress
@@ -31,10 +29,10 @@ from lumpbeam_ros.core.ident.identification import Identification, IdentifiedMod
 from lumpbeam_ros.core.ident.identify import identify_from
 from lumpbeam_ros.core.ident.ring_down import (
     JointRest,
-    along_swing,
     last_ring_down,
+    min_rest_s,
     rest_stretches,
-    ring_down_release,
+    swing_after,
 )
 from lumpbeam_ros.core.ident.samples import PoseWindow, clean_loads, clean_window
 from lumpbeam_ros.core.ident.segments import keep_release_segment
@@ -217,13 +215,12 @@ def identify_ring_down(
         LumpbeamError: The joints never move, or rest for fewer than ``quality.min_samples``
             pose periods after their last move.
     """
-    step = float(np.median(np.diff(window.t))) if len(window) > 1 else 0.0
     rest = last_ring_down(
         rest_stretches(joints.t, joints.angles, config.rest_tolerance_rad),
-        config.min_samples * step,
+        min_rest_s(window, config.min_samples),
     )
-    swing = along_swing(window, rest.start_s, rest.end_s)
-    result, fit = identify_from(swing, beam, config, strict=True, release=ring_down_release(rest))
+    swing, release = swing_after(window, rest)
+    result, fit = identify_from(swing, beam, config, strict=True, release=release)
     return result, fit, rest, swing
 
 

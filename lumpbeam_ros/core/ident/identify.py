@@ -39,6 +39,12 @@ from lumpbeam_ros.core.ident.mode_estimate import TWO_PI, ModeEstimate
 from lumpbeam_ros.core.ident.modes import choose_modes
 from lumpbeam_ros.core.ident.pencil import MatrixPencil
 from lumpbeam_ros.core.ident.release import Release, detect_release
+from lumpbeam_ros.core.ident.ring_down import (
+    RestTracker,
+    min_rest_s,
+    no_ring_down_message,
+    swing_after,
+)
 from lumpbeam_ros.core.ident.samples import PoseWindow
 from lumpbeam_ros.core.ident.settings import IdentifierConfig
 from lumpbeam_ros.core.ident.sinusoid import (
@@ -119,6 +125,44 @@ def identify_from(
     """
     with single_threaded_blas():
         return _identify(window, beam, config or IdentifierConfig(), strict, previous, release)
+
+
+def identify_live(
+    window: PoseWindow,
+    beam: BeamParameters,
+    config: IdentifierConfig,
+    previous: FitState | None,
+    joints: RestTracker,
+) -> tuple[Identification, FitState | None]:
+    """One update of the live identifier: never raises, an ERROR says why not.
+
+    A beam's window is identified whole; once ``/joint_states`` have been seen (an arm), only
+    the free vibration after the joints' last stop, along the tip's swing, and nothing until
+    the joints have rested for ``quality.min_samples`` poses.
+
+    Args:
+        window: The sliding window's snapshot.
+        beam: As :func:`identify`.
+        config: Settings.
+        previous: The last update's fit, to start from (``None``: a full identification).
+        joints: The joints' rests, as received live.
+
+    Returns:
+        The identification and the fit the next update starts from.
+    """
+    release = None
+    if joints.current is not None:
+        rest = joints.ring_down(min_rest_s(window, config.min_samples))
+        if rest is None:
+            return Identification(
+                Status.ERROR, no_ring_down_message(config.rest_tolerance_rad)
+            ), None
+        window, release = swing_after(window, rest)
+    try:
+        return identify_from(window, beam, config, previous=previous, release=release)
+    except (LumpbeamError, ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
+        # Numerically hopeless windows (e.g. a constant signal) give no estimate.
+        return Identification(Status.ERROR, f'identification failed: {exc}'), None
 
 
 def _identify(

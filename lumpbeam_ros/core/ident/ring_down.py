@@ -172,6 +172,33 @@ def last_ring_down(stretches: list[JointRest], min_duration_s: float) -> JointRe
     return long_enough[-1]
 
 
+def min_rest_s(window: PoseWindow, min_samples: int) -> float:
+    """How long the joints must rest: as many pose periods as an identification needs.
+
+    Args:
+        window: The poses (their median period).
+        min_samples: ``quality.min_samples``.
+
+    Returns:
+        The least duration of a ring-down, s (0 with fewer than two poses).
+    """
+    step = float(np.median(np.diff(window.t))) if len(window) > 1 else 0.0
+    return min_samples * step
+
+
+def no_ring_down_message(tolerance_rad: float) -> str:
+    """What the live identifier says while an arm's joints have not stopped after a move."""
+    return (
+        'no ring-down yet: the joints have not stopped after a move (at rest: '
+        f'within ring_down.rest_tolerance_rad = {tolerance_rad:g} rad)'
+    )
+
+
+def swing_after(window: PoseWindow, rest: JointRest) -> tuple[PoseWindow, Release]:
+    """The tip along its swing over a rest, and the release its free vibration starts at."""
+    return along_swing(window, rest.start_s, rest.end_s), ring_down_release(rest)
+
+
 def ring_down_release(rest: JointRest) -> Release:
     """The start of the free vibration where the joints stopped, as the identifier takes it.
 

@@ -6,7 +6,8 @@ import pytest
 
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.core.ident.identification import Status
-from lumpbeam_ros.core.ident.identify import identify, identify_from
+from lumpbeam_ros.core.ident.identify import identify, identify_from, identify_live
+from lumpbeam_ros.core.ident.ring_down import RestTracker
 from lumpbeam_ros.core.ident.samples import clean_loads, clean_window
 from lumpbeam_ros.core.ident.settings import IdentifierConfig
 from lumpbeam_ros.core.ident.window import SlidingWindow
@@ -257,3 +258,23 @@ def test_a_bag_replayed_twice_gives_the_second_pass(drop_case):
     result = identify(window.snapshot(), BEAM)
     assert result.status == Status.OK, result.message
     assert abs(result.release.time_s.value - 2.0) * 180.0 < 0.2
+
+
+def test_a_live_update_waits_for_an_arms_ring_down_and_never_raises(drop_case):
+    trajectory, _ = drop_case()
+    window = pose_window(trajectory, True)
+    config = IdentifierConfig()
+    joints = RestTracker(config.rest_tolerance_rad)
+    # A beam (no joint states): the whole window.
+    beam, state = identify_live(window, BEAM, config, None, joints)
+    assert beam.status == Status.OK and state is not None
+    # An arm that moved and has not rested long enough: an ERROR that says so.
+    joints.push(0.0, np.array([0.0]))
+    joints.push(window.end_s - 0.01, np.array([0.5]))
+    waiting, state = identify_live(window, BEAM, config, None, joints)
+    assert waiting.status == Status.ERROR and waiting.message.startswith('no ring-down yet')
+    assert state is None
+    # A window nothing can be fitted in: an ERROR, not an exception.
+    flat = clean_window(trajectory.t, np.zeros_like(trajectory.z), trajectory.pitch)
+    hopeless, state = identify_live(flat, BEAM, config, None, RestTracker(0.01))
+    assert hopeless.status == Status.ERROR and state is None

@@ -85,3 +85,13 @@ def test_the_swing_is_taken_across_the_link():
     # Without a measured x, z is kept.
     plain = clean_window(record.t, record.z)
     assert along_swing(plain, MOVE_S, 6.0) is plain
+
+
+def test_the_rest_needed_is_min_samples_pose_periods():
+    from lumpbeam_ros.core.ident.ring_down import min_rest_s
+    from lumpbeam_ros.core.ident.samples import clean_window
+
+    t = np.arange(0.0, 1.0, 0.01)
+    window = clean_window(t, np.zeros_like(t), np.zeros_like(t))
+    assert min_rest_s(window, 50) == pytest.approx(0.5)
+    assert min_rest_s(clean_window(t[:1], t[:1], t[:1]), 50) == 0.0
