@@ -167,7 +167,7 @@ def json_keys() -> dict[str, set[str]]:
         'compare': dict_keys('core/compare/comparison.py', 'Comparison.as_dict'),
         'track': dict_keys('apps/cli/track.py', 'run'),
         'bench': dict_keys('apps/cli/bench.py', 'run') | field_names(BenchResult),
-        'demo': dict_keys('apps/demo/steps.py', 'summarize'),
+        'demo': dict_keys('apps/demo/summary.py', 'summarize'),
         'campaign': set(ID_COLUMNS),
         'fit-links': dict_keys('core/ident/arm/link_fit.py', 'LinkEstimate.as_dict')
         | dict_keys('core/ident/arm/link_fit.py', 'LinkFit.as_json')

@@ -20,7 +20,8 @@ def run(args: argparse.Namespace) -> int:
         LumpbeamError: A bad option or a failed step (one line, see the logs it names).
     """
     from lumpbeam_ros.apps.demo.graph import DOMAIN_IDS
-    from lumpbeam_ros.apps.demo.steps import DemoOptions, run_demo
+    from lumpbeam_ros.apps.demo.run import DemoOptions
+    from lumpbeam_ros.apps.demo.steps import run_demo
     from lumpbeam_ros.base.errors import LumpbeamError
 
     if args.domain_id is not None and args.domain_id not in DOMAIN_IDS:
@@ -32,7 +33,7 @@ def run(args: argparse.Namespace) -> int:
         raise LumpbeamError(f'--out {args.out} is a file, not a folder')
     if args.arm is not None:
         return _run_arm(args)
-    from lumpbeam_ros.apps.demo.steps import HIDDEN_EFFECT
+    from lumpbeam_ros.apps.demo.run import HIDDEN_EFFECT
     from lumpbeam_ros.core.synthetic.drop_test import parse_effect
     from lumpbeam_ros.core.synthetic.images import parse_image_size
 

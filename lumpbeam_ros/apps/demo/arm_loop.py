@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from lumpbeam_ros.apps.demo.graph import ProcessGraph, node_command, python_command, wait_for_graph
-from lumpbeam_ros.apps.demo.steps import BAGS_DIR, DemoFolders, fresh_bags_dir, run_steps
+from lumpbeam_ros.apps.demo.run import BAGS_DIR, DemoFolders, fresh_bags_dir, run_steps
 from lumpbeam_ros.apps.json_output import write_json
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.base.interface import (

@@ -105,7 +105,7 @@ def test_demo_never_deletes_a_folder_it_did_not_make(tmp_path, capsys):
 
 
 def test_summary_table_reads_back_from_json():
-    from lumpbeam_ros.apps.demo.steps import summary_lines
+    from lumpbeam_ros.apps.demo.summary import summary_lines
 
     row = {'identified': 3.0588, 'identified_std': 1e-6, 'live': None, 'truth': 3.0588}
     summary = {

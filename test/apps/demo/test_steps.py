@@ -5,6 +5,7 @@ import json
 import pytest
 
 from lumpbeam_ros.apps.cli.main import main
+from lumpbeam_ros.apps.demo import run as run_module
 from lumpbeam_ros.apps.demo import steps
 from lumpbeam_ros.core.model.parameters import load_beam_config
 from lumpbeam_ros.core.synthetic.drop_test import SynthOptions, write_drop_test_bag
@@ -20,10 +21,10 @@ def test_diagnose_step_matches_the_command(tmp_path, capsys):
         bag,
         beam,
         drop,
-        SynthOptions(duration_s=6.0, markers_rate_hz=0.0, effects=steps.HIDDEN_EFFECT),
+        SynthOptions(duration_s=6.0, markers_rate_hz=0.0, effects=run_module.HIDDEN_EFFECT),
     )
-    run = steps.DemoRun(
-        options=steps.DemoOptions(out=tmp_path / 'out'),
+    run = run_module.DemoRun(
+        options=run_module.DemoOptions(out=tmp_path / 'out'),
         beam=beam,
         drop=drop,
         echo=lambda _line: None,
