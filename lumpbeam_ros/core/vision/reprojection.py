@@ -15,8 +15,6 @@ from typing import Protocol
 
 import numpy as np
 
-from lumpbeam_ros.core.vision.partial import sorted_median
-
 
 class ProjectionModel(Protocol):
     """What :func:`fit_pose` needs of a pose model."""
@@ -141,3 +139,17 @@ def _symmetric_inverse(a: np.ndarray) -> np.ndarray:
         raise np.linalg.LinAlgError('singular matrix')
     inverse: np.ndarray = np.array([[c00, c01, c02], [c01, c11, c12], [c02, c12, c22]]) / det
     return inverse
+
+
+def sorted_median(values: np.ndarray) -> float:
+    """``np.median`` of a 1-D array by one sort: some 5 times faster for a board's corners.
+
+    Args:
+        values: Finite or infinite numbers (no NaN), at least one.
+
+    Returns:
+        The middle value, or the mean of the two middle ones.
+    """
+    ordered = np.sort(values, axis=None)
+    n = ordered.size
+    return float((ordered[(n - 1) // 2] + ordered[n // 2]) / 2.0)

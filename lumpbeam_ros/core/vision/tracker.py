@@ -48,7 +48,6 @@ from lumpbeam_ros.core.vision.partial import (
     labelling_is_unambiguous,
     reject_outliers,
     select_corners,
-    sorted_median,
 )
 from lumpbeam_ros.core.vision.pose import (
     PlaneModel,
@@ -56,7 +55,7 @@ from lumpbeam_ros.core.vision.pose import (
     solve_board_pnp,
     tip_pose_from_board_pose,
 )
-from lumpbeam_ros.core.vision.reprojection import PoseFit
+from lumpbeam_ros.core.vision.reprojection import PoseFit, sorted_median
 
 #: Image encodings :meth:`TipTracker.process` takes (those of doc/interfaces.md, 'Topics').
 ENCODINGS = ('mono8', 'bgr8', 'rgb8')

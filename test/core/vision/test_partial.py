@@ -23,7 +23,6 @@ from lumpbeam_ros.core.vision.partial import (
     reject_outliers,
     saddle_fit,
     select_corners,
-    sorted_median,
 )
 from lumpbeam_ros.core.vision.pose import PlaneModel
 from lumpbeam_ros.core.vision.session import TrackingSession
@@ -326,13 +325,6 @@ def test_grid_axes_are_numpys_gradient(pattern):
     for axis, along, n in ((1, along_x, cols), (0, along_y, rows)):
         expected = np.gradient(g, axis=axis) if n > 1 else np.zeros_like(g)
         np.testing.assert_array_equal(along, expected.reshape(-1, 2))
-
-
-@pytest.mark.parametrize('n', [1, 2, 7, 48])
-def test_sorted_median_is_numpys(n):
-    values = np.random.default_rng(n).normal(size=n)
-    values[0] = np.inf
-    assert sorted_median(values) == np.median(values)
 
 
 def test_saddle_fit_is_the_same_at_the_image_border(config, rest_pose):

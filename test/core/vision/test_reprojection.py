@@ -5,7 +5,7 @@ import pytest
 
 from lumpbeam_ros.core.vision.free_pose import FreeModel
 from lumpbeam_ros.core.vision.pose import PlaneModel
-from lumpbeam_ros.core.vision.reprojection import _symmetric_inverse, fit_pose
+from lumpbeam_ros.core.vision.reprojection import _symmetric_inverse, fit_pose, sorted_median
 
 PLANE_POSE = np.array([2.3107, -0.012, 0.004])
 FREE_POSE = np.array([2.3107, 0.004, -0.012, 0.006, 0.004, -0.008])
@@ -77,3 +77,10 @@ def test_the_cofactor_inverse_is_numpys_and_refuses_a_singular_matrix():
     np.testing.assert_allclose(_symmetric_inverse(m), np.linalg.inv(m), rtol=1e-12)
     with pytest.raises(np.linalg.LinAlgError):
         _symmetric_inverse(np.ones((3, 3)))
+
+
+@pytest.mark.parametrize('n', [1, 2, 7, 48])
+def test_sorted_median_is_numpys(n):
+    values = np.random.default_rng(n).normal(size=n)
+    values[0] = np.inf
+    assert sorted_median(values) == np.median(values)
