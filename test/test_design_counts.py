@@ -170,3 +170,54 @@ def test_a_configuration_type_against_the_rule_is_found(tool, tmp_path):
         'RunOptions',
         'Window',
     ]
+
+
+def test_the_floors_and_the_twins_are_held_at_zero(tool):
+    assert tool.imports_back_up(ROOT) == []
+    assert tool.twins(ROOT) == []
+
+
+def _floors(tmp_path):
+    package = tmp_path / 'lumpbeam_ros'
+    layout = {
+        '': "__all__ = ['base', 'core', 'nodes', 'apps']\n",
+        'base': "__all__ = ['errors']\n",
+        'core': "LAYERED = True\n__all__ = ['bagio', 'model']\n",
+        'core/bagio': "__all__ = ['reader']\n",
+        'core/model': "__all__ = ['chain']\n",
+        'nodes': "__all__ = ['node']\n",
+        'apps': "LAYERED = True\n__all__ = ['cli']\n",
+        'apps/cli': "__all__ = ['main']\n",
+    }
+    for folder, init in layout.items():
+        (package / folder).mkdir(parents=True, exist_ok=True)
+        (package / folder / '__init__.py').write_text(init)
+    return package
+
+
+def test_an_import_back_up_is_found(tool, tmp_path):
+    package = _floors(tmp_path)
+    (package / 'base' / 'errors.py').write_text('import lumpbeam_ros.core.model.chain\n')
+    (package / 'core' / 'bagio' / 'reader.py').write_text(
+        'def f():\n    from lumpbeam_ros.core.model.chain import Chain\n'
+    )
+    (package / 'core' / 'model' / 'chain.py').write_text('from lumpbeam_ros.core.bagio import x\n')
+    (package / 'nodes' / 'node.py').write_text('from lumpbeam_ros.apps.cli.main import y\n')
+    assert tool.imports_back_up(tmp_path) == [
+        'lumpbeam_ros.base.errors imports lumpbeam_ros.core.model.chain',
+        'lumpbeam_ros.core.bagio.reader imports lumpbeam_ros.core.model.chain',
+        'lumpbeam_ros.nodes.node imports lumpbeam_ros.apps.cli.main',
+    ]
+
+
+def test_a_twin_is_found(tool, tmp_path):
+    package = tmp_path / 'lumpbeam_ros' / 'nodes'
+    package.mkdir(parents=True)
+    (package / 'shaper_node.py').write_text(
+        'times = [p.time_from_start.sec for p in msg.points]\n'
+        "path = config_path('x.yaml') if path is None else Path(path)\n"
+    )
+    assert [line.split(':')[0] for line in tool.twins(tmp_path)] == [
+        'trajectory message conversions',
+        'config loaders',
+    ]

@@ -18,7 +18,7 @@ import that runs back up is caught as well.
 
 from __future__ import annotations
 
-import ast
+import importlib.util
 import json
 import os
 import re
@@ -29,20 +29,25 @@ from typing import Any
 
 import pytest
 
-import lumpbeam_ros
-import lumpbeam_ros.apps
-import lumpbeam_ros.core
-
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / 'lumpbeam_ros'
 LAB = ROOT / 'lumpbeam_lab'
 
-#: The floors, bottom first, and the packages ordered inside a floor, bottom first.
-FLOORS: tuple[str, ...] = tuple(lumpbeam_ros.__all__)
-ORDERED: dict[str, tuple[str, ...]] = {
-    'core': tuple(lumpbeam_ros.core.__all__),
-    'apps': tuple(lumpbeam_ros.apps.__all__),
-}
+
+def _design_counts():
+    spec = importlib.util.spec_from_file_location(
+        'design_counts', ROOT / 'tools' / 'design_counts.py'
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+#: The rule, declared once (``tools/design_counts.py``, which counts what breaks it).
+_TOOL = _design_counts()
+_FLOORS = _TOOL.Floors(ROOT)
+may_import = _FLOORS.may_import
+
 
 #: Top-level names of ROS 2: the client library, its middleware and every interface package.
 _ROS = re.compile(
@@ -111,7 +116,7 @@ def _refusals(module: str) -> frozenset[str]:
 def _above(module: str) -> tuple[str, ...]:
     """What a module may not import: the floors above its own, and the lab."""
     floor = module.split('.')[1]
-    above = FLOORS[FLOORS.index(floor) + 1 :]
+    above = _FLOORS.floors[_FLOORS.floors.index(floor) + 1 :]
     return (*(f'lumpbeam_ros.{name}' for name in above), 'lumpbeam_lab')
 
 
@@ -134,7 +139,9 @@ def _core_groups() -> dict[Group, list[str]]:
     groups: dict[Group, list[str]] = {}
     for module in sorted({m for key in REFUSED for m in _modules(key)}):
         groups.setdefault((_refusals(module), _above(module)), []).append(module)
-    upper = tuple(f'lumpbeam_ros.{name}' for name in FLOORS[FLOORS.index('nodes') :])
+    upper = tuple(
+        f'lumpbeam_ros.{name}' for name in _FLOORS.floors[_FLOORS.floors.index('nodes') :]
+    )
     for prefix, refused in LAB_REFUSED.items():
         groups.setdefault((refused, upper), []).extend(_lab_modules(prefix))
     return groups
@@ -237,40 +244,7 @@ def test_the_refusal_catches_what_it_refuses(refused, upper, module, blocked):
     assert blocked in report['failures'][module]
 
 
-def _imported_names(path: Path) -> set[str]:
-    """Every module a source file imports, at the top or inside functions."""
-    names = set()
-    for node in ast.walk(ast.parse(path.read_text(encoding='utf-8'))):
-        if isinstance(node, ast.Import):
-            names.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-            names.add(node.module)
-    return names
-
-
-def rank(module: str) -> tuple[int, int]:
-    """Where a module stands: its floor, and its package's place inside an ordered floor.
-
-    The lab stands above every floor; a floor without an order (base, nodes) ranks its
-    modules alike.
-    """
-    parts = module.split('.')
-    if parts[0] == 'lumpbeam_lab':
-        return (len(FLOORS), 0)
-    if len(parts) == 1:
-        return (0, 0)
-    floor = parts[1]
-    order = ORDERED.get(floor, ())
-    inside = order.index(parts[2]) if len(parts) > 2 and parts[2] in order else 0
-    return (FLOORS.index(floor), inside)
-
-
-def may_import(module: str, name: str) -> bool:
-    """Whether ``module`` may import ``name``: its own floor or one below, never above."""
-    mine, theirs = rank(module), rank(name)
-    if theirs[0] != mine[0]:
-        return theirs[0] < mine[0]
-    return theirs[1] <= mine[1]
+_imported_names = _TOOL.imported_names
 
 
 #: Optional ROS lookups on the ground floor, each behind ``except ImportError``: the share
@@ -329,8 +303,8 @@ def test_the_order_allows_down_and_refuses_up(module, name, allowed):
 def test_every_floor_and_package_is_ranked():
     # A package left out of its floor's __all__ would rank as the bottom of its floor.
     found = {p.name for p in PACKAGE.iterdir() if (p / '__init__.py').is_file()}
-    assert set(FLOORS) == found
-    for floor, order in ORDERED.items():
+    assert set(_FLOORS.floors) == found
+    for floor, order in _FLOORS.ordered.items():
         inside = {p.stem for p in (PACKAGE / floor).glob('*.py') if p.stem != '__init__'}
         inside |= {p.parent.name for p in (PACKAGE / floor).glob('*/__init__.py')}
         assert set(order) == inside, floor

@@ -20,7 +20,10 @@ Usage: ``python tools/design_counts.py [REPO]``. Prints, one line each:
 - readers of bags: places that read MCAP records or CDR themselves (or through another
   bag reader) outside the one reader (``bagio/reader.py``, on the ``mcap`` package) and the
   fast path kept beside it with its agreement test (``bagio/fastscan.py``);
-- configuration types named against the naming rule (doc/architecture.md, "Names").
+- configuration types named against the naming rule (doc/architecture.md, "Names");
+- imports that run back up the floors (:class:`Floors`: ``lumpbeam_ros.__all__`` and the
+  order of each floor's packages), a rule ``test/test_layers.py`` holds module by module;
+- twins: a concept with one home (:data:`TWINS`) done again elsewhere.
 
 mypy's count is its own command: ``mypy`` (the configuration is ``mypy.ini``).
 """
@@ -507,17 +510,12 @@ _TYPE_SYSTEM = 'lumpbeam_ros/core/bagio/typestore.py'
 #: message for message (without the test, the fast path counts).
 FAST_PATH = ('lumpbeam_ros/core/bagio/fastscan.py', 'test/core/bagio/test_fastscan.py')
 
-#: The check of the record layout our writer makes (the checks of ``mcap doctor``): it
-#: looks at records to judge them, and reads no message for anyone.
-_LAYOUT_CHECKER = 'lumpbeam_ros/core/bagio/check.py'
-
 #: Modules that parse MCAP records, or read bags, on their own: mcap's record-level readers
 #: and rosbags' bag readers and deserializers.
 _READING_MODULES = (
     'mcap.reader',
     'mcap.stream_reader',
     'mcap.data_stream',
-    'mcap.opcode',
     'rosbags.rosbag2.reader',
     'rosbags.highlevel',
     'rosbags.serde',
@@ -547,7 +545,7 @@ def bag_readers(repo: Path) -> list[str]:
         for path in sorted((repo / package).rglob('*.py')):
             rel = path.relative_to(repo).as_posix()
             tested = rel == FAST_PATH[0] and (repo / FAST_PATH[1]).exists()
-            if rel in (_LAYOUT_CHECKER, _TYPE_SYSTEM) or tested:
+            if rel == _TYPE_SYSTEM or tested:
                 continue
             text = path.read_text()
             tree = ast.parse(text)
@@ -626,6 +624,137 @@ def config_type_names(repo: Path) -> list[str]:
     return found
 
 
+# --- Imports point down the floors -------------------------------------------------------------
+
+
+def _constant(package: Path, name: str) -> Any:
+    """A constant a package's ``__init__.py`` assigns, read without importing it (or None)."""
+    tree = ast.parse((package / '__init__.py').read_text())
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and any(
+            isinstance(target, ast.Name) and target.id == name for target in node.targets
+        ):
+            return ast.literal_eval(node.value)
+    return None
+
+
+def public_names(package: Path) -> list[str]:
+    """A package's ``__all__``, read from its ``__init__.py`` without importing it."""
+    return [str(name) for name in _constant(package, '__all__') or []]
+
+
+class Floors:
+    """The package's floors and the order inside them, as the ``__all__`` lists declare them.
+
+    ``lumpbeam_ros.__all__`` lists the floors bottom first; a floor that says it is
+    ``LAYERED`` (``core``, ``apps``) orders its ``__all__`` the same way. A module may import
+    its own floor and those below; inside an ordered floor, its own package and those listed
+    before it.
+    The lab (``lumpbeam_lab``) stands above every floor.
+
+    Args:
+        repo: The repository.
+    """
+
+    def __init__(self, repo: Path):
+        package = repo / 'lumpbeam_ros'
+        self.floors = tuple(public_names(package))
+        self.ordered = {
+            floor: tuple(names)
+            for floor in self.floors
+            if len(names := public_names(package / floor)) > 1
+            and all(
+                (package / floor / name / '__init__.py').is_file()
+                or (package / floor / f'{name}.py').is_file()
+                for name in names
+            )
+            and floor in ('core', 'apps')
+        }
+
+    def rank(self, module: str) -> tuple[int, int]:
+        """Where a module stands: its floor, and its package's place inside its floor."""
+        parts = module.split('.')
+        if parts[0] == LAB:
+            return (len(self.floors), 0)
+        if len(parts) == 1 or parts[1] not in self.floors:
+            return (0, 0)
+        order = self.ordered.get(parts[1], ())
+        inside = order.index(parts[2]) if len(parts) > 2 and parts[2] in order else 0
+        return (self.floors.index(parts[1]), inside)
+
+    def may_import(self, module: str, name: str) -> bool:
+        """Whether ``module`` may import ``name``: its own floor or one below, never above."""
+        mine, theirs = self.rank(module), self.rank(name)
+        if theirs[0] != mine[0]:
+            return theirs[0] < mine[0]
+        return theirs[1] <= mine[1]
+
+
+def imported_names(path: Path) -> set[str]:
+    """Every module a source file imports, at the top or inside functions."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding='utf-8'))):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names.add(node.module)
+    return names
+
+
+def imports_back_up(repo: Path) -> list[str]:
+    """Imports that run back up the floors, or back up the core's or the apps' order.
+
+    Returns:
+        ``module imports name`` for each.
+    """
+    floors = Floors(repo)
+    found = []
+    for package in ('lumpbeam_ros', LAB):
+        for path in sorted((repo / package).rglob('*.py')):
+            module = '.'.join(path.relative_to(repo).with_suffix('').parts)
+            module = module.removesuffix('.__init__')
+            for name in sorted(imported_names(path)):
+                ours = name.partition('.')[0] in {'lumpbeam_ros', LAB} and name != 'lumpbeam_ros'
+                if ours and not floors.may_import(module, name):
+                    found.append(f'{module} imports {name}')
+    return found
+
+
+# --- Twins: one of each ------------------------------------------------------------------------
+
+#: Each concept with its one home, and a pattern that, outside that home, is a second one.
+TWINS: dict[str, tuple[str, str]] = {
+    # Reading a JointTrajectory message's points.
+    'trajectory message conversions': (
+        'lumpbeam_ros/nodes/trajectory_messages.py',
+        r'\.time_from_start\b',
+    ),
+    # A parameter file read, or the package's own when none is given.
+    'config loaders': ('lumpbeam_ros/base/paramfile.py', r'config_path\(.*\) if \w+ is None'),
+    # A general least-squares solver (the alignment's reweighted fit on rotations is not one).
+    'least-squares solvers': (
+        'lumpbeam_ros/core/ident/optimize.py',
+        r'def \w*(gauss_newton|levenberg|marquardt)\w*\(',
+    ),
+    # A Gauss-Newton step on the reprojection error of the board's corners.
+    'reprojection fits': (
+        'lumpbeam_ros/core/vision/reprojection.py',
+        r'inverse @ \(j\.T @ r\)|solve\(jtj',
+    ),
+    # A walk over MCAP records: each record's opcode and length read before its content.
+    'MCAP record walkers': ('lumpbeam_ros/core/bagio/reader.py', r'\.read1\(\)|_RECORD_HEADER'),
+}
+
+
+def twins(repo: Path) -> list[str]:
+    """Places that do again what :data:`TWINS` gives one home (``concept: file:line``)."""
+    found = []
+    for concept, (home, pattern) in TWINS.items():
+        for hit in _grep(repo, pattern, (home,)):
+            found.append(f'{concept}: {hit}')
+    return found
+
+
 def main(argv: list[str]) -> int:
     """Prints the counts, each with the places that make it up."""
     repo = Path(argv[1]) if len(argv) > 1 else Path(__file__).resolve().parents[1]
@@ -645,6 +774,8 @@ def main(argv: list[str]) -> int:
         'places to change to add an effect (besides its physics)': effect_places(repo),
         'lab modules imported by the core': lab_imports(repo),
         'readers of bags besides bagio/reader.py and its tested fast path': bag_readers(repo),
+        'imports that run back up the floors or the core': imports_back_up(repo),
+        'twins (a concept done again outside its one home)': twins(repo),
         'configuration types named against the rule (Config, Settings, Options, Parameters)': (
             config_type_names(repo)
         ),

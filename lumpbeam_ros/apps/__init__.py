@@ -5,6 +5,9 @@ Listed in :data:`__all__` from the bottom up: :mod:`~.json_output` (the ``--json
 Dask), :mod:`~.demo` (the live pipeline) and :mod:`~.cli` (the commands).
 """
 
+#: :data:`__all__` lists the packages bottom first: each imports only those before it.
+LAYERED = True
+
 __all__ = [
     'json_output',
     'plots',

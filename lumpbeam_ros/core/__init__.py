@@ -17,6 +17,9 @@ ROS-free: numpy arrays, dataclasses and paths in, the same out. The packages are
 - :mod:`~.synthetic`: the experiments simulated into bags.
 """
 
+#: :data:`__all__` lists the packages bottom first: each imports only those before it.
+LAYERED = True
+
 __all__ = [
     'bagio',
     'model',

@@ -41,7 +41,7 @@ import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, NamedTuple, Unpack
+from typing import Any, Unpack
 
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
@@ -71,6 +71,7 @@ from lumpbeam_ros.core.bagio.convert import (
     seconds_to_ns,
     time_ns,
 )
+from lumpbeam_ros.core.bagio.tipseries import TipSeries
 from lumpbeam_ros.core.bagio.typestore import serialize
 from lumpbeam_ros.core.model.adopt import adopt_identified
 from lumpbeam_ros.core.model.arm.config import load_arm_config
@@ -285,16 +286,7 @@ class SimulatorNode(SchemaNode):
         self.get_logger().warning(text, throttle_duration_sec=WARN_PERIOD_S)
 
 
-class Predicted(NamedTuple):
-    """The tip a model predicts at each new sample (beam_base; s, m, m, rad)."""
-
-    t: np.ndarray
-    x: np.ndarray
-    z: np.ndarray
-    pitch: np.ndarray
-
-
-_NOTHING = Predicted(*(np.empty(0),) * 4)
+_NOTHING = TipSeries(*(np.empty(0),) * 4)
 
 
 class BeamSimulation:
@@ -338,7 +330,7 @@ class BeamSimulation:
 
     # -- the model's side of the loop ---------------------------------------------------------
 
-    def advance_to(self, now: float) -> Predicted:
+    def advance_to(self, now: float) -> TipSeries:
         """The samples due up to ``now``; the first call starts the simulation at rest."""
         if self.stream is None:
             self.stream = PredictionStream(self.beam, self._load_kg, now, self.values['rate_hz'])
@@ -349,7 +341,7 @@ class BeamSimulation:
         samples = self.stream.advance_to(now)
         if len(samples):
             self._latest = samples
-        return Predicted(samples.t, samples.x, samples.z, samples.pitch)
+        return samples
 
     def restart_at(self, now: float) -> bool:
         """Restarts at rest under the current load (False: nothing was running)."""
@@ -563,13 +555,13 @@ class ArmSimulation:
 
     # -- the model's side of the loop ---------------------------------------------------------
 
-    def advance_to(self, now: float) -> Predicted:
+    def advance_to(self, now: float) -> TipSeries:
         """The samples due up to ``now`` (none before the first command)."""
         samples = self.stream.advance_to(now)
         self._samples = samples
         if samples.t.size:
             self._latest = samples
-        return Predicted(samples.t, samples.tip_x, samples.tip_z, samples.tip_pitch)
+        return TipSeries(samples.t, samples.tip_x, samples.tip_z, samples.tip_pitch)
 
     def restart_at(self, now: float) -> bool:
         """Restarts at rest at the held angles (False: no command followed yet)."""

@@ -1,9 +1,9 @@
 """A structural check of MCAP files and rosbag2 bags, the checks of ``mcap doctor`` (no ROS).
 
 ``mcap doctor`` (the Go CLI) cannot be installed everywhere, so this module makes the same
-kind of checks in one streaming pass over the records, read with the ``mcap`` package's
-record classes (:mod:`mcap.records`) and its chunk decompression
-(:func:`mcap.stream_reader.get_chunk_data_stream`):
+kind of checks in one pass over the records, read by the one record reader of the bags
+(:func:`~lumpbeam_ros.core.bagio.reader.read_record_at`, mcap's record classes) and
+decompressed by mcap (:func:`~lumpbeam_ros.core.bagio.reader.decompress_chunk`):
 
 - the leading and trailing magic, every record parses and lies within the file (a cut file
   or a bad record is one problem, and the pass stops there), the Header first and a
@@ -27,18 +27,14 @@ product's bags must be whole. :func:`examine_bag` adds ``metadata.yaml``'s messa
 
 from __future__ import annotations
 
-import struct
+import mmap
+import os
 import zlib
 from collections import Counter
-from collections.abc import Callable
 from dataclasses import dataclass, field
-from io import BytesIO
 from pathlib import Path
 from typing import BinaryIO
 
-import zstandard
-from mcap.data_stream import ReadDataStream
-from mcap.exceptions import EndOfFile, McapError
 from mcap.opcode import Opcode
 from mcap.records import (
     Attachment,
@@ -58,11 +54,16 @@ from mcap.records import (
     Statistics,
     SummaryOffset,
 )
-from mcap.stream_reader import get_chunk_data_stream
 
 from lumpbeam_ros.base.errors import BagError
 from lumpbeam_ros.core.bagio import metadata
-from lumpbeam_ros.core.bagio.reader import MAGIC
+from lumpbeam_ros.core.bagio.reader import (
+    MAGIC,
+    UnreadableRecordError,
+    decompress_chunk,
+    opcode_name,
+    read_record_at,
+)
 from lumpbeam_ros.core.bagio.typestore import deserialize, is_known
 
 #: Profiles of the MCAP registry; ``''`` is a file without one.
@@ -71,24 +72,8 @@ ROS2_SCHEMA_ENCODINGS = ('ros2msg', 'ros2idl')
 #: Lines listed per kind of problem; the rest are counted in one line.
 MAX_LINES_PER_KIND = 20
 
-_RECORD_HEADER = struct.Struct('<BQ')
-_FOOTER_LENGTH = 8 + 8 + 4
-_READERS: dict[int, Callable[[ReadDataStream], McapRecord]] = {
-    Opcode.ATTACHMENT: Attachment.read,
-    Opcode.ATTACHMENT_INDEX: AttachmentIndex.read,
-    Opcode.CHANNEL: Channel.read,
-    Opcode.CHUNK: Chunk.read,
-    Opcode.CHUNK_INDEX: ChunkIndex.read,
-    Opcode.DATA_END: DataEnd.read,
-    Opcode.FOOTER: Footer.read,
-    Opcode.HEADER: Header.read,
-    Opcode.MESSAGE_INDEX: MessageIndex.read,
-    Opcode.METADATA: Metadata.read,
-    Opcode.METADATA_INDEX: MetadataIndex.read,
-    Opcode.SCHEMA: Schema.read,
-    Opcode.STATISTICS: Statistics.read,
-    Opcode.SUMMARY_OFFSET: SummaryOffset.read,
-}
+#: Where a Footer's summary CRC starts: after its opcode, length and two offsets.
+_FOOTER_CRC_AT = 1 + 8 + 8 + 8
 _SUMMARY_OPCODES = {
     Opcode.SCHEMA,
     Opcode.CHANNEL,
@@ -98,51 +83,10 @@ _SUMMARY_OPCODES = {
     Opcode.METADATA_INDEX,
 }
 _CHUNK_OPCODES = {Opcode.SCHEMA, Opcode.CHANNEL, Opcode.MESSAGE}
-# OverflowError: a damaged 8-byte length beyond what an index can hold (the fuzz campaign).
-_PARSE_ERRORS = (struct.error, EndOfFile, UnicodeDecodeError, ValueError, OverflowError)
-_DECOMPRESS_ERRORS = (McapError, RuntimeError, ValueError, zstandard.ZstdError)
 
 
 class _UnreadableError(Exception):
     """The file cannot be read on from here (cut, or a record that does not parse)."""
-
-
-class _ExactStream(ReadDataStream):
-    """A :class:`ReadDataStream` that fails on a short read instead of returning less."""
-
-    def read(self, length: int) -> bytes:
-        data = super().read(length)
-        if len(data) != length:
-            raise EndOfFile()
-        return data
-
-
-def _opcode_name(opcode: int) -> str:
-    try:
-        return Opcode(opcode).name.title().replace('_', '')
-    except ValueError:
-        return f'opcode 0x{opcode:02x}'
-
-
-def _parse(opcode: int, body: bytes, where: str) -> McapRecord | None:
-    """Parses one record's content with the ``mcap`` package's reader (None: unknown opcode).
-
-    Raises:
-        _UnreadableError: The content does not parse or is shorter than its fields say.
-    """
-    stream = _ExactStream(BytesIO(body))
-    try:
-        if opcode == Opcode.MESSAGE:
-            message: Message = Message.read(stream, len(body))
-            return message
-        reader = _READERS.get(opcode)
-        return None if reader is None else reader(stream)
-    except _PARSE_ERRORS as exc:
-        detail = f': {exc}' if str(exc) else ''
-        raise _UnreadableError(
-            f'{_opcode_name(opcode)} record at {where} does not parse '
-            f'({type(exc).__name__}{detail})'
-        ) from None
 
 
 @dataclass
@@ -190,9 +134,9 @@ class FileReport:
 class _Examiner:
     """One pass over one MCAP file, collecting problems."""
 
-    def __init__(self, file: BinaryIO, size: int):
-        self.file = file
-        self.size = size
+    def __init__(self, data: mmap.mmap):
+        self.data = data
+        self.size = len(data)
         self.problems: list[str] = []
         self.kind_counts: Counter[str] = Counter()
         self.header: Header | None = None
@@ -254,7 +198,7 @@ class _Examiner:
         Raises:
             _UnreadableError: The file is cut or holds a record that does not parse.
         """
-        if self.file.read(len(MAGIC)) != MAGIC:
+        if self.data[: len(MAGIC)] != MAGIC:
             raise _UnreadableError('no MCAP magic at the start: not an MCAP file')
         offset = len(MAGIC)
         while True:
@@ -263,20 +207,14 @@ class _Examiner:
                     f'file ends at offset {offset} without a Footer: its writer did not '
                     'finish it (no summary, statistics or chunk indexes)'
                 )
-            head = self.file.read(_RECORD_HEADER.size)
-            if len(head) < _RECORD_HEADER.size:
-                raise _UnreadableError(f'truncated: a record header at offset {offset} is cut')
-            opcode, length = _RECORD_HEADER.unpack(head)
-            if length > self.size - offset - len(head):
-                raise _UnreadableError(
-                    f'truncated: {_opcode_name(opcode)} record at offset {offset} declares '
-                    f'{length} bytes, only {self.size - offset - len(head)} are left'
+            try:
+                opcode, record, end = read_record_at(
+                    self.data, offset, self.size, f'offset {offset}'
                 )
-            body = self.file.read(length)
-            record = _parse(opcode, body, f'offset {offset}')
-            end = offset + len(head) + length
+            except UnreadableRecordError as exc:
+                raise _UnreadableError(f'truncated: {exc}' if exc.cut else str(exc)) from None
             if self.data_end_at is None and opcode != Opcode.DATA_END:
-                self.data_crc = zlib.crc32(body, zlib.crc32(head, self.data_crc))
+                self.data_crc = zlib.crc32(self.data[offset:end], self.data_crc)
             if opcode != Opcode.MESSAGE_INDEX:
                 self.indexing = None
             if isinstance(record, Footer):
@@ -287,7 +225,7 @@ class _Examiner:
 
     def on_record(self, opcode: int, record: McapRecord | None, offset: int, end: int) -> None:
         """Checks one record before the Footer."""
-        name = _opcode_name(opcode)
+        name = opcode_name(opcode)
         if self.header is None:
             if not isinstance(record, Header):
                 raise _UnreadableError(
@@ -420,16 +358,11 @@ class _Examiner:
         self.chunks[offset] = seen
         self.indexing = seen
         try:
-            stream, size = get_chunk_data_stream(chunk, validate_crc=False)
-            data = stream.read(size)
-        except _DECOMPRESS_ERRORS as exc:
+            data = decompress_chunk(chunk)
+        except UnreadableRecordError as exc:
             seen.readable = False
             self.lost_definitions = True
-            self.problem(
-                'chunk',
-                f'{label} does not decompress ({chunk.compression!r}: '
-                f'{type(exc).__name__}: {exc})',
-            )
+            self.problem('chunk', f'{label} does not decompress ({chunk.compression!r}: {exc})')
             return
         if len(data) != chunk.uncompressed_size:
             self.problem(
@@ -454,23 +387,17 @@ class _Examiner:
         at = 0
         while at < len(data):
             where = f'{label} + {at}'
-            if len(data) - at < _RECORD_HEADER.size:
-                raise _UnreadableError(f'a record header at {where} is cut')
-            opcode, length = _RECORD_HEADER.unpack_from(data, at)
-            body_at = at + _RECORD_HEADER.size
-            if length > len(data) - body_at:
-                raise _UnreadableError(
-                    f'{_opcode_name(opcode)} record at {where} declares {length} bytes, only '
-                    f'{len(data) - body_at} are left in the chunk'
-                )
-            record = _parse(opcode, data[body_at : body_at + length], where)
+            try:
+                opcode, record, end = read_record_at(data, at, len(data), where, ' in the chunk')
+            except UnreadableRecordError as exc:
+                raise _UnreadableError(str(exc)) from None
             if opcode not in _CHUNK_OPCODES:
-                self.problem('order', f'{_opcode_name(opcode)} record inside {where}')
+                self.problem('order', f'{opcode_name(opcode)} record inside {where}')
             elif isinstance(record, (Schema, Channel, Message)):
                 if isinstance(record, Message):
                     seen.messages[at] = (record.channel_id, record.log_time)
                 self.on_content(record, where)
-            at = body_at + length
+            at = end
         times = [t for _, t in seen.messages.values()]
         if times and (seen.chunk.message_start_time, seen.chunk.message_end_time) != (
             min(times),
@@ -520,10 +447,10 @@ class _Examiner:
         if record is None:
             return  # an opcode of a later format version: readers skip it
         if opcode not in _SUMMARY_OPCODES:
-            self.problem('order', f'{_opcode_name(opcode)} record after the DataEnd, at {offset}')
+            self.problem('order', f'{opcode_name(opcode)} record after the DataEnd, at {offset}')
             return
         if self.first_summary_offset_at is not None:
-            self.problem('order', f'{_opcode_name(opcode)} at {offset} after a SummaryOffset')
+            self.problem('order', f'{opcode_name(opcode)} at {offset} after a SummaryOffset')
         self.summary.append((offset, end, opcode))
         if isinstance(record, Schema):
             self.define_schema(record, where, in_summary=True)
@@ -542,7 +469,7 @@ class _Examiner:
 
     def on_footer(self, footer: Footer, offset: int, end: int) -> None:
         """Checks the trailing magic, the footer's offsets and CRC and the whole summary."""
-        if self.file.read(len(MAGIC) + 1) != MAGIC:
+        if self.data[end : end + len(MAGIC) + 1] != MAGIC:
             self.problem('magic', f'no MCAP magic (alone) after the Footer at offset {offset}')
         if self.data_end_at is None:
             self.problem('order', 'no DataEnd record before the Footer')
@@ -591,9 +518,7 @@ class _Examiner:
             return
         # The summary CRC covers the summary sections and the Footer up to the CRC field.
         crc_from = footer.summary_start if 0 < footer.summary_start <= offset else offset
-        self.file.seek(crc_from)
-        covered = self.file.read(offset + _RECORD_HEADER.size + _FOOTER_LENGTH - 4 - crc_from)
-        crc = zlib.crc32(covered)
+        crc = zlib.crc32(self.data[crc_from : offset + _FOOTER_CRC_AT])
         if crc != footer.summary_crc:
             self.problem(
                 'crc', f'Footer.summary_crc {footer.summary_crc:#010x} != {crc:#010x}, computed'
@@ -604,7 +529,7 @@ class _Examiner:
         for group in self.summary_offsets:
             if group.group_length == 0:
                 continue  # an empty group (the mcap package writes one per kind it has none of)
-            name = _opcode_name(group.group_opcode)
+            name = opcode_name(group.group_opcode)
             label = f'SummaryOffset of {name} ({group.group_start}, +{group.group_length})'
             first = starts.get(group.group_start)
             if first is None:
@@ -703,6 +628,15 @@ class _Examiner:
                 )
 
 
+def _mapped(file: BinaryIO) -> mmap.mmap:
+    """The file's bytes, mapped (an empty file maps to nothing: a one-byte stand-in)."""
+    if os.fstat(file.fileno()).st_size == 0:
+        stand_in = mmap.mmap(-1, 1)
+        stand_in.resize(1)
+        return stand_in
+    return mmap.mmap(file.fileno(), 0, access=mmap.ACCESS_READ)
+
+
 def examine(path: str | Path) -> FileReport:
     """Checks one MCAP file as ``mcap doctor`` does (see the module docstring).
 
@@ -721,8 +655,8 @@ def examine(path: str | Path) -> FileReport:
     except OSError as exc:
         raise BagError(f'{path}: cannot open ({exc.strerror or exc})') from None
     complete = True
-    with file:
-        examiner = _Examiner(file, path.stat().st_size)
+    with file, _mapped(file) as data:
+        examiner = _Examiner(data)
         try:
             examiner.run()
         except _UnreadableError as exc:

@@ -1,11 +1,13 @@
 """Reading rosbag2 bags with MCAP storage: whole, cut short, or damaged.
 
-The ``mcap`` package reads the records: :class:`mcap.stream_reader.StreamReader` parses
-each one, :func:`mcap.stream_reader.breakup_chunk` decompresses a chunk, checks its CRC-32
-(when its writer stored one, as :class:`~lumpbeam_ros.core.bagio.writer.BagWriter` does) and
-parses what it holds, and :class:`mcap.reader.SeekingReader` reads the closing summary. What
-this module adds is the policy for damage, which the package's own ``iter_messages`` does not
-have (it stops the whole read at the first bad chunk):
+The ``mcap`` package reads the records: each record's content is parsed by mcap's reader of
+its kind (:func:`read_record_at`, the one record reader, which the structural check of
+:mod:`~lumpbeam_ros.core.bagio.check` uses too), a chunk is decompressed by mcap
+(:func:`decompress_chunk`) and checked against its CRC-32 (when its writer stored one, as
+:class:`~lumpbeam_ros.core.bagio.writer.BagWriter` does), and
+:class:`mcap.reader.SeekingReader` reads the closing summary. What this module adds is the
+policy for damage, which the package's own ``iter_messages`` does not have (it stops the
+whole read at the first bad chunk):
 
 - a complete file is read chunk by chunk through its summary's chunk indexes (the summary
   first checked against its CRC); a chunk that does not read, does not match its index or
@@ -29,18 +31,35 @@ import mmap
 import struct
 import zlib
 from collections import Counter
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any, cast
 
 import zstandard
 from mcap.data_stream import ReadDataStream
-from mcap.exceptions import McapError, RecordLengthLimitExceeded
+from mcap.exceptions import EndOfFile, McapError
 from mcap.opcode import Opcode
 from mcap.reader import FOOTER_SIZE, SeekingReader
-from mcap.records import Channel, Chunk, ChunkIndex, DataEnd, Footer, McapRecord, Message, Schema
-from mcap.stream_reader import StreamReader, breakup_chunk, read_magic
+from mcap.records import (
+    Attachment,
+    AttachmentIndex,
+    Channel,
+    Chunk,
+    ChunkIndex,
+    DataEnd,
+    Footer,
+    Header,
+    McapRecord,
+    Message,
+    MessageIndex,
+    Metadata,
+    MetadataIndex,
+    Schema,
+    Statistics,
+    SummaryOffset,
+)
+from mcap.stream_reader import StreamReader, get_chunk_data_stream, read_magic
 from mcap.summary import Summary
 from mcap.writer import MCAP0_MAGIC
 
@@ -369,6 +388,136 @@ def _summary_crc_ok(buffer: mmap.mmap) -> bool:
     return bool(zlib.crc32(covered) == footer.summary_crc)
 
 
+class UnreadableRecordError(Exception):
+    """No record can be read where one should start.
+
+    Attributes:
+        cut: Whether the data end inside it (its header, or the content its length declares).
+    """
+
+    def __init__(self, reason: str, cut: bool):
+        super().__init__(reason)
+        self.cut = cut
+
+
+#: mcap's readers of each record's content, by opcode.
+_RECORD_READERS: dict[int, Callable[[ReadDataStream], McapRecord]] = {
+    Opcode.ATTACHMENT: Attachment.read,
+    Opcode.ATTACHMENT_INDEX: AttachmentIndex.read,
+    Opcode.CHANNEL: Channel.read,
+    Opcode.CHUNK: Chunk.read,
+    Opcode.CHUNK_INDEX: ChunkIndex.read,
+    Opcode.DATA_END: DataEnd.read,
+    Opcode.FOOTER: Footer.read,
+    Opcode.HEADER: Header.read,
+    Opcode.MESSAGE_INDEX: MessageIndex.read,
+    Opcode.METADATA: Metadata.read,
+    Opcode.METADATA_INDEX: MetadataIndex.read,
+    Opcode.SCHEMA: Schema.read,
+    Opcode.STATISTICS: Statistics.read,
+    Opcode.SUMMARY_OFFSET: SummaryOffset.read,
+}
+
+
+class _ExactStream(ReadDataStream):
+    """A :class:`ReadDataStream` that fails on a short read instead of returning less."""
+
+    def read(self, length: int) -> bytes:
+        data = super().read(length)
+        if len(data) != length:
+            raise EndOfFile()
+        return data
+
+
+def opcode_name(opcode: int) -> str:
+    """A record's kind as the MCAP specification names it (``'ChunkIndex'``)."""
+    try:
+        return Opcode(opcode).name.title().replace('_', '')
+    except ValueError:
+        return f'opcode 0x{opcode:02x}'
+
+
+def read_record_at(
+    data: bytes | mmap.mmap, at: int, end: int, where: str, inside: str = ''
+) -> tuple[int, McapRecord | None, int]:
+    """The record that starts at ``at``: the one record reader of the walks over MCAP bytes.
+
+    The file walk of a cut or damaged file, a chunk's records and the structural check
+    (:mod:`~lumpbeam_ros.core.bagio.check`) all read records here: the opcode and length,
+    then the content by mcap's reader of that kind of record, bounded by its length.
+
+    Args:
+        data: The bytes (a file's map, or a chunk's records).
+        at: Where the record starts.
+        end: Where the data end.
+        where: The record's place, for the reason (``'offset 8'``).
+        inside: Said after the bytes left when the record runs past ``end``.
+
+    Returns:
+        The opcode, the record (``None``: an opcode mcap does not know, skipped as the
+        specification says) and where the record ends.
+
+    Raises:
+        UnreadableRecordError: Its header is cut, it declares more bytes than are left, or its
+            content does not parse.
+    """
+    if end - at < _RECORD_PREFIX:
+        raise UnreadableRecordError(f'a record header at {where} is cut', cut=True)
+    prefix = ReadDataStream(io.BytesIO(data[at : at + _RECORD_PREFIX]))
+    opcode, length = prefix.read1(), prefix.read8()
+    left = end - at - _RECORD_PREFIX
+    if length > left:
+        raise UnreadableRecordError(
+            f'{opcode_name(opcode)} record at {where} declares {length} bytes, only {left} '
+            f'are left{inside}',
+            cut=True,
+        )
+    body = bytes(data[at + _RECORD_PREFIX : at + _RECORD_PREFIX + length])
+    stream = _ExactStream(io.BytesIO(body))
+    try:
+        if opcode == Opcode.MESSAGE:
+            record: McapRecord | None = Message.read(stream, len(body))
+        else:
+            reader = _RECORD_READERS.get(opcode)
+            record = None if reader is None else reader(stream)
+    except _READ_ERRORS as exc:
+        detail = f': {exc}' if str(exc) else ''
+        raise UnreadableRecordError(
+            f'{opcode_name(opcode)} record at {where} does not parse '
+            f'({type(exc).__name__}{detail})',
+            cut=False,
+        ) from None
+    return opcode, record, at + _RECORD_PREFIX + length
+
+
+def decompress_chunk(chunk: Chunk) -> bytes:
+    """A chunk's records as written, decompressed by mcap (not checked against its CRC).
+
+    Raises:
+        UnreadableRecordError: An unknown compression, a size no chunk should have, or data the
+            decompressor refuses (the reason names the error).
+    """
+    if chunk.compression not in _COMPRESSIONS:
+        # mcap takes an unknown compression for none.
+        raise UnreadableRecordError(f'UnsupportedCompression: {chunk.compression!r}', cut=False)
+    if chunk.uncompressed_size > MAX_CHUNK_BYTES:
+        raise UnreadableRecordError(
+            f'ValueError: uncompressed_size {chunk.uncompressed_size} is over '
+            f'{MAX_CHUNK_BYTES} bytes',
+            cut=False,
+        )
+    try:
+        if chunk.compression == 'zstd':
+            # The decompressor allocates the size the frame states, not the record's.
+            stated = zstandard.frame_content_size(chunk.data)
+            if stated != chunk.uncompressed_size:
+                raise ValueError(f'the zstd frame states {stated} bytes')
+        stream, size = get_chunk_data_stream(chunk, validate_crc=False)
+        return bytes(stream.read(size))
+    except _READ_ERRORS as exc:
+        raise UnreadableRecordError(f'{type(exc).__name__}: {exc}', cut=False) from None
+
+
 def _as_stream(buffer: mmap.mmap) -> IO[bytes]:
     """The file's map as the stream mcap reads from.
 
@@ -379,19 +528,15 @@ def _as_stream(buffer: mmap.mmap) -> IO[bytes]:
 
 
 def _read_record(buffer: mmap.mmap, at: int) -> tuple[McapRecord, int] | None:
-    """The record at ``at`` as mcap parses it, and where it ends (``None``: it does not parse).
+    """The record at ``at`` as mcap parses it, and where it ends (``None``: none readable).
 
     A chunk comes whole (:class:`~mcap.records.Chunk`, not yet decompressed).
     """
-    buffer.seek(at)
-    reader = StreamReader(
-        _as_stream(buffer), skip_magic=True, emit_chunks=True, record_size_limit=len(buffer)
-    )
     try:
-        record = next(iter(reader.records))
-    except (*_READ_ERRORS, StopIteration):
+        _, record, end = read_record_at(buffer, at, len(buffer), f'offset {at}')
+    except UnreadableRecordError:
         return None
-    return record, buffer.tell()
+    return None if record is None else (record, end)
 
 
 def _chunk_end(at: int, chunk: Chunk) -> int:
@@ -406,16 +551,24 @@ def _chunk_end(at: int, chunk: Chunk) -> int:
 
 def _chunk_records(chunk: Chunk) -> list[McapRecord] | None:
     """A chunk's records, decompressed, CRC-checked and parsed by mcap (``None``: damaged)."""
-    if chunk.compression not in _COMPRESSIONS or chunk.uncompressed_size > MAX_CHUNK_BYTES:
-        return None  # mcap takes an unknown compression for none
     try:
-        if chunk.compression == 'zstd':
-            # The decompressor allocates the size the frame states, not the record's.
-            if zstandard.frame_content_size(chunk.data) != chunk.uncompressed_size:
-                return None
-        return breakup_chunk(chunk, validate_crc=True)
-    except _READ_ERRORS:
+        data = decompress_chunk(chunk)
+    except UnreadableRecordError:
         return None
+    if len(data) != chunk.uncompressed_size:
+        return None
+    if chunk.uncompressed_crc != 0 and zlib.crc32(data) != chunk.uncompressed_crc:
+        return None
+    records = []
+    at = 0
+    while at < len(data):
+        try:
+            _, record, at = read_record_at(data, at, len(data), 'a chunk')
+        except UnreadableRecordError:
+            return None
+        if record is not None:
+            records.append(record)
+    return records
 
 
 class FileWalk:
@@ -543,40 +696,53 @@ class FileWalk:
         at = len(MAGIC)
         chunked = False
         while at < size:
-            buffer.seek(at)
-            reader = StreamReader(
-                _as_stream(buffer), skip_magic=True, emit_chunks=True, record_size_limit=size
-            )
-            ran_out = False
             try:
-                for record in reader.records:
-                    end = buffer.tell()
-                    if isinstance(record, Chunk):
-                        chunked = True
-                        intact = end == _chunk_end(at, record)
-                        records = _chunk_records(record) if intact else None
-                        if records is None:
-                            break  # resume at the next intact chunk
-                        yield from self._records(records)
-                    elif isinstance(record, DataEnd | Footer):
-                        return
-                    elif not chunked and not self.damaged:
-                        # Records outside chunks are only believed in an unchunked file read
-                        # without damage so far: after damage, garbage may look like one.
-                        yield from self._records([record])
-                    at = end
-                else:
-                    return
-            except _READ_ERRORS as exc:
+                _, record, end = read_record_at(buffer, at, size, f'offset {at}')
+            except UnreadableRecordError as exc:
                 # A record that runs past the end of the file: cut, unless data follows.
-                ran_out = isinstance(exc, RecordLengthLimitExceeded) or buffer.tell() >= size
-            resume = self._next_chunk(buffer, at + 1)
-            if resume is None and ran_out and not self.damaged:
-                self._note_cut(at)
+                resume = self._resume(buffer, at, exc.cut)
+                if resume is None:
+                    return
+                at = resume
+                continue
+            if isinstance(record, Chunk):
+                chunked = True
+                intact = end == _chunk_end(at, record)
+                records = _chunk_records(record) if intact else None
+                if records is None:
+                    resume = self._resume(buffer, at, cut=False)
+                    if resume is None:
+                        return
+                    at = resume
+                    continue
+                yield from self._records(records)
+            elif isinstance(record, DataEnd | Footer):
                 return
-            stop = size if resume is None else resume
-            self.damaged.append(f'unreadable records at bytes {at}-{stop}')
-            at = stop
+            elif record is not None and not chunked and not self.damaged:
+                # Records outside chunks are only believed in an unchunked file read without
+                # damage so far: after damage, garbage may look like one.
+                yield from self._records([record])
+            at = end
+
+    def _resume(self, buffer: mmap.mmap, at: int, cut: bool) -> int | None:
+        """Where the walk goes on after what cannot be read at ``at`` (``None``: it stops).
+
+        Args:
+            buffer: The file.
+            at: Where the unreadable record starts.
+            cut: Whether the file ends inside it.
+
+        Returns:
+            The next intact chunk after ``at``, the file's end when there is none, or ``None``
+            for a recording cut there (nothing damaged before it).
+        """
+        resume = self._next_chunk(buffer, at + 1)
+        if resume is None and cut and not self.damaged:
+            self._note_cut(at)
+            return None
+        stop = len(buffer) if resume is None else resume
+        self.damaged.append(f'unreadable records at bytes {at}-{stop}')
+        return stop
 
     def _note_cut(self, offset: int) -> None:
         self.cut = True

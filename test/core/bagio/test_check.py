@@ -25,6 +25,7 @@ from lumpbeam_ros.base.errors import BagError
 from lumpbeam_ros.core.bagio import BagWriter
 from lumpbeam_ros.core.bagio import check as doctor
 from lumpbeam_ros.core.bagio.check import MAGIC, examine, examine_bag, examine_file
+from lumpbeam_ros.core.bagio.reader import UnreadableRecordError, read_record_at
 
 ROOT = Path(__file__).resolve().parents[3]
 FOOTER_RECORD = 9 + 20  # opcode, length, summary_start, summary_offset_start, crc
@@ -392,5 +393,6 @@ def test_an_empty_folder_is_not_a_bag(tmp_path: Path) -> None:
 def test_a_chunk_length_beyond_an_index_is_an_unreadable_record():
     """A damaged chunk whose data length is about 1.2e19 raised OverflowError (fuzz case)."""
     body = struct.pack('<QQQI', 0, 0, 0, 0) + struct.pack('<I', 0) + struct.pack('<Q', 2**63 + 5)
-    with pytest.raises(doctor._UnreadableError):
-        doctor._parse(doctor.Opcode.CHUNK, body, 'offset 8')
+    record = struct.pack('<BQ', 0x06, len(body)) + body  # a Chunk record holding it
+    with pytest.raises(UnreadableRecordError, match='Chunk record at offset 8 does not parse'):
+        read_record_at(record, 0, len(record), 'offset 8')
