@@ -51,17 +51,3 @@ __all__ = [
     'reindex',
     'repair_bag',
 ]
-
-__all__ = [
-    'convert',
-    'fastscan',
-    'metadata',
-    'qos',
-    'reader',
-    'repair',
-    'series',
-    'tipbuffer',
-    'tipseries',
-    'typestore',
-    'writer',
-]

@@ -41,14 +41,3 @@ __all__ = [
     'fit_rigid',
     'read_comparison_input',
 ]
-
-__all__ = [
-    'align',
-    'bag_comparison',
-    'comparison',
-    'offset',
-    'refine',
-    'rigid',
-    'streams',
-    'transforms',
-]

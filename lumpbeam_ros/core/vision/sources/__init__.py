@@ -63,12 +63,3 @@ def open_footage(
         kind = 'an image folder' if path.is_dir() else 'a video'
         raise FootageError(f'{path} is {kind} without stamps: give {how_to_stamp}')
     return FolderSource(path, stamps) if path.is_dir() else VideoSource(path, stamps)
-
-
-__all__ = [
-    'folder',
-    'frame',
-    'pixels',
-    'stamps',
-    'video',
-]
