@@ -15,16 +15,19 @@ from lumpbeam_ros.base.errors import LumpbeamError
 LAB = 'lumpbeam_lab'
 
 
-def lab_runner() -> ModuleType:
+def lab_runner(checkout: Path | None = None) -> ModuleType:
     """The lab's bench runner, from the checkout this package was installed from.
 
     The lab is not installed with the product (what proves it is kept apart from what users
     run); an editable install or a source tree has it beside ``lumpbeam_ros/``.
 
+    Args:
+        checkout: Where to look for the lab (default: the folder above this package).
+
     Raises:
         LumpbeamError: The package was installed without its repository (a wheel).
     """
-    checkout = Path(__file__).resolve().parents[3]
+    checkout = Path(__file__).resolve().parents[3] if checkout is None else checkout
     if (checkout / LAB / '__init__.py').is_file() and str(checkout) not in sys.path:
         sys.path.append(str(checkout))
     try:
