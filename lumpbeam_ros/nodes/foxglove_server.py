@@ -67,6 +67,9 @@ def _check_free(host: str, port: int) -> None:
         raise LumpbeamError(f'cannot serve on {host}:{port}: {exc.strerror}') from None
     family, kind, proto, _, address = infos[0]
     with socket.socket(family, kind, proto) as probe:
+        # As a server binds (the SDK's too): the connections of a server just stopped, left in
+        # TIME_WAIT, do not hold the port; a server still listening on it does.
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
             probe.bind(address)
         except OSError as exc:
@@ -86,6 +89,7 @@ class ChannelSink:
         self._context = context
         self._channels: dict[str, Any] = {}
         self.sent: dict[str, int] = {}
+        self._latest_log_time_ns = -1
 
     def has_topic(self, topic: str) -> bool:
         """Whether a channel was opened for the topic."""
@@ -128,6 +132,12 @@ class ChannelSink:
             raise BagError(f'topic {topic!r} has no channel')
         channel.log(bytes(data), log_time=int(log_time_ns))
         self.sent[topic] += 1
+        self._latest_log_time_ns = max(self._latest_log_time_ns, int(log_time_ns))
+
+    @property
+    def flushed_log_time_ns(self) -> int:
+        """The latest log time sent (-1 before the first message), ns: nothing waits to go."""
+        return self._latest_log_time_ns
 
     def flush(self) -> None:
         """Nothing is buffered: every message is sent as it comes."""

@@ -201,3 +201,56 @@ def test_a_port_out_of_range_is_a_usage_error(capsys):
         main(['view', '--port', '70000'])
     assert exit_info.value.code == 2
     assert 'port must be in 0..65535' in capsys.readouterr().err.splitlines()[-1]
+
+
+def _serve_live(domain_id, port='0'):
+    """``lumpbeam view`` on the live graph of a test's domain, and the port it serves."""
+    from harness import ros_env
+
+    process = subprocess.Popen(
+        [sys.executable, '-m', 'lumpbeam_ros.apps.cli.main', 'view', '--port', port]
+        + ['--duration', '60'],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=ros_env(domain_id),
+    )
+    line = process.stdout.readline()
+    match = re.search(r'at ws://127\.0\.0\.1:(\d+)', line)
+    assert match, f'no address announced: {line!r} {process.stderr.read() if not line else ""}'
+    return process, int(match.group(1))
+
+
+def test_the_live_graph_is_served_and_the_port_is_free_at_once_after(ros_graph):
+    # A node publishing on the graph; the viewer forwards it to a WebSocket client.
+    import threading
+
+    from geometry_msgs.msg import PoseStamped
+
+    process, port = _serve_live(ros_graph.domain_id)
+    done = threading.Event()
+
+    def publish():
+        msg = PoseStamped()
+        msg.header.frame_id = 'beam_base'
+        while not done.is_set():
+            msg.pose.position.z = -0.04
+            ros_graph.publish('/tip_pose', msg)
+            done.wait(0.05)
+
+    publisher = threading.Thread(target=publish, daemon=True)
+    publisher.start()
+    try:
+        wanted = {'/tip_pose': 'geometry_msgs/msg/PoseStamped'}
+        channels, payloads = asyncio.run(_watch(port, wanted=wanted))
+    finally:
+        done.set()
+        publisher.join(5)
+        _stop(process)
+    assert channels['/tip_pose']['schemaName'] == wanted['/tip_pose']
+    pose = deserialize(payloads['/tip_pose'], wanted['/tip_pose'])
+    assert pose.pose.position.z == -0.04 and process.returncode == 0
+    # A client has been connected: the port is taken up again at once by the next viewer.
+    again, again_port = _serve_live(ros_graph.domain_id, str(port))
+    _stop(again)
+    assert again_port == port and again.returncode == 0
