@@ -77,11 +77,26 @@ def run_node(
     # calls the handler it found, this one, which interrupts a callback that computes.
     # Without it SIGTERM, and SIGINT in a process started with SIGINT ignored (a background
     # job), only shut the context down, and a callback busy in a long solve runs on.
+    argv = list(sys.argv if args is None else args)
+    if _wants_help(argv):
+        from lumpbeam_ros.nodes.params.reference import help_text
+
+        sys.stdout.write(help_text(name))
+        return 0
+    problem = params_file_problem(argv)
+    if problem is not None:
+        print(f'{name}: error: {problem}', file=sys.stderr)
+        return CONFIG_ERROR
     previous = interrupt_on_signals()
     node: _N | None = None
     try:
-        rclpy.init(args=list(args) if args is not None else None)
+        try:
+            rclpy.init(args=argv)
+        except _rclpy.RCLError as exc:
+            print(f'{name}: error: bad --ros-args ({exc})', file=sys.stderr)
+            return CONFIG_ERROR
         node = make()
+        node.get_logger().info('ready')
         run(node)
     except (LumpbeamError, ParameterException) as exc:
         print(f'{name}: error: {exc}', file=sys.stderr)
@@ -105,6 +120,42 @@ def run_node(
         rclpy.try_shutdown()
         restore_handlers(previous)
     return 0
+
+
+def _wants_help(argv: Sequence[str]) -> bool:
+    """Whether ``-h`` or ``--help`` stands before ``--ros-args`` (the node's own arguments)."""
+    own = argv[1 : argv.index('--ros-args')] if '--ros-args' in argv else argv[1:]
+    return any(arg in ('-h', '--help') for arg in own)
+
+
+def params_file_problem(argv: Sequence[str]) -> str | None:
+    """What is wrong with the ``--params-file`` files of ``--ros-args``, naming the file.
+
+    rcl reads them in ``rclpy.init`` and, on a missing or broken one, logs only that it
+    failed to parse its arguments; the node would then start without its parameters.
+
+    Args:
+        argv: The command line.
+
+    Returns:
+        One line, or ``None`` when every file given is a ROS 2 parameter file.
+    """
+    from lumpbeam_ros.base.paramfile import read_parameter_file
+
+    inside = False
+    for i, arg in enumerate(argv):
+        if arg == '--ros-args':
+            inside = True
+        elif arg == '--':
+            inside = False
+        elif inside and arg == '--params-file':
+            if i + 1 >= len(argv):
+                return '--params-file needs a file'
+            try:
+                read_parameter_file(argv[i + 1])
+            except LumpbeamError as exc:
+                return str(exc)
+    return None
 
 
 #: Longest time :func:`spin_events` stays in the executor before it looks at the context and

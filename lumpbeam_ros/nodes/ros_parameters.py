@@ -222,6 +222,12 @@ class SchemaNode(Node):
             parameter_overrides=overrides,
         )
         self.parameter_values = declare_parameters(self, schema, on_change)
+        for name in sorted(self._parameter_overrides):
+            if not self.has_parameter(name) and not name.startswith('qos_overrides.'):
+                self.get_logger().warning(
+                    f'unknown parameter {name!r}: not a parameter of {schema.node} '
+                    f'(--help lists them); ignored'
+                )
         if REALTIME_PRIORITY.name in self.parameter_values:
             # A schema that declares it has it applied here, before the node's own set-up.
             problem = set_realtime_priority(int(self.parameter_values[REALTIME_PRIORITY.name]))

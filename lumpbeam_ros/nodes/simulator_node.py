@@ -167,7 +167,7 @@ class SimulatorNode(SchemaNode):
         self._markers_timer = self._make_markers_timer(values['markers_rate_hz'])
         sim = self.get_parameter('use_sim_time').value
         self.get_logger().info(
-            f'simulator ready: {self.model.description}, {values["rate_hz"]:g} Hz, '
+            f'simulating the {self.model.description}, {values["rate_hz"]:g} Hz, '
             f'{"sim" if sim else "wall"} time'
         )
 
@@ -320,8 +320,8 @@ class BeamSimulation:
 
     @property
     def description(self) -> str:
-        """What the node simulates, for its ready line."""
-        return f'n_s={self._base_beam.n_segments}'
+        """What the node simulates, for its start-up line."""
+        return f'beam of {self._base_beam.n_segments} segments'
 
     @property
     def beam(self) -> BeamParameters:

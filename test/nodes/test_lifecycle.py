@@ -257,3 +257,58 @@ def test_a_node_stops_within_the_bound_while_it_works(ros_graph, filmed_bag, nod
     assert worked, stderr
     assert code == 0, stderr
     assert 'Traceback' not in stderr
+
+
+NODE_NAMES = ['camera_node', 'identifier_node', 'simulator_node', 'diagnosis_node', 'shaper_node']
+
+
+@pytest.mark.parametrize('node', NODE_NAMES)
+def test_help_lists_the_parameters_and_starts_nothing(node, capsys):
+    from lumpbeam_ros.nodes.params.reference import SCHEMAS
+
+    schema = next(s for s in SCHEMAS if s.node == node)
+    module = __import__(f'lumpbeam_ros.nodes.{node}', fromlist=['main'])
+    assert module.main([node, '--help']) == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f'usage: {node} ')
+    for spec in schema:
+        assert f'  {spec.name} ({spec.kind}, default ' in out
+
+
+@pytest.mark.parametrize(
+    ('text', 'problem'),
+    [
+        (None, 'no such file'),
+        ('x: [', 'not valid YAML at line'),
+        ('just text', 'expected a mapping of node names'),
+    ],
+)
+def test_a_bad_params_file_names_the_file_and_exits_2(tmp_path, capsys, text, problem):
+    path = tmp_path / 'params.yaml'
+    if text is not None:
+        path.write_text(text)
+    module = __import__('lumpbeam_ros.nodes.shaper_node', fromlist=['main'])
+    code = module.main(['shaper_node', '--ros-args', '--params-file', str(path)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == CONFIG_ERROR
+    assert len(err) == 1 and err[0].startswith(f'shaper_node: error: {path}') and problem in err[0]
+
+
+def test_an_unknown_parameter_is_warned_about_and_the_node_says_it_is_ready(ros_domain_id):
+    env = ros_env(ros_domain_id)
+    env['PYTHONPATH'] = str(ROOT)
+    process = start_process(
+        env, 'lumpbeam_ros.nodes.shaper_node', '--ros-args', '-p', 'no_such_param:=1'
+    )
+    lines = []
+    try:
+        for line in process.stderr:
+            lines.append(line)
+            if line.rstrip().endswith('ready'):
+                break
+    finally:
+        code, _, stderr = stop_with(process, signal.SIGINT)
+    text = ''.join(lines) + stderr
+    assert "unknown parameter 'no_such_param': not a parameter of shaper_node" in text
+    assert any(line.rstrip().endswith('ready') for line in lines), text
+    assert code == 0

@@ -98,6 +98,37 @@ def node_table(schema: ParameterSchema) -> str:
     return '\n'.join(lines) + '\n'
 
 
+def help_text(node: str) -> str:
+    """A node's ``--help``: its usage and every parameter with type, default, range and unit.
+
+    Args:
+        node: The node's name (its executable's).
+
+    Returns:
+        Plain text, from the same declarations as ``doc/parameters.md``.
+
+    Raises:
+        KeyError: No schema of that name.
+    """
+    schema = {s.node: s for s in SCHEMAS}[node]
+    lines = [
+        f'usage: {node} [--ros-args [--params-file FILE] [-p NAME:=VALUE] ...]',
+        '',
+        schema.summary,
+        '',
+        'parameters (name, type, default, range, unit):',
+    ]
+    for spec in schema:
+        unit = f' [{spec.unit}]' if spec.unit else ''
+        limits = spec.constraints()
+        default = _value(spec.default).strip('`')
+        lines.append(f'  {spec.name} ({spec.kind}, default {default}){unit}')
+        lines.append(f'      {limits + ". " if limits else ""}{spec.description}')
+    if schema.config_file:
+        lines += ['', f'defaults: config/{schema.config_file} (lumpbeam_ros share folder)']
+    return '\n'.join(lines) + '\n'
+
+
 def reference(schemas: tuple[ParameterSchema, ...] = SCHEMAS) -> str:
     """The whole reference: a header and one table per node.
 

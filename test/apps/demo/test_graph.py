@@ -150,7 +150,7 @@ def test_wait_for_graph_sees_a_node_child(tmp_path):
         )
         assert heard['/tip_pose_predicted'] > 0
         assert graph.interrupt('simulator') == 0
-    assert 'simulator ready' in log.read_text()
+    assert '[simulator_node]: ready' in log.read_text()
 
 
 def test_wait_for_quiet_returns_on_a_topic_without_publisher(tmp_path, monkeypatch):
