@@ -1,12 +1,13 @@
 # The two commands a newcomer needs: `make demo` and `make test`.
-# Both create .venv on first use and install the package with every extra, plus the test
-# tools (requirements-dev.txt), from PyPI.
+# Both create .venv on first use and install the package with every extra from PyPI
+# (requirements.txt); `make test` adds the development tools (requirements-dev.txt).
 # Nothing is cached outside this folder: pip, matplotlib and ROS logs live under .cache/.
 
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
+DEV_STAMP := $(VENV)/.dev-installed-stamp
 
 export PIP_CACHE_DIR := $(CURDIR)/.cache/pip
 export MPLCONFIGDIR := $(CURDIR)/.cache/matplotlib
@@ -16,18 +17,25 @@ export ROS_HOME := $(CURDIR)/.cache/ros
 export ROS_AUTOMATIC_DISCOVERY_RANGE ?= LOCALHOST
 export PYTHONDONTWRITEBYTECODE :=
 
-.PHONY: venv demo test test-slow fuzz lint typecheck bench docs clean
+.PHONY: venv dev demo test test-slow fuzz lint typecheck bench docs clean
 
 # One pip run: the venv's own pip installs these wheels as well as a newer one would, so it
 # is not upgraded first (about 5 s). --no-compile: Python compiles a module when it is first
 # imported instead of pip compiling all ~6000 files of the dependencies up front (~28 s of
 # CPU), most of which nothing here imports.
-$(STAMP): setup.py setup.cfg package.xml requirements.txt requirements-dev.txt
+$(STAMP): setup.py setup.cfg package.xml requirements.txt
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install -q --disable-pip-version-check --no-compile -r requirements.txt
+	@touch $@
+
+# The tests, lint, types, the docs site and the lab's peers (MuJoCo, pyyeti), on top.
+$(DEV_STAMP): $(STAMP) requirements-dev.txt
 	$(BIN)/python -m pip install -q --disable-pip-version-check --no-compile -r requirements-dev.txt
 	@touch $@
 
 venv: $(STAMP)
+
+dev: $(DEV_STAMP)
 
 demo: venv
 	$(BIN)/lumpbeam demo --out results
@@ -41,7 +49,7 @@ PYTEST_PARALLEL := -n $(PYTEST_WORKERS) --maxprocesses=4 --dist loadscope
 
 # pytest also builds the documentation site (mkdocs build --strict) and checks its links
 # (test/test_docs.py).
-test: venv
+test: dev
 	$(BIN)/ruff check .
 	$(BIN)/mypy
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL)
@@ -49,7 +57,7 @@ test: venv
 # The long validation matrices (marked slow): CI runs them after `make test`. The computing
 # ones run in parallel; the live graphs among them (marked ros) then run alone, on a machine
 # no other worker keeps busy (best-effort camera frames, replays at their rate).
-test-slow: venv
+test-slow: dev
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -m 'slow and not ros'
 	$(BIN)/python -m pytest -m 'slow and ros'
 
@@ -58,25 +66,25 @@ test-slow: venv
 # analyze and diagnose (test/core/bagio/test_fuzz.py), and random messages into the nodes'
 # callbacks (test/nodes/test_fuzz_callbacks.py). make test runs them at 200 cases.
 FUZZ_CASES ?= 5000
-fuzz: venv
+fuzz: dev
 	LUMPBEAM_FUZZ_CASES=$(FUZZ_CASES) $(BIN)/python -m pytest test/core/bagio/test_fuzz.py \
 		test/nodes/test_fuzz_callbacks.py -n0 -q -p no:logging -s
 
-lint: venv
+lint: dev
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 
 # Strict static types of the ROS-free core (the module list is in mypy.ini).
-typecheck: venv
+typecheck: dev
 	$(BIN)/mypy
 
-bench: venv
+bench: dev
 	$(BIN)/lumpbeam bench --json results/bench.json
 
 # The documentation site (mkdocs.yml): the README, the pages under doc/ and the API reference
 # from the docstrings, into site/. `make test` builds it too, with warnings as errors, and
 # checks its internal links (test/test_docs.py).
-docs: venv
+docs: dev
 	$(BIN)/mkdocs build --strict --site-dir site
 
 clean:

@@ -1,6 +1,7 @@
 """Build script: an ament_python package that also installs with plain pip."""
 
 from glob import glob
+from pathlib import Path
 
 from setuptools import find_packages, setup
 
@@ -42,6 +43,8 @@ setup(
     maintainer='lumpbeam_ros maintainers',
     maintainer_email='lumpbeam@example.org',
     description='Live tip tracking and online identification of flexible beams (ROS 2).',
+    long_description=Path(__file__).with_name('README.md').read_text(encoding='utf-8'),
+    long_description_content_type='text/markdown',
     license='Apache-2.0',
     python_requires='>=3.10',
     entry_points={

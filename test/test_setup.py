@@ -64,6 +64,10 @@ def install_space(tmp_path_factory):
 def test_colcon_installs_every_console_script(install_space):
     scripts = {p.name for p in (install_space / 'lib' / PACKAGE).iterdir()}
     assert _declared_scripts() <= scripts
+    # They run with the python3 on PATH (a venv holding ROS from pip), not colcon's own.
+    for name in _declared_scripts():
+        first = (install_space / 'lib' / PACKAGE / name).read_text().splitlines()[0]
+        assert first == '#!/usr/bin/env python3', name
     assert {'camera_node', 'identifier_node', 'simulator_node', 'lumpbeam'} <= scripts
 
 
@@ -79,3 +83,11 @@ def test_colcon_installs_the_package_index_configs_and_data(install_space):
     # The product alone: what proves it stays in the repository.
     assert (site / PACKAGE / 'core' / 'model' / 'arm' / 'simulate.py').is_file()
     assert not (site / 'lumpbeam_lab').exists()
+
+
+def test_the_distribution_carries_the_readme():
+    metadata = importlib.metadata.metadata(PACKAGE)
+    assert metadata['Description-Content-Type'] == 'text/markdown'
+    assert (ROOT / 'README.md').read_text(encoding='utf-8').splitlines()[0] in (
+        metadata.get_payload() or metadata['Description']
+    )
