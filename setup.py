@@ -35,6 +35,7 @@ setup(
             f'share/{PACKAGE}/config',
             glob('config/*.yaml') + glob('config/*.json') + glob('config/*.rviz'),
         ),
+        (f'share/{PACKAGE}/launch', glob('launch/*.launch.yaml')),
     ],
     package_data={f'{PACKAGE}.base': ['data/*.csv', 'data/*.xml']},
     install_requires=REQUIRES,

@@ -100,6 +100,8 @@ DIAGNOSIS_NODE = 'diagnosis_node'
 SHAPER_NODE = 'shaper_node'
 PLAYER_NODE = 'lumpbeam_player'
 RECORDER_NODE = 'lumpbeam_recorder'
+#: The nodes, each also the name of its executable (``setup.py``'s console scripts).
+NODE_NAMES = (CAMERA_NODE, IDENTIFIER_NODE, SIMULATOR_NODE, DIAGNOSIS_NODE, SHAPER_NODE)
 
 
 def node_topic(topic: str) -> str:

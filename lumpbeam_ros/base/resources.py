@@ -27,6 +27,18 @@ def _candidate_share_dirs() -> list[Path]:
     return candidates
 
 
+def share_dir() -> Path:
+    """The package's share folder, the one holding ``config/`` (and ``launch/``).
+
+    Raises:
+        FileNotFoundError: The package is installed without its ``config/`` files.
+    """
+    for share in _candidate_share_dirs():
+        if (share / 'config').is_dir():
+            return share
+    raise FileNotFoundError(f'{PACKAGE}: the share folder (config/, launch/) is not installed')
+
+
 def config_path(name: str) -> Path:
     """Returns the path of a default configuration file.
 

@@ -520,6 +520,22 @@ def add_doctor(parser: argparse.ArgumentParser) -> None:
 
 
 @_subcommand(
+    'launch',
+    help='start the nodes of a ROS 2 YAML launch file (launch/*.launch.yaml)',
+    description='Starts the nodes of a ROS 2 YAML launch file, as `ros2 launch` does, where '
+    "ROS's own launch is not installed (ROS from pip): each node a child process, all "
+    'stopped together on Ctrl-C or SIGTERM, or when one of them fails. The shipped files '
+    "are in the share folder's launch/ (the repository's launch/).",
+)
+def add_launch(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam launch FILE [NAME:=VALUE ...]``."""
+    parser.add_argument('file', help='the .launch.yaml file')
+    parser.add_argument(
+        'arguments', nargs='*', metavar='NAME:=VALUE', help="the file's launch arguments"
+    )
+
+
+@_subcommand(
     'play',
     help='replay a bag into the live graph with /clock',
     description='Publishes a bag with its original relative timing and /clock '

@@ -59,6 +59,7 @@ COMMANDS = (
     Command('repair', arguments.add_repair, 'lumpbeam_ros.apps.cli.repair:run'),
     Command('doctor', arguments.add_doctor, 'lumpbeam_ros.apps.cli.doctor:run'),
     Command('play', arguments.add_play, 'lumpbeam_ros.apps.cli.play:run'),
+    Command('launch', arguments.add_launch, 'lumpbeam_ros.apps.cli.launch:run'),
     Command('bench', arguments.add_bench, 'lumpbeam_ros.apps.cli.bench:run'),
     Command('demo', arguments.add_demo, 'lumpbeam_ros.apps.cli.demo:run'),
     Command('campaign', arguments.add_campaign, 'lumpbeam_ros.apps.cli.campaign:run'),
