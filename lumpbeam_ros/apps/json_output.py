@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -34,6 +35,29 @@ def plain_json(value: Any) -> Any:
     if isinstance(value, float) and not math.isfinite(value):
         return None  # JSON has no NaN or inf
     return value
+
+
+def typed_values(values: Mapping[str, str]) -> dict[str, Any]:
+    """A message's key-value strings (``DiagnosticStatus.values``) with numbers as numbers.
+
+    Args:
+        values: The strings by key.
+
+    Returns:
+        Each value as an ``int`` or a ``float`` when it reads as one (``nan`` as ``None``,
+        as :func:`plain_json` writes it), else the string.
+    """
+    typed: dict[str, Any] = {}
+    for key, text in values.items():
+        try:
+            typed[key] = int(text)
+        except ValueError:
+            try:
+                typed[key] = float(text)
+            except ValueError:
+                typed[key] = text
+    plain: dict[str, Any] = plain_json(typed)
+    return plain
 
 
 def write_json(path: str | Path, result: dict[str, Any]) -> None:

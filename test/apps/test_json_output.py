@@ -46,3 +46,15 @@ def test_write_json_names_a_path_it_cannot_write(tmp_path):
     blocker.write_text('x')
     with pytest.raises(LumpbeamError, match=r'cannot write JSON to .*file/out\.json'):
         write_json(blocker / 'out.json', {'a': 1})
+
+
+def test_a_messages_values_are_written_as_numbers_where_they_are_numbers():
+    from lumpbeam_ros.apps.json_output import typed_values
+
+    values = {'mode_count': '2', 'natural_frequency_hz': '1.79', 'std': 'nan', 'status': 'OK'}
+    assert typed_values(values) == {
+        'mode_count': 2,
+        'natural_frequency_hz': 1.79,
+        'std': None,
+        'status': 'OK',
+    }

@@ -575,7 +575,9 @@ def add_bench(parser: argparse.ArgumentParser) -> None:
 )
 def add_demo(parser: argparse.ArgumentParser) -> None:
     """Declares ``lumpbeam demo``."""
-    parser.add_argument('--out', type=Path, default=Path('results'), help='output folder')
+    parser.add_argument(
+        '--out', type=Path, help='output folder (default results, with --arm results/arm)'
+    )
     parser.add_argument(
         '--duration', type=positive_float, default=12.0, help='record length, s (default 12)'
     )

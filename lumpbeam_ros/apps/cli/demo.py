@@ -6,6 +6,7 @@ Without ``--arm`` the synthetic drop test; with it the input-shaping loop on an 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from lumpbeam_ros.apps.cli.output import write_json
 
@@ -29,6 +30,7 @@ def run(args: argparse.Namespace) -> int:
             f'--domain-id must be in {DOMAIN_IDS.start}..{DOMAIN_IDS.stop - 1}, '
             f'got {args.domain_id}'
         )
+    args.out = output_folder(args.out, args.arm is not None)
     if args.out.exists() and not args.out.is_dir():
         raise LumpbeamError(f'--out {args.out} is a file, not a folder')
     if args.arm is not None:
@@ -60,6 +62,18 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Where the demos write when ``--out`` is not given: the two never share a folder.
+DEFAULT_OUT = Path('results')
+ARM_OUT = DEFAULT_OUT / 'arm'
+
+
+def output_folder(out: Path | None, arm: bool) -> Path:
+    """``--out``, or the demo's own folder under ``results/`` (the arm's in ``results/arm``)."""
+    if out is not None:
+        return out
+    return ARM_OUT if arm else DEFAULT_OUT
+
+
 #: The options of the drop test that the arm demo has no use for, with their defaults.
 BEAM_ONLY = {
     'duration': 12.0,
@@ -74,8 +88,6 @@ BEAM_ONLY = {
 
 def _run_arm(args: argparse.Namespace) -> int:
     """Runs the arm demo (``--arm``); refuses the drop test's options beside it."""
-    from pathlib import Path
-
     from lumpbeam_ros.apps.demo.arm_loop import ArmDemoOptions, run_arm_demo
     from lumpbeam_ros.base.errors import LumpbeamError
     from lumpbeam_ros.base.resources import config_path

@@ -33,7 +33,7 @@ import numpy as np
 
 from lumpbeam_ros.apps.demo.graph import ProcessGraph, node_command, python_command, wait_for_graph
 from lumpbeam_ros.apps.demo.run import BAGS_DIR, DemoFolders, fresh_bags_dir, run_steps
-from lumpbeam_ros.apps.json_output import write_json
+from lumpbeam_ros.apps.json_output import typed_values, write_json
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.base.interface import (
     BEAM_MARKERS,
@@ -486,7 +486,7 @@ def summarize(run: ArmDemoRun) -> None:
     outcome = _outcome(run)
     run.summary = {
         'arm_config': str(run.options.arm_config),
-        'identified': run.estimate,
+        'identified': typed_values(run.estimate),
         'shaper': run.shaper_log,
         'shaped_duration_added_s': run.added_s,
         'residual_unshaped_m': outcome.unshaped.residual_m,

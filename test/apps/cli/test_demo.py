@@ -176,3 +176,13 @@ def test_demo_names_the_hidden_latency_live_and_the_simulator_adopts_it(demo_res
     # The simulator accepted it through its parameter service (whenever the worker finished).
     assert live['adoption'].startswith('adopted by simulator_node: effects.sensor_latency')
     assert 'adoption: adopted by simulator_node' in printed
+
+
+def test_the_two_demos_write_to_folders_of_their_own():
+    from pathlib import Path
+
+    from lumpbeam_ros.apps.cli.demo import output_folder
+
+    assert output_folder(None, arm=False) == Path('results')
+    assert output_folder(None, arm=True) == Path('results/arm')
+    assert output_folder(Path('elsewhere'), arm=True) == Path('elsewhere')
