@@ -16,8 +16,7 @@ from lumpbeam_ros.core.model.parameters import load_beam_config, write_beam_conf
 
 def _summary(d: Diagnosis, seconds: float) -> str:
     lines = [
-        f'missing effect: {d.missing_effect}'
-        + ''.join(f'  ({k} = {v:.4g})' for k, v in d.effect_parameters.items()),
+        f'missing effect: {named_effects(d)}',
         f'  missing effects: {" + ".join(e.name for e in d.missing_effects) or "-"} '
         f'(confidence {d.confidence:.3g})',
         f'  {d.decision.reason}',
@@ -44,6 +43,16 @@ def _summary(d: Diagnosis, seconds: float) -> str:
 
 
 _REFIT = ('k_total_nm_per_rad', 'beta_identified')
+
+
+def named_effects(d: Diagnosis) -> str:
+    """The verdict: each named effect beside its own parameters (``'none'``, ``'unexplained'``)."""
+    if not d.missing_effects:
+        return d.missing_effect
+    return ' + '.join(
+        e.name + ''.join(f' ({k} = {v:.4g})' for k, v in e.parameters.items())
+        for e in d.missing_effects
+    )
 
 
 def run(args: argparse.Namespace) -> int:

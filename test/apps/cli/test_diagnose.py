@@ -127,3 +127,22 @@ def test_a_bag_too_short_after_dropping_poses_says_why(late_bag, tmp_path, capsy
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1
     assert 'need a longer record (dropped ' in err and 'with a NaN or inf stamp' in err
+
+
+def test_each_named_effect_is_printed_beside_its_own_parameter():
+    from types import SimpleNamespace
+
+    from lumpbeam_ros.apps.cli.diagnose import named_effects
+    from lumpbeam_ros.core.diagnose.workflow import NamedEffect
+
+    two = SimpleNamespace(
+        missing_effect='coulomb_friction',
+        missing_effects=(
+            NamedEffect('coulomb_friction', {'torque_nm': 1.003}, 0.8),
+            NamedEffect('sensor_latency', {'latency_s': 0.015}, 0.5),
+        ),
+    )
+    assert named_effects(two) == (
+        'coulomb_friction (torque_nm = 1.003) + sensor_latency (latency_s = 0.015)'
+    )
+    assert named_effects(SimpleNamespace(missing_effect='none', missing_effects=())) == 'none'
