@@ -127,7 +127,10 @@ def add_reproduce(parser: argparse.ArgumentParser) -> None:
 @_subcommand('synth', help='write a synthetic drop-test bag')
 def add_synth(parser: argparse.ArgumentParser) -> None:
     """Declares ``lumpbeam synth``."""
-    parser.add_argument('out', help='bag folder to create (must not exist)')
+    parser.add_argument('out', help='bag folder to create (must not exist, unless --force)')
+    parser.add_argument(
+        '--force', action='store_true', help='replace OUT when it is a bag (or a folder of bags)'
+    )
     parser.add_argument(
         '--loads',
         metavar='KG,KG,...',
@@ -148,7 +151,8 @@ def add_synth(parser: argparse.ArgumentParser) -> None:
         action='append',
         default=[],
         metavar='NAME=VALUE',
-        help='hide a physical effect of the diagnosis in the data (repeatable)',
+        help='hide a physical effect of the diagnosis in the data (repeatable); '
+        '--effect none hides nothing',
     )
     tracker = parser.add_argument_group('reference sensor (/tracker/point)')
     tracker.add_argument(
@@ -232,7 +236,10 @@ def tracker_pose(text: str) -> tuple[float, ...]:
 def add_track(parser: argparse.ArgumentParser) -> None:
     """Declares ``lumpbeam track``."""
     parser.add_argument('src', help='rosbag2 folder, video file, or folder of images')
-    parser.add_argument('out', help='bag folder to create (must not exist)')
+    parser.add_argument('out', help='bag folder to create (must not exist, unless --force)')
+    parser.add_argument(
+        '--force', action='store_true', help='replace OUT when it is a bag (or a folder of bags)'
+    )
     parser.add_argument('--config', help='camera file (default: config/camera.yaml)')
     parser.add_argument(
         '--camera-info', metavar='FILE', help='ROS camera calibration YAML (the intrinsics)'

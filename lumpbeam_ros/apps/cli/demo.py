@@ -36,15 +36,10 @@ def run(args: argparse.Namespace) -> int:
     if args.arm is not None:
         return _run_arm(args)
     from lumpbeam_ros.apps.demo.run import HIDDEN_EFFECT
-    from lumpbeam_ros.core.synthetic.drop_test import parse_effect
+    from lumpbeam_ros.core.synthetic.drop_test import parse_effects
     from lumpbeam_ros.core.synthetic.images import parse_image_size
 
-    if args.effect is None:
-        effects = dict(HIDDEN_EFFECT)
-    elif args.effect == ['none']:
-        effects = {}
-    else:
-        effects = dict(parse_effect(text) for text in args.effect)
+    effects = dict(HIDDEN_EFFECT) if args.effect is None else parse_effects(args.effect)
     size = None if args.no_images else parse_image_size(args.image_size)
     options = DemoOptions(
         out=args.out,

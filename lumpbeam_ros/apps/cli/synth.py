@@ -5,8 +5,9 @@ from __future__ import annotations
 import argparse
 
 from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.core.bagio.writer import replace_bags
 from lumpbeam_ros.core.model.parameters import BeamParameters, DropTestConfig, load_beam_config
-from lumpbeam_ros.core.synthetic.drop_test import SynthOptions, parse_effect, write_drop_test_bag
+from lumpbeam_ros.core.synthetic.drop_test import SynthOptions, parse_effects, write_drop_test_bag
 from lumpbeam_ros.core.synthetic.images import ImageOptions, parse_image_size
 from lumpbeam_ros.core.synthetic.reference_sensor import ReferenceSensorOptions
 
@@ -28,9 +29,11 @@ def _reference_sensor_options(args: argparse.Namespace) -> ReferenceSensorOption
 
 def run(args: argparse.Namespace) -> int:
     """Simulates and writes the bag, then prints what it holds."""
+    if args.force:
+        replace_bags(args.out)
     if args.arm is not None or args.trajectory is not None:
         return _write_arm(args)
-    effects = dict(parse_effect(text) for text in args.effect)
+    effects = parse_effects(args.effect)
     beam, drop = load_beam_config(args.config)
     options = SynthOptions(
         duration_s=args.duration,

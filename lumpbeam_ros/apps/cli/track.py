@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from pathlib import Path
 from typing import Any
 
 from lumpbeam_ros.apps.cli.output import write_json
@@ -58,11 +59,16 @@ class _ProgressBar:
 
 def run(args: argparse.Namespace) -> int:
     """Tracks SRC into OUT and prints the summary."""
+    from lumpbeam_ros.core.bagio.writer import replace_bags
     from lumpbeam_ros.core.vision.camera_info_file import read_camera_info_file
     from lumpbeam_ros.core.vision.config import load_camera_config, parse_board, with_board
     from lumpbeam_ros.core.vision.offline import track_bag, track_footage
     from lumpbeam_ros.core.vision.sources import FrameStamps, is_bag, open_footage
 
+    if args.force:
+        if Path(args.out).resolve() == Path(args.src).resolve():
+            raise LumpbeamError(f'--force would replace the source {args.src} with OUT')
+        replace_bags(args.out)
     config = load_camera_config(args.config)
     board = None if args.board is None else parse_board(args.board)
     config = with_board(config, board, args.square_m)

@@ -24,6 +24,11 @@ VERSION: Final = 9
 FILENAME = 'metadata.yaml'
 
 
+def is_bag(path: str | Path) -> bool:
+    """Tells whether ``path`` is a rosbag2 folder (it holds ``metadata.yaml``)."""
+    return (Path(path) / FILENAME).is_file()
+
+
 @dataclass(frozen=True)
 class TopicEntry:
     """A topic as the metadata lists it.

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import logging
 import operator
+import shutil
 import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -45,7 +46,7 @@ from rosbags.interfaces import Qos
 
 from lumpbeam_ros import __version__
 from lumpbeam_ros.base.closing import ClosedOnExit
-from lumpbeam_ros.base.errors import BagError
+from lumpbeam_ros.base.errors import BagError, LumpbeamError
 from lumpbeam_ros.base.interface import BASE_FRAME, CAMERA_FRAME, CLOCK
 from lumpbeam_ros.core.bagio import convert, metadata
 from lumpbeam_ros.core.bagio.qos import default_profile
@@ -70,6 +71,31 @@ class _Topic:
     channel_id: int
     qos: list[Qos]
     type_hash: str
+
+
+def replace_bags(path: str | Path) -> None:
+    """Removes a bag, or a folder of bags, so that it can be written anew (``--force``).
+
+    Nothing else is ever removed: a folder that is neither is refused.
+
+    Args:
+        path: The bag folder, or a folder whose every entry is a bag folder; nothing happens
+            when it does not exist.
+
+    Raises:
+        LumpbeamError: ``path`` is something else (a file, a folder with other things in it).
+    """
+    path = Path(path)
+    if not path.exists():
+        return
+    bags = path.is_dir() and (
+        metadata.is_bag(path) or all(metadata.is_bag(entry) for entry in path.iterdir())
+    )
+    if not bags:
+        raise LumpbeamError(
+            f'{path} exists and is not a bag (or a folder of bags): --force replaces bags only'
+        )
+    shutil.rmtree(path)
 
 
 class BagWriter(ClosedOnExit):

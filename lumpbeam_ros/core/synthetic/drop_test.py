@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import shutil
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -118,6 +118,23 @@ def parse_effect(text: str) -> tuple[str, float]:
     if problem is not None:
         raise LumpbeamError(f'--effect {text!r}: {EFFECT_PARAMETERS[name]} {problem}')
     return name, value
+
+
+#: ``--effect none``: no effect hidden at all (the demo hides one by default).
+NO_EFFECT = 'none'
+
+
+def parse_effects(texts: Sequence[str]) -> dict[str, float]:
+    """Parses every ``--effect`` given: ``NAME=VALUE`` each, or ``none`` alone.
+
+    Raises:
+        LumpbeamError: A bad ``NAME=VALUE`` (:func:`parse_effect`), or ``none`` beside others.
+    """
+    if list(texts) == [NO_EFFECT]:
+        return {}
+    if NO_EFFECT in texts:
+        raise LumpbeamError(f'--effect {NO_EFFECT} stands alone: it hides no effect')
+    return dict(parse_effect(text) for text in texts)
 
 
 def with_effects(beam: BeamParameters, effects: Mapping[str, float]) -> BeamParameters:

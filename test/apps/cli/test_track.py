@@ -157,3 +157,14 @@ def test_no_pose_in_any_frame_is_an_error_without_out(bag, tmp_path, capsys):
     assert err.startswith('lumpbeam track: error:') and len(err.splitlines()) == 1
     assert f'{dark}: no pose in any of its 12 frames (' in err and 'first:' in err
     assert not out.exists() and not (tmp_path / 'r.json').exists()
+
+
+def test_force_replaces_the_output_never_the_source(tmp_path, capsys):
+    from lumpbeam_ros.apps.cli.main import main as lumpbeam
+
+    src = tmp_path / 'src'
+    assert lumpbeam(['synth', str(src), '--duration', '3']) == 0
+    capsys.readouterr()
+    assert lumpbeam(['track', str(src), str(src), '--force']) == 2
+    assert 'would replace the source' in capsys.readouterr().err
+    assert (src / 'metadata.yaml').is_file()

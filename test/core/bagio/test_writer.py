@@ -6,7 +6,7 @@ import textwrap
 import numpy as np
 import pytest
 
-from lumpbeam_ros.base.errors import BagError
+from lumpbeam_ros.base.errors import BagError, LumpbeamError
 from lumpbeam_ros.core.bagio import BagReader, BagWriter, read_tip_poses
 
 from .helpers import write_drop_bag
@@ -165,3 +165,25 @@ def test_chunks_the_data_section_and_the_summary_carry_their_crcs(tmp_path):
     assert data_end.data_section_crc == zlib.crc32(data[:data_end_at]) != 0
     summary_crc_at = len(data) - 8 - 4  # the CRC precedes the closing magic
     assert footer.summary_crc == zlib.crc32(data[footer.summary_start : summary_crc_at]) != 0
+
+
+def test_replace_bags_removes_a_bag_or_a_folder_of_bags_and_nothing_else(tmp_path):
+    from lumpbeam_ros.core.bagio.metadata import is_bag
+    from lumpbeam_ros.core.bagio.writer import replace_bags
+
+    campaign = tmp_path / 'campaign'
+    for name in ('a', 'b'):
+        with BagWriter(campaign / name) as bag:
+            bag.write_float('/tip_load', 0.0, 4.5)
+    assert is_bag(campaign / 'a') and not is_bag(campaign)
+    replace_bags(tmp_path / 'absent')  # nothing to replace
+    replace_bags(campaign / 'a')
+    assert not (campaign / 'a').exists() and (campaign / 'b').exists()
+    replace_bags(campaign)
+    assert not campaign.exists()
+    other = tmp_path / 'other'
+    other.mkdir()
+    (other / 'x.txt').write_text('x')
+    with pytest.raises(LumpbeamError, match='not a bag'):
+        replace_bags(other)
+    assert (other / 'x.txt').exists()

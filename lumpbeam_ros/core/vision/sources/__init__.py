@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from lumpbeam_ros.core.bagio.metadata import is_bag
 from lumpbeam_ros.core.vision.sources.folder import FolderSource
 from lumpbeam_ros.core.vision.sources.frame import FootageFrame
 from lumpbeam_ros.core.vision.sources.stamps import FootageError, FrameStamps
@@ -32,11 +33,6 @@ __all__ = [
     'is_bag',
     'open_footage',
 ]
-
-
-def is_bag(path: str | Path) -> bool:
-    """Tells whether ``path`` is a rosbag2 folder (it holds ``metadata.yaml``)."""
-    return (Path(path) / 'metadata.yaml').is_file()
 
 
 def open_footage(
