@@ -29,6 +29,17 @@ import numpy as np
 
 from lumpbeam_ros.core.ident.stiffness import RAYLEIGH_BEAM_FRACTION
 
+#: The method in words, for a reader of the campaign's report (the module's docstring in full).
+METHOD = (
+    "EI comes from the tip's static rise when the hanging load leaves (B.3): a weighted "
+    'straight line through the origin of the rise against the load, whose slope is '
+    "L^3 / (3 EI); k_tE = 2 EI / L (B.6, B.12). The beam's own mass comes from the level "
+    'the unloaded tip settles to, its weight a uniform load and the mounted mass an end load '
+    '(B.1, B.3, B.5). As a check, the unloaded frequency predicted from EI and the mass '
+    "(Rayleigh's effective mass) is set beside the measured one. Standard deviations come "
+    "from the bags' own and grow when the bags scatter more than those say."
+)
+
 
 @dataclass(frozen=True)
 class BeamFit:

@@ -41,6 +41,10 @@ class LoadGroup:
     stds: dict[str, float]
 
 
+#: The columns of a diagnosed bag's effect parameters (``lumpbeam diagnose``'s JSON, flat).
+EFFECT_COLUMNS = 'effect_parameters.'
+
+
 @dataclass(frozen=True)
 class CampaignSummary:
     """What a campaign shows.
@@ -62,6 +66,21 @@ class CampaignSummary:
     beam_fit: BeamFit | None
     beam: BeamParameters
     beam_fit_error: str = ''
+
+    @property
+    def diagnoses(self) -> list[tuple[str, str, str]]:
+        """``(bag, missing effect, its parameters)`` of every bag diagnosed, in row order."""
+        found = []
+        for row in self.ok:
+            if not row.get('diagnosed') or row.get('missing_effect') is None:
+                continue
+            parameters = ', '.join(
+                f'{key.removeprefix(EFFECT_COLUMNS)} = {value:.4g}'
+                for key, value in row.items()
+                if key.startswith(EFFECT_COLUMNS) and isinstance(value, int | float)
+            )
+            found.append((str(row['path']), str(row['missing_effect']), parameters))
+        return found
 
     @property
     def configured(self) -> dict[str, float]:
@@ -103,6 +122,10 @@ class CampaignSummary:
                 f'  frequency check: predicted {fit.frequency_predicted_hz:.5g} Hz from EI and '
                 f'm_b, measured {measured} Hz',
             ]
+        for path, effect, parameters in self.diagnoses:
+            lines.append(
+                f'diagnosis: {path}: {effect}' + (f' ({parameters})' if parameters else '')
+            )
         for path, error in self.failed:
             lines.append(
                 f'failed: {error}' if error.startswith(path) else f'failed: {path}: {error}'
@@ -284,7 +307,7 @@ def write_campaign_report(summary: CampaignSummary, path: str | Path) -> Path:
         ],
     )
     page.heading("The beam across the campaign (the paper's Table B.1 method, from data)")
-    page.paragraph(' '.join((fit_module.__doc__ or '').split()))
+    page.paragraph(fit_module.METHOD)
     fit = summary.beam_fit
     if fit is None:
         page.paragraph(f'No fit: {summary.beam_fit_error}', note=True)
@@ -318,6 +341,9 @@ def write_campaign_report(summary: CampaignSummary, path: str | Path) -> Path:
             ],
         )
     page.png(summary_figure(summary), 'frequency, damping and stiffness against the load')
+    if summary.diagnoses:
+        page.heading('The diagnosis of each bag (lumpbeam diagnose)')
+        page.table(['bag', 'missing effect', 'its parameters'], summary.diagnoses)
     if summary.failed:
         page.heading('Bags without results')
         page.table(['bag', 'error'], [list(item) for item in summary.failed])

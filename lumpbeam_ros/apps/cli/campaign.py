@@ -29,11 +29,14 @@ def run(args: argparse.Namespace) -> int:
         stream=sys.stderr,
         timeout_s=args.connect_timeout,
     )
-    rate = result.submitted / result.seconds if result.seconds > 0 else float('nan')
+    rate = (
+        f' ({result.submitted / result.seconds:.2f} bags/s)'
+        if result.submitted and result.seconds > 0
+        else ''
+    )
     print(
         f'{len(bags)} bags: {result.submitted} run on {result.workers} workers in '
-        f'{result.seconds:.1f} s ({rate:.2f} bags/s), {result.skipped} already done, '
-        f'{result.failed} failed'
+        f'{result.seconds:.1f} s{rate}, {result.skipped} already done, {result.failed} failed'
     )
     summary = summarize(store.completed(), beam)
     print(summary.text())

@@ -108,6 +108,11 @@ def test_cli_campaign_writes_table_and_report(campaign_bags, tmp_path):
         assert (tmp_path / 'out' / name).is_file()
     html = (tmp_path / 'out' / 'report.html').read_text()
     assert 'data:image/png;base64,' in html and 'EI, N m^2' in html
+    # A rerun has nothing new to run: no rate of nothing over no time.
+    code, out, _ = _run(
+        ['campaign', *map(str, campaign_bags), '--out', str(tmp_path / 'out'), '--workers', '1']
+    )
+    assert code == 0 and '3 already done' in out and 'nan' not in out
 
 
 #: A process that starts a local cluster once it has said so (its imports done), and exits

@@ -164,3 +164,23 @@ def test_a_report_that_cannot_be_written_is_a_clear_error(tmp_path, name, match)
     (tmp_path / 'a_file').write_text('x')
     with pytest.raises(LumpbeamError, match=match):
         write_campaign_report(summarize([], BEAM), tmp_path / name)
+
+
+def test_the_diagnosed_effects_are_in_the_text_and_the_report(tmp_path):
+    rows = [_row(load, k) for k, load in enumerate(LOADS)]
+    rows[0].update(
+        {'diagnosed': True, 'missing_effect': 'coulomb_friction',
+         'effect_parameters.torque_nm': 1.003}
+    )  # fmt: skip
+    rows[1].update({'diagnosed': True, 'missing_effect': 'none'})
+    summary = summarize(rows, BEAM)
+    assert summary.diagnoses == [
+        ('/bags/1kg_0', 'coulomb_friction', 'torque_nm = 1.003'),
+        ('/bags/1kg_1', 'none', ''),
+    ]
+    text = summary.text().splitlines()
+    assert 'diagnosis: /bags/1kg_0: coulomb_friction (torque_nm = 1.003)' in text
+    page = html.unescape(write_campaign_report(summary, tmp_path / 'r.html').read_text())
+    assert 'The diagnosis of each bag' in page and 'torque_nm = 1.003' in page
+    # The method is in words, not the module's reStructuredText.
+    assert '``' not in page and 'L^3 / (3 EI)' in page
