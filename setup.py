@@ -36,6 +36,7 @@ setup(
             glob('config/*.yaml') + glob('config/*.json') + glob('config/*.rviz'),
         ),
         (f'share/{PACKAGE}/launch', glob('launch/*.launch.yaml')),
+        (f'share/{PACKAGE}/examples', glob('examples/*.csv')),
     ],
     package_data={f'{PACKAGE}.base': ['data/*.csv', 'data/*.xml']},
     install_requires=REQUIRES,

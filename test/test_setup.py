@@ -79,6 +79,8 @@ def test_colcon_installs_the_package_index_configs_and_data(install_space):
     assert {p.name for p in (ROOT / 'config').iterdir()} <= shipped
     launch = {p.name for p in (share / PACKAGE / 'launch').iterdir()}
     assert {p.name for p in (ROOT / 'launch').glob('*.launch.yaml')} <= launch
+    examples = {p.name for p in (share / PACKAGE / 'examples').iterdir()}
+    assert {p.name for p in (ROOT / 'examples').glob('*.csv')} <= examples
     (site,) = (install_space / 'lib').glob('python3*/site-packages')
     data = {p.name for p in (site / PACKAGE / 'base' / 'data').iterdir()}
     assert {p.name for p in (ROOT / PACKAGE / 'base' / 'data').iterdir()} <= data

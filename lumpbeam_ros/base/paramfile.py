@@ -15,7 +15,7 @@ from typing import Any
 import yaml
 
 from lumpbeam_ros.base.errors import ConfigError
-from lumpbeam_ros.base.resources import config_path
+from lumpbeam_ros.base.resources import config_path, packaged
 
 #: libyaml's loader when PyYAML was built with it: the same safe subset of YAML, parsed ten
 #: times faster than the pure-Python one (a command reads two or three files as it starts).
@@ -69,7 +69,7 @@ def read_yaml_document(path: str | Path) -> Any:
     Raises:
         ConfigError: The file is missing, unreadable or not YAML.
     """
-    path = Path(path)
+    path = packaged(path)
     try:
         text = path.read_text(encoding='utf-8')
     except FileNotFoundError:

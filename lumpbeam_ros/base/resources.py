@@ -39,6 +39,29 @@ def share_dir() -> Path:
     raise FileNotFoundError(f'{PACKAGE}: the share folder (config/, launch/) is not installed')
 
 
+def packaged(path: str | Path) -> Path:
+    """A file given by path, or the installed package's own of that relative path.
+
+    The docs name the package's files by their place in the repository (``config/...``,
+    ``launch/...``, ``examples/...``); after a wheel or colcon install they are in the share
+    folder instead, and the same words find them there.
+
+    Args:
+        path: A file, as the user gave it.
+
+    Returns:
+        ``path`` when it exists, or is absolute; else the share folder's file of that relative
+        path when there is one; else ``path`` (for the caller's "no such file").
+    """
+    given = Path(path)
+    if given.exists() or given.is_absolute():
+        return given
+    for share in _candidate_share_dirs():
+        if (share / given).is_file():
+            return share / given
+    return given
+
+
 def config_path(name: str) -> Path:
     """Returns the path of a default configuration file.
 

@@ -75,3 +75,17 @@ def test_the_large_frames_profile_gives_whole_frames_room():
     used = {e.text for e in default[0].iter(f'{FASTDDS}transport_id')}
     declared = {e.text for e in root.iter(f'{FASTDDS}transport_id')} - used
     assert 'shm_large' in used and not declared  # every transport declared is used
+
+
+def test_a_packaged_file_is_found_by_its_repository_path_from_anywhere(tmp_path, monkeypatch):
+    from lumpbeam_ros.base.resources import packaged, share_dir
+
+    monkeypatch.chdir(tmp_path)
+    assert packaged('config/arm_3link.yaml') == share_dir() / 'config' / 'arm_3link.yaml'
+    assert packaged('examples/two_joint_move.csv').is_file()
+    # A file where the user runs wins; an absolute path and a missing one stay as given.
+    (tmp_path / 'config').mkdir()
+    (tmp_path / 'config' / 'arm_3link.yaml').write_text('mine')
+    assert packaged('config/arm_3link.yaml') == Path('config/arm_3link.yaml')
+    assert packaged(tmp_path / 'no.yaml') == tmp_path / 'no.yaml'
+    assert packaged('config/no_such.yaml') == Path('config/no_such.yaml')

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from lumpbeam_ros.base.errors import ConfigError, LumpbeamError
+from lumpbeam_ros.base.resources import packaged
 
 #: Name of the time column, the first of a trajectory file.
 TIME_COLUMN = 'time_s'
@@ -117,7 +118,7 @@ def read_trajectory_csv(path: str | Path) -> JointTrajectory:
             by ``joint_1`` ... ``joint_n``, a row has another number of values, a value is
             not a finite number, the times do not increase, or it has fewer than 2 rows.
     """
-    path = Path(path)
+    path = packaged(path)
     try:
         with path.open(encoding='utf-8', newline='') as file:
             rows = [(n, row) for n, row in enumerate(csv.reader(file), start=1) if row]
