@@ -77,13 +77,19 @@ POLL_PERIOD_S = 0.1
 
 
 def _start_worker() -> None:
-    """Readies a worker process: it ignores Ctrl-C, yields the CPU, imports the workflow.
+    """Readies a worker process: the node's signals left to it, the CPU yielded, imports done.
 
-    Ctrl-C is for the node, which then ends the worker. A diagnosis is background work: at a
-    lower priority it does not starve the nodes that must keep up with the stream (a camera
-    node tracking frames) on a machine with few cores. The import is done now rather than
+    Ctrl-C is for the node, which then ends the worker; so is a signal to the node's process
+    group, which the worker leaves (it ends with the node all the same: its task pipe
+    closes). A diagnosis is background work: at a lower priority it does not starve the
+    nodes that must keep up with the stream (a camera node tracking frames) on a machine
+    with few cores. The import is done now rather than
     when the first diagnosis waits for it.
     """
+    # A signal to the node's process group (a terminal's Ctrl-C, a launcher's SIGTERM) is the
+    # node's to act on: it ends the worker itself. Killed by it here, the worker would be
+    # started again by the pool while the node stops, and the node would wait on the new one.
+    os.setpgrp()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     os.nice(WORKER_NICENESS)
     import lumpbeam_ros.core.diagnose.workflow  # noqa: F401

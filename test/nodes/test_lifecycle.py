@@ -5,6 +5,7 @@ from __future__ import annotations
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -312,3 +313,68 @@ def test_an_unknown_parameter_is_warned_about_and_the_node_says_it_is_ready(ros_
     assert "unknown parameter 'no_such_param': not a parameter of shaper_node" in text
     assert any(line.rstrip().endswith('ready') for line in lines), text
     assert code == 0
+
+
+def _children(pid: int) -> set[int]:
+    """Every descendant of a process (Linux's /proc children lists)."""
+    found: set[int] = set()
+    todo = [pid]
+    while todo:
+        parent = todo.pop()
+        for task in Path(f'/proc/{parent}/task').glob('*'):
+            try:
+                kids = {int(k) for k in (task / 'children').read_text().split()}
+            except OSError:
+                continue
+            todo += sorted(kids - found)
+            found |= kids
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f'/proc/{pid}/stat').read_text().split(') ', 1)[1][0]
+    except (OSError, IndexError):
+        return False
+    return state != 'Z'
+
+
+#: A hang, not a slow stop, is what this catches (the stop takes 0.2 to 2 s here).
+STOP_BOUND_S = 10.0
+
+
+@pytest.mark.parametrize('sig', SIGNALS, ids=lambda s: s.name)
+@pytest.mark.parametrize('node', NODE_NAMES)
+def test_a_signal_to_the_process_group_stops_the_node_and_its_children(ros_domain_id, node, sig):
+    import os
+    import threading
+
+    env = ros_env(ros_domain_id)
+    env['PYTHONPATH'] = str(ROOT)
+    process = subprocess.Popen(
+        [sys.executable, '-m', f'lumpbeam_ros.nodes.{node}'],
+        env=env,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    lines: list[str] = []
+    for line in process.stderr:
+        lines.append(line)
+        if line.rstrip().endswith('ready'):
+            break
+    threading.Thread(target=lambda: lines.extend(process.stderr), daemon=True).start()
+    time.sleep(1.0)  # the diagnosis node's worker starts after the node is ready
+    family = _children(process.pid)
+    started = time.monotonic()
+    os.killpg(process.pid, sig)
+    while time.monotonic() - started < STOP_BOUND_S and (
+        process.poll() is None or any(_alive(pid) for pid in family)
+    ):
+        time.sleep(0.05)
+    left = [pid for pid in family if _alive(pid)]
+    if process.poll() is None or left:
+        os.killpg(process.pid, signal.SIGKILL)
+        for pid in left:
+            os.kill(pid, signal.SIGKILL)
+    assert process.wait(5) == 0 and not left, ''.join(lines)[-2000:]
