@@ -9,24 +9,17 @@ from __future__ import annotations
 import argparse
 import signal
 import subprocess
-import sys
 import time
 from typing import Any
 
+from lumpbeam_ros.apps.demo.graph import launched_command
 from lumpbeam_ros.base.errors import LumpbeamError
-from lumpbeam_ros.nodes.launch_file import NodeLaunch, parse_assignments, read_launch_file
+from lumpbeam_ros.nodes.launch_file import parse_assignments, read_launch_file
 
 #: How often the children are looked at, s.
 POLL_S = 0.1
 #: How long the children have to stop after SIGINT before they are killed, s.
 STOP_GRACE_S = 10.0
-#: A node's console script (``setup.py``), run by this interpreter.
-_SCRIPT = 'import sys; from lumpbeam_ros.nodes.scripts import {} as main; sys.exit(main())'
-
-
-def node_command(node: NodeLaunch) -> list[str]:
-    """The command that starts a node as its console script does, with this interpreter."""
-    return [sys.executable, '-c', _SCRIPT.format(node.executable), *node.argv()]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -50,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
     ended: tuple[str, int] | None = None
     try:
         for node in plan.nodes:
-            children.append((node.label, subprocess.Popen(node_command(node))))
+            children.append((node.label, subprocess.Popen(launched_command(node))))
         labels = ', '.join(label for label, _ in children)
         print(f'lumpbeam launch: started {labels} from {plan.source}', flush=True)
         while not stop['requested'] and ended is None:

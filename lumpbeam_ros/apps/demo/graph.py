@@ -15,13 +15,14 @@ import subprocess
 import sys
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import IO
 
 from lumpbeam_ros.base.closing import ClosedOnExit
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.base.resources import large_frames_profile
+from lumpbeam_ros.nodes.launch_file import NodeLaunch
 from lumpbeam_ros.nodes.ros_domain import PRIVATE_DOMAIN_IDS, claim_domain_id
 
 #: The domains a graph may use (see :mod:`lumpbeam_ros.nodes.ros_domain`).
@@ -39,15 +40,26 @@ def python_command(module: str, *args: str) -> list[str]:
     return [sys.executable, '-m', module, *args]
 
 
-def node_command(module: str, *ros_args: str) -> list[str]:
-    """The command that runs a node as its console script does, with ``--ros-args ros_args``.
+def script_command(script: str, *args: str) -> list[str]:
+    """The command that runs a node's console script (``identifier_node``) with this interpreter.
 
     Through :mod:`lumpbeam_ros.nodes.scripts`: the signal handlers come before the node's
-    imports, so stopping the demo early stops a node that is still starting.
+    imports, so stopping the graph early stops a node that is still starting.
     """
-    script = module.rpartition('.')[2]
     code = f'import sys; from lumpbeam_ros.nodes.scripts import {script}; sys.exit({script}())'
-    return [sys.executable, '-c', code, '--ros-args', *ros_args]
+    return [sys.executable, '-c', code, *args]
+
+
+def node_command(module: str, *ros_args: str) -> list[str]:
+    """The command that runs a node's module as its console script, with ``--ros-args``."""
+    return script_command(module.rpartition('.')[2], '--ros-args', *ros_args)
+
+
+def launched_command(node: NodeLaunch, *ros_args: str) -> list[str]:
+    """The command that starts a launch file's node, with more ``--ros-args`` after its own."""
+    return script_command(
+        node.executable, *replace(node, ros_args=(*node.ros_args, *ros_args)).argv()
+    )
 
 
 @dataclass

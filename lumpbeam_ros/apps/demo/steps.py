@@ -2,7 +2,8 @@
 
 1. ``synthesize``: a drop-test bag (``/tip_pose`` with noise, ``/tip_pose_truth``,
    ``/tip_load``; images once the synthetic camera writes them).
-2. ``replay``: the live graph as separate processes on a private ROS domain: the player
+2. ``replay``: the live graph as separate processes on a private ROS domain, the nodes as
+   ``launch/drop_test.launch.yaml`` starts them (``use_sim_time:=true``): the player
    (``lumpbeam play``, with ``/clock``), the simulator node (``use_sim_time``), the identifier
    node and the camera node when they are installed (the camera only for a bag with images;
    it then makes ``/tip_pose`` from the images instead of the player), and the recorder
@@ -32,7 +33,7 @@ from collections.abc import Callable, Sequence
 from lumpbeam_ros.apps.demo.accounting import count
 from lumpbeam_ros.apps.demo.graph import (
     ProcessGraph,
-    node_command,
+    launched_command,
     python_command,
     wait_for_graph,
     wait_for_quiet,
@@ -71,17 +72,24 @@ from lumpbeam_ros.apps.json_output import plain_json, write_json
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.base.interface import (
     BEAM_PARAMS,
+    CAMERA_NODE,
     CLOCK,
     DIAGNOSIS_NODE,
+    IDENTIFIER_NODE,
     RECORDER_NODE,
     SIMULATOR_NODE,
     TIP_LOAD,
     TIP_POSE,
     TIP_POSE_PREDICTED,
 )
+from lumpbeam_ros.base.resources import packaged
 from lumpbeam_ros.core.bagio import BagReader, read_tip_poses
 from lumpbeam_ros.core.model.parameters import load_beam_config
 from lumpbeam_ros.nodes.counts import COUNTS_DIR_ENV
+from lumpbeam_ros.nodes.launch_file import NodeLaunch, read_launch_file
+
+#: The graph the demo replays the experiment through (share folder, or the repository).
+LAUNCH_FILE = 'launch/drop_test.launch.yaml'
 
 
 def synthesize(run: DemoRun) -> None:
@@ -111,12 +119,8 @@ def replay(run: DemoRun) -> None:
     """Runs the live graph on the synthetic bag and records it (``out/bags/recorded``)."""
     topics = BagReader(run.input_bag).topics
     run.with_camera = IMAGE_TOPIC in topics and module_available(CAMERA_MODULE)
-    sim_time = ('-p', 'use_sim_time:=true')
-    simulator_args = [
-        *sim_time,
-        '-p',
-        f'adopt_identified:={str(run.options.adopt_identified).lower()}',
-    ]
+    nodes = launched_nodes()
+    simulator_args = ['-p', f'adopt_identified:={str(run.options.adopt_identified).lower()}']
     if run.options.beam_config is not None:
         simulator_args += ['-p', f'beam_config:={run.options.beam_config}']
     # Readers each recorded topic must have before the replay: the probe's and the
@@ -129,17 +133,17 @@ def replay(run: DemoRun) -> None:
     with ProcessGraph(run.log_dir, run.options.domain_id) as graph:
         graph.env[COUNTS_DIR_ENV] = str(run.counts_dir)
         run.echo(f'  ROS_DOMAIN_ID={graph.domain_id}, logs in {run.log_dir}')
-        graph.start('simulator', node_command(SIMULATOR_MODULE, *simulator_args))
+        graph.start('simulator', launched_command(nodes[SIMULATOR_NODE], *simulator_args))
         run.nodes = [SIMULATOR_MODULE]
         if module_available(IDENTIFIER_MODULE):
-            graph.start('identifier', node_command(IDENTIFIER_MODULE, *sim_time))
+            graph.start('identifier', launched_command(nodes[IDENTIFIER_NODE]))
             run.nodes.append(IDENTIFIER_MODULE)
             readers[TIP_POSE] += 1
             readers[TIP_LOAD] += 1
         if module_available(DIAGNOSIS_NODE_MODULE):
-            _start_diagnosis_node(graph, run, readers)
+            _start_diagnosis_node(graph, run, readers, nodes[DIAGNOSIS_NODE])
         if run.with_camera:
-            graph.start('camera', node_command(CAMERA_MODULE, *sim_time))
+            graph.start('camera', launched_command(nodes[CAMERA_NODE]))
             run.nodes.append(CAMERA_MODULE)
             readers[IMAGE_TOPIC] = 1
         graph.start(
@@ -195,13 +199,25 @@ def replay(run: DemoRun) -> None:
     run.echo(f'  recorded {run.recorded_bag} with {", ".join(run.nodes)}')
 
 
-def _start_diagnosis_node(graph: ProcessGraph, run: DemoRun, readers: dict[str, int]) -> None:
+def launched_nodes() -> dict[str, NodeLaunch]:
+    """The nodes of the drop-test chain's launch file on sim time, by executable.
+
+    The demo runs the graph a user starts with ``lumpbeam launch`` (or ``ros2 launch``),
+    each node with the few settings of the demo's own added.
+    """
+    plan = read_launch_file(packaged(LAUNCH_FILE), {'use_sim_time': 'true'})
+    return {node.executable: node for node in plan.nodes}
+
+
+def _start_diagnosis_node(
+    graph: ProcessGraph, run: DemoRun, readers: dict[str, int], node: NodeLaunch
+) -> None:
     """Starts the diagnosis node on the ring-down, adopting into the simulator."""
-    args = ['-p', 'use_sim_time:=true', '-p', 'adopt:=true']
+    args = ['-p', 'adopt:=true']
     args += ['-p', f'ring_down.decay_s:={LIVE_DECAY_S}']
     if run.options.beam_config is not None:
         args += ['-p', f'beam_config:={run.options.beam_config}']
-    graph.start('diagnosis', node_command(DIAGNOSIS_NODE_MODULE, *args))
+    graph.start('diagnosis', launched_command(node, *args))
     run.nodes.append(DIAGNOSIS_NODE_MODULE)
     for topic in (TIP_POSE, TIP_LOAD, TIP_POSE_PREDICTED):
         readers[topic] += 1
