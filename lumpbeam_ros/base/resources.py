@@ -54,11 +54,14 @@ def packaged(path: str | Path) -> Path:
         path when there is one; else ``path`` (for the caller's "no such file").
     """
     given = Path(path)
-    if given.exists() or given.is_absolute():
-        return given
-    for share in _candidate_share_dirs():
-        if (share / given).is_file():
-            return share / given
+    try:
+        if given.exists() or given.is_absolute():
+            return given
+        for share in _candidate_share_dirs():
+            if (share / given).is_file():
+                return share / given
+    except OSError:
+        pass  # a name the system refuses (too long): the caller's read says so
     return given
 
 

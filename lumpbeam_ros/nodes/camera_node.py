@@ -437,6 +437,7 @@ def main(args: Sequence[str] | None = None) -> int:
 def _run(node: CameraNode) -> None:
     """Spins a live node; a node given a bag or footage reads it through, then says so."""
     if not node.in_process:
+        node.get_logger().info('ready')
         spin_events(node)
         return
 

@@ -96,7 +96,10 @@ def run_node(
             print(f'{name}: error: bad --ros-args ({exc})', file=sys.stderr)
             return CONFIG_ERROR
         node = make()
-        node.get_logger().info('ready')
+        if run in (rclpy.spin, spin_events, spin_live):
+            # A node that joins the graph says so once; one that reads a bag through (the
+            # camera node given a bag) is a batch job and says what it reads instead.
+            node.get_logger().info('ready')
         run(node)
     except (LumpbeamError, ParameterException) as exc:
         print(f'{name}: error: {exc}', file=sys.stderr)
