@@ -9,6 +9,7 @@ from pathlib import Path
 
 from lumpbeam_ros.apps.cli.output import write_json
 from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.core.diagnose.live import named_effects
 from lumpbeam_ros.core.diagnose.measurement import read_record
 from lumpbeam_ros.core.diagnose.workflow import Diagnosis, diagnose
 from lumpbeam_ros.core.model.parameters import load_beam_config, write_beam_config
@@ -16,7 +17,7 @@ from lumpbeam_ros.core.model.parameters import load_beam_config, write_beam_conf
 
 def _summary(d: Diagnosis, seconds: float) -> str:
     lines = [
-        f'missing effect: {named_effects(d)}',
+        f'missing effect: {verdict_text(d)}',
         f'  missing effects: {" + ".join(e.name for e in d.missing_effects) or "-"} '
         f'(confidence {d.confidence:.3g})',
         f'  {d.decision.reason}',
@@ -45,13 +46,14 @@ def _summary(d: Diagnosis, seconds: float) -> str:
 _REFIT = ('k_total_nm_per_rad', 'beta_identified')
 
 
-def named_effects(d: Diagnosis) -> str:
+def verdict_text(d: Diagnosis) -> str:
     """The verdict: each named effect beside its own parameters (``'none'``, ``'unexplained'``)."""
-    if not d.missing_effects:
+    named = named_effects(d)
+    if not named:
         return d.missing_effect
     return ' + '.join(
-        e.name + ''.join(f' ({k} = {v:.4g})' for k, v in e.parameters.items())
-        for e in d.missing_effects
+        name + ''.join(f' ({k} = {v:.4g})' for k, v in parameters.items())
+        for name, parameters in named
     )
 
 

@@ -106,6 +106,8 @@ MARGIN_S = 0.5
 LEFT_RINGING = 0.02
 #: ... but at most this long, s (a lightly damped arm would keep the demo waiting minutes).
 MAX_GAP_S = 30.0
+#: How long the children get to match each other's endpoints once the probe sees them all, s.
+SETTLE_S = 2.0
 #: Longest wait for the identifier's OK estimate and the shaper's adoption after move 1, s.
 ESTIMATE_TIMEOUT_S = 60.0
 #: Longest wait for the simulators to publish past a residual window, s (wall time: a busy
@@ -345,6 +347,11 @@ def _drive(graph: ProcessGraph, run: ArmDemoRun) -> None:
             run.options.ready_timeout_s,
             'the nodes did not discover the demo (its commands and its camera)',
         )
+        # The probe sees every endpoint, but not whether the children have matched each
+        # other's: the shaper's forward of move 1 reached the arm and not the recorder once,
+        # on a loaded machine. The children's own discovery gets a moment more.
+        settled = time.monotonic() + SETTLE_S
+        spin_until(lambda: time.monotonic() > settled, SETTLE_S + 1.0, 'settling')
         # Move 1: the shaper has no estimate yet and forwards it unshaped.
         start = publish(move_out)
         end_1 = start + float(move_out.time_s[-1])

@@ -6,6 +6,7 @@ frequency against the amplitude, the envelope law of the peaks.
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import matplotlib
@@ -16,6 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
+from lumpbeam_ros.apps.plots.lines import broken_at_gaps  # noqa: E402
 from lumpbeam_ros.base.errors import LumpbeamError  # noqa: E402
 from lumpbeam_ros.core.diagnose.gap import SETTLE_S  # noqa: E402
 from lumpbeam_ros.core.diagnose.live import named_effects  # noqa: E402
@@ -23,6 +25,9 @@ from lumpbeam_ros.core.diagnose.signatures import decay_peaks  # noqa: E402
 from lumpbeam_ros.core.diagnose.workflow import Diagnosis  # noqa: E402
 from lumpbeam_ros.core.model.parameters import EFFECTS  # noqa: E402
 from lumpbeam_ros.core.model.trajectory import TipTrajectory  # noqa: E402
+
+#: The candidates figure's title is wrapped at this many characters (its reason is long).
+TITLE_CHARS = 160
 
 #: The files :func:`plot_diagnosis` writes.
 FIGURES = (
@@ -45,8 +50,13 @@ def _fit_figure(d: Diagnosis, path: Path) -> None:
     label_after = f'augmented ({d.missing_effect})'
     for ax, name, scale, unit in ((axes[0], 'z', 1e3, 'mm'), (axes[1], 'pitch', 1e3, 'mrad')):
         ax.plot(r.t, getattr(r, name) * scale, '.', ms=1.5, color='0.5', label='measured')
-        ax.plot(d.before.t, getattr(d.before, name) * scale, lw=1.0, label='nominal (refit)')
-        ax.plot(d.after.t, getattr(d.after, name) * scale, lw=1.0, ls='--', label=label_after)
+        ax.plot(
+            *broken_at_gaps(d.before.t, getattr(d.before, name) * scale),
+            lw=1.0,
+            label='nominal (refit)',
+        )
+        ax.plot(*broken_at_gaps(d.after.t, getattr(d.after, name) * scale), lw=1.0, ls='--',
+                label=label_after)  # fmt: skip
         ax.axvline(d.train_end_s, color='k', lw=0.6, ls=':')
         ax.set_ylabel(f'tip {name}, {unit}')
     axes[0].legend(loc='lower right', fontsize=8)
@@ -62,8 +72,13 @@ def _residual_figure(d: Diagnosis, path: Path) -> None:
     r = d.record
     before = (d.before.z - r.z) * 1e6
     after = (d.after.z - r.z) * 1e6
-    ax.plot(r.t, before, lw=0.7, label=f'nominal: rms {d.gap_before.rms_m * 1e6:.1f} um')
-    ax.plot(r.t, after, lw=0.7, label=f'augmented: rms {d.gap_after.rms_m * 1e6:.1f} um')
+    ax.plot(
+        *broken_at_gaps(r.t, before),
+        lw=0.7,
+        label=f'nominal: rms {d.gap_before.rms_m * 1e6:.1f} um',
+    )
+    ax.plot(*broken_at_gaps(r.t, after), lw=0.7,
+            label=f'augmented: rms {d.gap_after.rms_m * 1e6:.1f} um')  # fmt: skip
     noise = d.noise_z_m * 1e6
     ax.axhspan(-noise, noise, color='0.85', label=f'noise +-{noise:.1f} um')
     ax.axvline(d.train_end_s, color='k', lw=0.6, ls=':')
@@ -189,7 +204,8 @@ def _candidate_figure(d: Diagnosis, path: Path) -> None:
     axes[1].axvline(1.0, color='k', lw=0.6, ls=':')
     axes[1].set_xlabel('held-out chi2 / n (dotted: the noise)')
     axes[1].invert_yaxis()
-    fig.suptitle(f'Candidates (green: named, red: unphysical): {d.decision.reason}', fontsize=8)
+    title = f'Candidates (green: named, red: unphysical): {d.decision.reason}'
+    fig.suptitle(textwrap.fill(title, TITLE_CHARS), fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

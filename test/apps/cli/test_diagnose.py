@@ -132,7 +132,7 @@ def test_a_bag_too_short_after_dropping_poses_says_why(late_bag, tmp_path, capsy
 def test_each_named_effect_is_printed_beside_its_own_parameter():
     from types import SimpleNamespace
 
-    from lumpbeam_ros.apps.cli.diagnose import named_effects
+    from lumpbeam_ros.apps.cli.diagnose import verdict_text
     from lumpbeam_ros.core.diagnose.workflow import NamedEffect
 
     two = SimpleNamespace(
@@ -142,7 +142,7 @@ def test_each_named_effect_is_printed_beside_its_own_parameter():
             NamedEffect('sensor_latency', {'latency_s': 0.015}, 0.5),
         ),
     )
-    assert named_effects(two) == (
+    assert verdict_text(two) == (
         'coulomb_friction (torque_nm = 1.003) + sensor_latency (latency_s = 0.015)'
     )
-    assert named_effects(SimpleNamespace(missing_effect='none', missing_effects=())) == 'none'
+    assert verdict_text(SimpleNamespace(missing_effect='none', missing_effects=())) == 'none'
