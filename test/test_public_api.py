@@ -50,6 +50,18 @@ def test_a_package_names_its_public_api_once_and_every_name_exists(init):
     assert missing == []
 
 
+@pytest.mark.parametrize('init', INITS, ids=lambda p: p.parent.relative_to(PACKAGE).as_posix())
+def test_a_package_that_lists_its_modules_lists_every_one(init):
+    # A face of re-exported names (core.bagio's BagReader, ...) lists no module; one that
+    # lists modules lists them all, so a new module is on the API reference at once.
+    (names,), _ = _faces(init)
+    folder = init.parent
+    modules = {p.stem for p in folder.glob('*.py') if not p.stem.startswith('_')}
+    modules |= {p.parent.name for p in folder.glob('*/__init__.py')}
+    if modules & set(names):
+        assert sorted(modules - set(names)) == []
+
+
 def test_the_check_sees_a_second_face_and_a_missing_name(tmp_path):
     init = tmp_path / '__init__.py'
     init.write_text("from x import A\n__all__ = ['A']\n__all__ = ['b']\n")

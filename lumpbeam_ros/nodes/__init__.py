@@ -12,6 +12,7 @@ __all__ = [
     'endpoints',
     'foxglove_server',
     'identifier_node',
+    'launch_file',
     'lifecycle',
     'msgtypes',
     'player',
@@ -22,5 +23,6 @@ __all__ = [
     'scripts',
     'shaper_node',
     'simulator_node',
+    'trajectory_messages',
     'params',
 ]

@@ -16,6 +16,7 @@ __all__ = [
     'diagnose',
     'doctor',
     'fit_links',
+    'launch',
     'main',
     'modes',
     'output',

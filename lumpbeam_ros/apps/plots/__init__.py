@@ -8,5 +8,6 @@ __all__ = [
     'demo',
     'diagnosis',
     'files',
+    'lines',
     'shaping',
 ]

@@ -1,6 +1,7 @@
 """Identification of stiffness, frequency and damping from tip oscillations."""
 
 __all__ = [
+    'assembly',
     'backbone',
     'bag_analysis',
     'covariance',

@@ -16,6 +16,7 @@ __all__ = [
     'partial',
     'placement',
     'pose',
+    'reprojection',
     'session',
     'synthetic',
     'tracker',
