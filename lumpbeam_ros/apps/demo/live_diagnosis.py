@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from lumpbeam_ros.apps.demo.graph import ProcessGraph
+from lumpbeam_ros.apps.demo.recording import RecordingAnalysis, prediction_lag
 from lumpbeam_ros.apps.plots.demo import Residual
 from lumpbeam_ros.base.interface import DIAGNOSIS_STATUS, MODEL_DISCREPANCY
 from lumpbeam_ros.core.bagio import BagReader
@@ -26,6 +27,8 @@ STATUS_NAME = DIAGNOSIS_STATUS
 #: The live gap after an adoption starts this long after it: the prediction published in
 #: the tick that applied it still carries the old model.
 SETTLE_S = 0.2
+#: A lag left after the adoption is worth a line from this much on, s.
+TIMING_SHOWN_S = 0.001
 
 
 def _settled(values: dict[str, str], message: str) -> bool:
@@ -91,21 +94,26 @@ def _number(values: dict[str, str], key: str) -> float:
         return math.nan
 
 
-def live_diagnosis(bag: Any, residual: Residual, release_s: float) -> dict[str, Any] | None:
+def live_diagnosis(
+    bag: Any, analysis: RecordingAnalysis, release_s: float
+) -> dict[str, Any] | None:
     """The node's first diagnosis and adoption, and the live gap before and after it.
 
     Args:
         bag: The recording (with ``/model_discrepancy`` as the node published it).
-        residual: Measured against predicted tip z of the recording.
+        analysis: The recording's measured and predicted tip.
         release_s: The load change the diagnosis followed, s.
 
     Returns:
         ``missing_effect``, ``missing_effects``, ``parameters``, the diagnosis's own
         ``gap_before_rms_m``/``gap_after_rms_m``, ``adoption`` (what became of it),
-        ``adopted_at_s`` and the live ``prediction_before_rms_m`` (release to adoption) and
-        ``prediction_after_rms_m`` (adoption to the end); ``None`` when the recording holds
-        no diagnosis.
+        ``adopted_at_s`` and, for the spans ``before`` (release to adoption) and ``after``
+        (adoption to the end), the live ``prediction_{span}_rms_m``, its
+        ``prediction_{span}_relative`` to the swing, and the ``prediction_{span}_lag_s`` that
+        aligns the prediction best there with the ``prediction_{span}_aligned_rms_m`` it
+        leaves; ``None`` when the recording holds no diagnosis.
     """
+    residual = analysis.residual
     if TOPIC not in BagReader(bag).topics:
         return None
     found: dict[str, Any] | None = None
@@ -141,6 +149,12 @@ def live_diagnosis(bag: Any, residual: Residual, release_s: float) -> dict[str, 
         for name, (start, end) in spans.items():
             found[f'prediction_{name}_rms_m'] = residual.rms(start=start, end=end)
             found[f'prediction_{name}_relative'] = _relative(residual, start, end)
+            # The simulator dates the unstamped /tip_load on arrival (its own clock, which
+            # may be a /clock tick behind): the lag in each span separates that timing from
+            # the effect's own shift of the prediction.
+            lag, aligned = prediction_lag(analysis.measured, analysis.predicted, start, end)
+            found[f'prediction_{name}_lag_s'] = lag
+            found[f'prediction_{name}_aligned_rms_m'] = aligned
     return found
 
 
@@ -181,4 +195,11 @@ def live_diagnosis_lines(live: dict[str, Any]) -> list[str]:
             f'adoption at {live["adopted_at_s"]:.2f} s, {after * 1e3:.3f} mm '
             f'({live["prediction_after_relative"]:.1%} of the swing) after it'
         )
+        lag = live['prediction_after_lag_s']
+        if math.isfinite(lag) and abs(lag) > TIMING_SHOWN_S:
+            lines.append(
+                f'  of which timing after it: the prediction runs {lag * 1e3:.1f} ms late '
+                '(the simulator dates the unstamped /tip_load on arrival); '
+                f'{live["prediction_after_aligned_rms_m"] * 1e3:.3f} mm once aligned'
+            )
     return lines

@@ -251,7 +251,11 @@ def live_value(analysis: RecordingAnalysis, key: str) -> float:
 
 
 def prediction_lag(
-    measured: TipSeries, predicted: TipSeries, start_s: float, max_lag_s: float = 0.2
+    measured: TipSeries,
+    predicted: TipSeries,
+    start_s: float,
+    end_s: float = math.inf,
+    max_lag_s: float = 0.2,
 ) -> tuple[float, float]:
     """How late the prediction runs behind the measurement, and the gap once shifted by it.
 
@@ -263,6 +267,7 @@ def prediction_lag(
         measured: ``/tip_pose``.
         predicted: ``/tip_pose_predicted``.
         start_s: Compare from this time on (the release), s.
+        end_s: Compare up to (not including) this time, s.
         max_lag_s: The largest lag searched either way, s.
 
     Returns:
@@ -270,7 +275,7 @@ def prediction_lag(
         prediction shifted back by it over the stretch, m (NaN, NaN when they do not overlap
         there).
     """
-    keep = measured.t >= start_s
+    keep = (measured.t >= start_s) & (measured.t < end_s)
     t, z = measured.t[keep], measured.z[keep]
 
     def rms(lag: float) -> float:

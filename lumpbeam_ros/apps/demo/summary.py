@@ -132,7 +132,7 @@ def summarize(run: DemoRun) -> None:
     }
     if run.diagnosis is not None:
         run.summary['diagnosis'] = run.diagnosis
-    live = live_diagnosis(run.recorded_bag, residual, run.drop.release_time_s)
+    live = live_diagnosis(run.recorded_bag, analysis, run.drop.release_time_s)
     if live is not None:
         run.summary['live_diagnosis'] = live
     for line in summary_lines(run.summary):

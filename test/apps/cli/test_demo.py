@@ -1,4 +1,5 @@
 import json
+import math
 
 import pytest
 from demo_results import DURATION_S
@@ -30,10 +31,18 @@ def test_demo_runs_the_graph_end_to_end(demo_results, mcap_doctor):
     # The node dates the release on /tip_load's arrival: a reading delivered late hides as
     # much of the latency (the live-latency test below), and the rest stays in the gap.
     late_s = live['window_s'][0] + 1.0 - 2.0  # pre_release_s before the 2 s release
-    if after is None:
+    if after is None or not math.isfinite(after):
         assert summary['prediction_rms_aligned_m'] < 100e-6
     elif abs(late_s) <= 0.002:
-        assert after < 40e-6 < 1e-3 < live['prediction_before_rms_m']
+        # The simulator dates the release on its own clock, which may be a /clock tick off:
+        # that lag stays in both spans, and the adoption moved the prediction by the latency.
+        shift_s = live['prediction_after_lag_s'] - live['prediction_before_lag_s']
+        assert shift_s == pytest.approx(0.015, abs=0.002)
+        assert (
+            live['prediction_after_aligned_rms_m'] < 40e-6 < 1e-3 < live['prediction_before_rms_m']
+        )
+        if abs(live['prediction_after_lag_s']) < 0.001:
+            assert after < 40e-6
     else:
         assert after < live['prediction_before_rms_m']
     samples = DURATION_S * 180 + 1
