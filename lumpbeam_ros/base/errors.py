@@ -35,6 +35,10 @@ class BagError(LumpbeamError):
     """A bag is missing, unreadable, truncated or lacks a required topic."""
 
 
+class RecordError(LumpbeamError):
+    """A lab file cannot be read as a record: its format, a column, its time or its rate."""
+
+
 class SolverBudgetError(LumpbeamError):
     """An integration spent its budget of work before reaching its end time.
 

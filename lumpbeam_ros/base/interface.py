@@ -21,6 +21,8 @@ from __future__ import annotations
 BASE_FRAME = 'beam_base'
 #: The optical frame of the synthetic camera's images.
 CAMERA_FRAME = 'camera'
+#: The frame of an accelerometer or IMU at the tip (``/tip_imu``).
+TIP_FRAME = 'tip'
 
 # -- message types ----------------------------------------------------------------------------
 
@@ -36,6 +38,7 @@ CLOCK_TYPE = 'rosgraph_msgs/msg/Clock'
 MARKER_ARRAY = 'visualization_msgs/msg/MarkerArray'
 JOINT_STATE_TYPE = 'sensor_msgs/msg/JointState'
 JOINT_TRAJECTORY_TYPE = 'trajectory_msgs/msg/JointTrajectory'
+IMU_TYPE = 'sensor_msgs/msg/Imu'
 
 # -- topics (absolute: the default graph's and the bags' names) -------------------------------
 
@@ -45,6 +48,8 @@ COMPRESSED_IMAGE = '/camera/image_raw/compressed'
 TIP_POSE = '/tip_pose'
 TIP_POSE_COVARIANCE = '/tip_pose_covariance'
 TIP_LOAD = '/tip_load'
+#: The tip's acceleration (m/s^2, in the header's frame): an accelerometer or IMU at the tip.
+TIP_IMU = '/tip_imu'
 BEAM_PARAMS = '/beam_params'
 TIP_POSE_PREDICTED = '/tip_pose_predicted'
 CLOCK = '/clock'
@@ -66,6 +71,7 @@ TOPIC_TYPES: dict[str, str] = {
     TIP_POSE: POSE_STAMPED,
     TIP_POSE_COVARIANCE: POSE_WITH_COVARIANCE,
     TIP_LOAD: FLOAT64,
+    TIP_IMU: IMU_TYPE,
     BEAM_PARAMS: DIAGNOSTIC_ARRAY,
     TIP_POSE_PREDICTED: POSE_STAMPED,
     CLOCK: CLOCK_TYPE,

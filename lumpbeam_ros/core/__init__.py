@@ -5,6 +5,8 @@ ROS-free: numpy arrays, dataclasses and paths in, the same out. The packages are
 (``test/test_layers.py``):
 
 - :mod:`~.bagio`: rosbag2/MCAP bags, read and written, and messages as numpy;
+- :mod:`~.records`: a lab's measurement files (LabVIEW, CSV, NumPy, MATLAB) read, and
+  written as bags;
 - :mod:`~.model`: the lumped beam (B.14-B.18), its statics, modes and simulation, the
   physical effects; :mod:`~.model.arm`: the flexible arm and the joint motion that drives it;
 - :mod:`~.ident`: stiffness, frequency and damping from the vibration (B.12-B.22);
@@ -22,6 +24,7 @@ LAYERED = True
 
 __all__ = [
     'bagio',
+    'records',
     'model',
     'ident',
     'shaping',

@@ -16,6 +16,7 @@ __all__ = [
     'diagnose',
     'doctor',
     'fit_links',
+    'import_',
     'launch',
     'main',
     'modes',

@@ -17,6 +17,7 @@ from typing import Any
 
 from lumpbeam_ros.apps.cli.output import non_negative_float, positive_float
 from lumpbeam_ros.base.interface import CAMERA_INFO, TIP_POSE, TRACKER_POINT
+from lumpbeam_ros.core.records.units import AXES, DEFAULT_START, UNITS
 
 Subparsers = argparse._SubParsersAction
 
@@ -510,6 +511,57 @@ def add_repair(parser: argparse.ArgumentParser) -> None:
     """Declares ``lumpbeam repair BAG [OUT]``."""
     parser.add_argument('bag', help='the damaged rosbag2 folder (MCAP)')
     parser.add_argument('out', nargs='?', help='bag folder to create (default: BAG-repaired)')
+
+
+IMPORT_DESCRIPTION = """\
+Writes OUT, a rosbag2 bag (MCAP), from a measured record: a displacement becomes /tip_pose
+(the value along --axis of beam_base, identity orientation), an acceleration /tip_imu
+(sensor_msgs/Imu, linear_acceleration along --axis of the frame tip).
+
+SRC is one of:
+  a CSV file (.csv, .tsv, .txt)  one header row of names; fields separated by , or ; or tab
+                                 (with ; or tab, a decimal comma is read too); --column NAME
+                                 (needed when there are several), --time-column NAME or --rate
+  a LabVIEW file (.lvm)          the channel by its name in the last header (--column, needed
+                                 when there are several); time from its X_Value column where
+                                 it has one, else from X0 and Delta_X; . or , decimals as its
+                                 header says
+  a NumPy file (.npy, .npz)      a 1-D array, a 2-D one with --column INDEX (and
+                                 --time-column INDEX), or an .npz array by --column NAME
+  a MATLAB file (.mat, v7)       a variable by --column NAME, --time-column NAME or --rate
+Stamps are --start plus the record's time. An empty cell is a gap: its sample is left out and
+counted. Time must increase.
+"""
+
+
+@_subcommand(
+    'import',
+    help='write a bag from a lab file (CSV, LabVIEW .lvm, NumPy, MATLAB)',
+    description=IMPORT_DESCRIPTION,
+    formatter_class=argparse.RawDescriptionHelpFormatter,
+)
+def add_import(parser: argparse.ArgumentParser) -> None:
+    """Declares ``lumpbeam import SRC OUT``."""
+    parser.add_argument('src', help='the measured record')
+    parser.add_argument('out', help='bag folder to create (must not exist)')
+    parser.add_argument(
+        '--quantity', required=True, choices=tuple(UNITS), help='what the record measured'
+    )
+    parser.add_argument('--column', help='the channel: a name, or an index of a 2-D .npy')
+    when = parser.add_mutually_exclusive_group()
+    when.add_argument('--time-column', help='the time column or array, s')
+    when.add_argument('--rate', type=positive_float, help='the sampling rate, Hz')
+    units = '; '.join(
+        f'{quantity}: {", ".join(names)} (default {next(iter(names))})'
+        for quantity, names in UNITS.items()
+    )
+    parser.add_argument('--unit', help=f"the record's unit ({units})")
+    parser.add_argument(
+        '--axis', choices=AXES, default=AXES[-1], help=f'measured along (default {AXES[-1]})'
+    )
+    parser.add_argument(
+        '--start', default=DEFAULT_START, help=f'ISO 8601 time of t = 0 (default {DEFAULT_START})'
+    )
 
 
 @_subcommand(

@@ -50,6 +50,7 @@ COMMANDS = (
     Command('reproduce', arguments.add_reproduce, 'lumpbeam_ros.apps.cli.reproduce:run'),
     Command('synth', arguments.add_synth, 'lumpbeam_ros.apps.cli.synth:run'),
     Command('track', arguments.add_track, 'lumpbeam_ros.apps.cli.track:run'),
+    Command('import', arguments.add_import, 'lumpbeam_ros.apps.cli.import_:run'),
     Command('analyze', arguments.add_analyze, 'lumpbeam_ros.apps.cli.analyze:run'),
     Command('shape', arguments.add_shape, 'lumpbeam_ros.apps.cli.shape:run'),
     Command('modes', arguments.add_modes, 'lumpbeam_ros.apps.cli.modes:run'),

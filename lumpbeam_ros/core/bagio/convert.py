@@ -25,6 +25,7 @@ from lumpbeam_ros.base.interface import (
     DIAGNOSTIC_ARRAY,
     FLOAT64,
     IMAGE_TYPE,
+    IMU_TYPE,
     JOINT_STATE_TYPE,
     POINT_STAMPED,
     POSE_STAMPED,
@@ -147,6 +148,38 @@ def pose_values(msg: Any) -> tuple[int, float, float, float, str]:
     q = msg.pose.orientation
     pitch = quaternion_to_pitch(q.x, q.y, q.z, q.w)
     return time_ns(msg.header.stamp), float(p.x), float(p.z), pitch, msg.header.frame_id
+
+
+def imu_acceleration(ns: int, acceleration: tuple[float, float, float], frame_id: str) -> Any:
+    """Builds a ``sensor_msgs/msg/Imu`` that carries only a linear acceleration.
+
+    The orientation and the angular velocity are marked unknown (element 0 of their
+    covariance -1, as the message's definition asks); the acceleration's covariance is all
+    zeros, "unknown" too.
+
+    Args:
+        ns: Stamp, ns.
+        acceleration: ``(x, y, z)``, m/s^2, in ``frame_id``.
+        frame_id: The sensor's frame.
+    """
+    vector = message_class('geometry_msgs/msg/Vector3')
+    unknown = np.zeros(9)
+    unknown[0] = -1.0
+    return message_class(IMU_TYPE)(
+        header=header(ns, frame_id),
+        orientation=message_class('geometry_msgs/msg/Quaternion')(x=0.0, y=0.0, z=0.0, w=1.0),
+        orientation_covariance=unknown,
+        angular_velocity=vector(x=0.0, y=0.0, z=0.0),
+        angular_velocity_covariance=unknown.copy(),
+        linear_acceleration=vector(*(float(v) for v in acceleration)),
+        linear_acceleration_covariance=np.zeros(9),
+    )
+
+
+def imu_acceleration_values(msg: Any) -> tuple[int, float, float, float, str]:
+    """Returns ``(stamp_ns, ax, ay, az, frame_id)`` of a ``sensor_msgs/msg/Imu``."""
+    a = msg.linear_acceleration
+    return time_ns(msg.header.stamp), float(a.x), float(a.y), float(a.z), msg.header.frame_id
 
 
 def float64(value: float) -> Any:

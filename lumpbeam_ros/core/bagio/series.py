@@ -7,9 +7,9 @@ synthetic bags and is the receive time in recorded ones.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -18,10 +18,12 @@ from lumpbeam_ros.base.interface import (
     BEAM_PARAMS,
     CAMERA_INFO,
     IMAGE,
+    IMU_TYPE,
     JOINT_STATE_TYPE,
     JOINT_STATES,
     POINT_STAMPED,
     POSE_STAMPED,
+    TIP_IMU,
     TIP_LOAD,
     TIP_POSE,
     TRACKER_POINT,
@@ -34,7 +36,10 @@ Bag = str | Path | BagReader
 
 
 class PointSeries(NamedTuple):
-    """Reference points (``/tracker/point``): ``t, x, y, z`` arrays and their frame."""
+    """Stamped 3-vectors and their frame: ``t, x, y, z`` arrays.
+
+    Reference points (``/tracker/point``, m) or the tip's acceleration (``/tip_imu``, m/s^2).
+    """
 
     t: np.ndarray
     x: np.ndarray
@@ -187,8 +192,28 @@ def read_points(bag: Bag, topic: str = TRACKER_POINT) -> PointSeries:
         BagError: Missing topic, another type or mixed frames (a message that does not
             decode is skipped and counted).
     """
+    return _vectors(bag, topic, POINT_STAMPED, convert.point_values)
+
+
+def read_accelerations(bag: Bag, topic: str = TIP_IMU) -> PointSeries:
+    """Reads the linear accelerations of a ``sensor_msgs/Imu`` topic (m/s^2), sorted by stamp.
+
+    Raises:
+        BagError: Missing topic, another type or mixed frames (a message that does not
+            decode is skipped and counted).
+    """
+    return _vectors(bag, topic, IMU_TYPE, convert.imu_acceleration_values)
+
+
+def _vectors(
+    bag: Bag,
+    topic: str,
+    msgtype: str,
+    decode: Callable[[Any], tuple[int, float, float, float, str]],
+) -> PointSeries:
+    """A topic of stamped 3-vectors, each message decoded to ``(ns, x, y, z, frame_id)``."""
     reader = open_bag(bag)
-    decoded = (convert.point_values(m) for _, m in reader.messages(topic, POINT_STAMPED))
+    decoded = (decode(m) for _, m in reader.messages(topic, msgtype))
     (t, x, y, z), frame = _stamped_columns(decoded, reader, topic)
     return PointSeries(t, x, y, z, frame)
 

@@ -312,6 +312,13 @@ class BagWriter(ClosedOnExit):
         ns = convert.seconds_to_ns(stamp)
         self.write_message(topic, convert.point_stamped(ns, x, y, z, frame), ns)
 
+    def write_acceleration(
+        self, topic: str, stamp: float, acceleration: tuple[float, float, float], frame: str
+    ) -> None:
+        """Writes a ``sensor_msgs/msg/Imu`` of a linear acceleration, m/s^2 (``/tip_imu``)."""
+        ns = convert.seconds_to_ns(stamp)
+        self.write_message(topic, convert.imu_acceleration(ns, acceleration, frame), ns)
+
     def write_image(
         self,
         topic: str,

@@ -1,3 +1,4 @@
+
 """The lazy dispatch of ``lumpbeam``: light help, offline commands without the optional packages.
 
 Each check runs ``lumpbeam`` in a fresh interpreter (this one has long imported everything);
@@ -5,6 +6,7 @@ a meta-path finder installed before the CLI refuses the optional packages, as on
 where they are not installed.
 """
 
+import keyword
 import subprocess
 import sys
 
@@ -69,7 +71,9 @@ def test_every_command_is_listed_in_the_help():
 
 def test_every_target_exists():
     for command in COMMANDS:
-        assert command.target == f'lumpbeam_ros.apps.cli.{command.name}:run'
+        # A command named by a Python keyword lives in a module with a trailing underscore.
+        module = command.name + ('_' if keyword.iskeyword(command.name) else '')
+        assert command.target == f'lumpbeam_ros.apps.cli.{module}:run'
         assert callable(load_target(command.target))
 
 
