@@ -252,3 +252,11 @@ def test_a_matlab_matrix_is_not_a_vector(tmp_path):
     savemat(tmp_path / 'r.mat', {'acc': np.zeros((3, 3))})
     with pytest.raises(RecordError, match=r"'acc' has shape \(3, 3\), not a vector"):
         read_lab_file(tmp_path / 'r.mat', ChannelChoice(rate_hz=1.0))
+
+
+def test_a_matlab_v73_file_says_how_to_save_it(tmp_path):
+    # A v7.3 file is HDF5 behind MATLAB's 128-byte header, whose version field says 0x0200.
+    header = b'MATLAB 7.3 MAT-file'.ljust(116, b' ') + bytes(8) + b'\x00\x02' + b'IM'
+    (tmp_path / 'r.mat').write_bytes(header + b'\x89HDF\r\n\x1a\n' + bytes(64))
+    with pytest.raises(RecordError, match=r'v7\.3 \(HDF5\) file; save it with -v7'):
+        read_lab_file(tmp_path / 'r.mat', ChannelChoice(rate_hz=1.0))
