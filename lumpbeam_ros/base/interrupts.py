@@ -112,6 +112,14 @@ def interrupt_on_signals(handler: Handler = raise_interrupt) -> dict[int, Any]:
     return {s: signal.signal(s, handler) for s in STOP_SIGNALS}
 
 
+def record_signal(signum: int, _frame: FrameType | None) -> None:
+    """A signal handler: only records the signal (:func:`interrupted`), raises nothing.
+
+    For a cleanup that must run to its end once the work has stopped.
+    """
+    _received.append(signum)
+
+
 def restore_handlers(previous: dict[int, Any]) -> None:
     """Puts back the handlers :func:`interrupt_on_signals` replaced."""
     for sig, handler in previous.items():

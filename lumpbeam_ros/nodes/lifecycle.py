@@ -42,7 +42,12 @@ from rclpy.validate_namespace import validate_namespace
 from rclpy.validate_topic_name import validate_topic_name
 
 from lumpbeam_ros.base.errors import LumpbeamError
-from lumpbeam_ros.base.interrupts import interrupt_on_signals, interrupted, restore_handlers
+from lumpbeam_ros.base.interrupts import (
+    interrupt_on_signals,
+    interrupted,
+    record_signal,
+    restore_handlers,
+)
 from lumpbeam_ros.nodes.counts import write_counts
 
 #: Exit code of a node whose configuration is invalid.
@@ -88,7 +93,31 @@ def run_node(
         print(f'{name}: error: {problem}', file=sys.stderr)
         return CONFIG_ERROR
     previous = interrupt_on_signals()
-    node: _N | None = None
+    built: list[_N] = []
+    try:
+        return _build_and_run(name, argv, make, run, built)
+    except KeyboardInterrupt:
+        # rclpy's handler runs first and shuts the context down, which may end the spin; the
+        # interrupt then reaches Python only in one of _build_and_run's except clauses.
+        return 0
+    finally:
+        try:
+            _finish(name, built, published, received)
+        except KeyboardInterrupt:
+            # That interrupt may also come at the call itself, before _finish holds it off; a
+            # signal raises once, so the second call runs through.
+            _finish(name, built, published, received)
+        restore_handlers(previous)
+
+
+def _build_and_run(
+    name: str,
+    argv: list[str],
+    make: Callable[[], _N],
+    run: Callable[[_N], None],
+    built: list[_N],
+) -> int:
+    """:func:`run_node`'s init, build and run; the node built is appended to ``built``."""
     try:
         try:
             rclpy.init(args=argv)
@@ -96,6 +125,7 @@ def run_node(
             print(f'{name}: error: bad --ros-args ({exc})', file=sys.stderr)
             return CONFIG_ERROR
         node = make()
+        built.append(node)
         if run in (rclpy.spin, spin_events, spin_live):
             # A node that joins the graph says so once; one that reads a bag through (the
             # camera node given a bag) is a batch job and says what it reads instead.
@@ -116,13 +146,26 @@ def run_node(
         # comes out as a RuntimeError: after a signal, that is the stop too.
         if not interrupted():
             raise
-    finally:
-        if node is not None:
-            write_counts(name, published(node), received(node) if received else None)
-            node.destroy_node()
-        rclpy.try_shutdown()
-        restore_handlers(previous)
     return 0
+
+
+def _finish(
+    name: str,
+    built: list[_N],
+    published: Callable[[_N], Mapping[str, int]],
+    received: Callable[[_N], Mapping[str, int]] | None,
+) -> None:
+    """:func:`run_node`'s end: the counts written, the node destroyed, rclpy shut down.
+
+    A further signal is only recorded from here on: the counts are written however the node
+    stopped.
+    """
+    interrupt_on_signals(record_signal)
+    for node in built:
+        write_counts(name, published(node), received(node) if received else None)
+        node.destroy_node()
+    built.clear()
+    rclpy.try_shutdown()
 
 
 def _wants_help(argv: Sequence[str]) -> bool:

@@ -61,6 +61,16 @@ def test_the_interrupt_names_its_signal():
     assert signal_number(KeyboardInterrupt()) == signal.SIGINT
 
 
+def test_a_recorded_signal_raises_nothing_and_is_remembered(monkeypatch):
+    monkeypatch.setattr(interrupts, '_received', [])
+    previous = interrupts.interrupt_on_signals(interrupts.record_signal)
+    try:
+        signal.raise_signal(signal.SIGINT)
+    finally:
+        interrupts.restore_handlers(previous)
+    assert interrupts.interrupted()
+
+
 #: run_script in a process of its own: what it returns, and how much of the heap it froze.
 RUN_SCRIPT = """
 import gc, os, signal, sys

@@ -136,6 +136,46 @@ def test_a_runtime_error_is_the_stop_only_after_a_signal(counts_dir, monkeypatch
             stop()
 
 
+def test_a_signal_that_reaches_python_after_the_spin_ended_is_the_stop(counts_dir, monkeypatch):
+    # rclpy's handler shuts the context down first, which ends the spin (here: a publish
+    # fails); Python's handler, run at its next check, then raised the interrupt inside
+    # run_node's except clause (seen in CI: exit 1 with a traceback, a node stopped by SIGINT).
+    monkeypatch.setattr(interrupts, '_received', [])
+    monkeypatch.setattr(sys, 'unraisablehook', sys.unraisablehook)
+    ok = rclpy.ok
+
+    def late_interrupt(**kwargs: object) -> bool:
+        interrupts.raise_interrupt(signal.SIGINT, None)
+        return ok(**kwargs)
+
+    def run(node: _Publishing) -> None:
+        node.publish()
+        rclpy.shutdown()
+        monkeypatch.setattr(rclpy, 'ok', late_interrupt)
+        node.publish()
+
+    assert run_node('counting_node', _Publishing, lambda n: {'/x': n.sent}, [], run=run) == 0
+    assert read_counts(counts_dir)['counting_node']['published'] == {'/x': 1}
+
+
+def test_a_signal_during_the_cleanup_still_writes_the_counts(counts_dir, monkeypatch):
+    monkeypatch.setattr(interrupts, '_received', [])
+    monkeypatch.setattr(sys, 'unraisablehook', sys.unraisablehook)
+
+    def published(node: _Publishing) -> dict[str, int]:
+        signal.raise_signal(signal.SIGTERM)
+        return {'/x': node.sent}
+
+    def run(node: _Publishing) -> None:
+        node.publish()
+
+    assert run_node('counting_node', _Publishing, published, [], run=run) == 0
+    assert read_counts(counts_dir)['counting_node']['published'] == {'/x': 1}
+    # The signal was recorded, not lost, and the handlers are back as they were.
+    assert interrupts.interrupted()
+    assert signal.getsignal(signal.SIGTERM) is not interrupts.record_signal
+
+
 def test_a_middleware_error_while_running_is_not_hidden(counts_dir):
     def run(node: _Publishing) -> None:
         raise _rclpy.RCLError('failed to take a message')

@@ -1,4 +1,3 @@
-
 """The lazy dispatch of ``lumpbeam``: light help, offline commands without the optional packages.
 
 Each check runs ``lumpbeam`` in a fresh interpreter (this one has long imported everything);
