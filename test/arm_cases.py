@@ -3,8 +3,11 @@
 import numpy as np
 
 from lumpbeam_lab.mujoco_arm import beam_as_arm
+from lumpbeam_ros.core.ident.arm.link_fit import MeasuredMode, ModeObservation
 from lumpbeam_ros.core.model.arm.config import ArmConfig, arm_from_mapping
 from lumpbeam_ros.core.model.arm.drive import SmoothMotion
+from lumpbeam_ros.core.model.arm.model import ArmModel
+from lumpbeam_ros.core.model.arm.statics import arm_modes
 from lumpbeam_ros.core.model.parameters import BeamParameters
 
 
@@ -72,3 +75,32 @@ def write_move_bag(out, arm: ArmConfig, final, move_s=0.5, record_s=4.0, names=(
     trajectory = JointTrajectory(t, np.outer(s, np.asarray(final, dtype=float)), tuple(names))
     write_arm_bag(out, arm, trajectory, ArmSynthOptions(duration_s=record_s))
     return out
+
+
+#: Final joint angles of the moves (the vertical arm's modes change with them).
+FINALS = ([0.3, -0.4, 0.5], [-0.4, 0.6, -0.3], [0.6, 0.2, 0.4], [-0.2, -0.7, 0.9])
+#: Relative standard deviations of the measured frequencies and damping ratios, mode k
+#: (1-based) times these: the contract's accuracy of multi-mode identification.
+F_REL, ZETA_REL = 1e-3, 0.05
+
+
+def observe_modes(truth, finals, n_modes, rng=None, modes_at=None):
+    """The truth's first ``n_modes`` at each final configuration, noisy when ``rng`` is given."""
+    model = ArmModel.from_config(truth)
+    out = []
+    for q in finals:
+        q = np.asarray(q, dtype=float)
+        f, zeta = modes_at(q) if modes_at else modes_of(model, q)
+        measured = []
+        for k in range(n_modes):
+            f_std, z_std = F_REL * (k + 1) * f[k], ZETA_REL * (k + 1) * zeta[k]
+            df, dz = (f_std, z_std) * rng.standard_normal(2) if rng is not None else (0.0, 0.0)
+            measured.append(MeasuredMode(f[k] + df, f_std, zeta[k] + dz, z_std))
+        out.append(ModeObservation(q, tuple(measured), f'q={q.tolist()}'))
+    return out
+
+
+def modes_of(model, q):
+    """The model's frequencies and damping ratios at rest at q."""
+    modes = arm_modes(model, q)
+    return modes.natural_frequency_hz, modes.damping_ratio

@@ -29,12 +29,18 @@ __all__ = ['CONTRACT_KEYS', 'Progress', 'read_window', 'result_json', 'run']
 
 def run(args: argparse.Namespace) -> int:
     """Reads the bag, identifies the whole record, prints a summary, writes JSON and plots."""
-    if args.fit_links:
-        from lumpbeam_ros.apps.cli.fit_links import run_fit_links
+    if args.fit_links and args.fit_payload:
+        raise LumpbeamError('give --fit-links or --fit-payload, not both')
+    if args.fit_links or args.fit_payload:
+        from lumpbeam_ros.apps.cli.fit_links import run_fit_links, run_fit_payload
 
-        return run_fit_links(args)
+        return run_fit_links(args) if args.fit_links else run_fit_payload(args)
+    if args.write_arm:
+        raise LumpbeamError('--write-arm needs --fit-links or --fit-payload')
     if len(args.bag) > 1:
-        raise LumpbeamError(f'{len(args.bag)} bags given: several bags only with --fit-links')
+        raise LumpbeamError(
+            f'{len(args.bag)} bags given: several bags only with --fit-links or --fit-payload'
+        )
     args.bag = args.bag[0]
     beam, _ = load_beam_config(args.config)
     config = load_identifier_config(args.identifier_config)

@@ -313,6 +313,18 @@ def add_analyze(parser: argparse.ArgumentParser) -> None:
         'the last move of each BAG (moves ending in different configurations, each with a '
         'short quick step of the outer joint so that every mode rings); with --arm',
     )
+    arm.add_argument(
+        '--fit-payload',
+        action='store_true',
+        help='fit the payload mass (kg) to the modes measured after the last move of each BAG, '
+        'the links as --arm gives them (the arm that picked up an unknown part); with --arm',
+    )
+    arm.add_argument(
+        '--write-arm',
+        metavar='OUT',
+        help='with --fit-links or --fit-payload: also write the arm file with the fitted values '
+        '(everything else as --arm)',
+    )
 
 
 @_subcommand(

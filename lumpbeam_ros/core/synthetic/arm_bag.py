@@ -90,13 +90,15 @@ def simulate_arm_record(
     """The arm along the trajectory at the record's stamps.
 
     Raises:
-        LumpbeamError: The trajectory has the wrong number of joints, the record is shorter
-            than it, or it needs more samples than the drop test's limit.
+        LumpbeamError: The trajectory has the wrong number of joints or leaves a joint's
+            limits, the record is shorter than it, or it needs more samples than the drop
+            test's limit.
     """
     if trajectory.joint_count != config.n_joints:
         raise LumpbeamError(
             f'the trajectory has {trajectory.joint_count} joints, the arm {config.n_joints}'
         )
+    config.check_within_limits(trajectory.angles_rad, 'the trajectory')
     if options.duration_s < trajectory.duration_s:
         raise LumpbeamError(
             f'--duration {options.duration_s:g} s is shorter than the trajectory '

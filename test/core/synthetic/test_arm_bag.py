@@ -1,5 +1,6 @@
 """``lumpbeam synth --arm --trajectory``: the bag's topics, stamps, truth and noise; bad input."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -84,6 +85,17 @@ def test_bad_inputs_are_one_line(tmp_path, joints, duration, start, words):
             _move(joints, start),
             ArmSynthOptions(duration_s=duration),
         )
+    assert not (tmp_path / 'bag').exists()
+
+
+def test_a_trajectory_outside_a_joints_limits_writes_no_bag(tmp_path):
+    arm = small_arm(2)
+    limited = replace(arm, links=(arm.links[0], replace(arm.links[1], joint_limits_rad=(-0.4, 1))))
+    with pytest.raises(
+        LumpbeamError,
+        match=r'the trajectory: joint_2 at -0.40\d* rad is outside its limits \[-0.4, 1\]',
+    ):
+        write_arm_bag(tmp_path / 'bag', limited, _move(2), ArmSynthOptions(duration_s=1.0))
     assert not (tmp_path / 'bag').exists()
 
 

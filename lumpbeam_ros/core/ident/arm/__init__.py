@@ -1,7 +1,8 @@
-"""The flexible arm from data: its moves, the modes of its ring-downs, its links fitted."""
+"""The flexible arm from data: its moves, the modes of its ring-downs, its links and payload."""
 
 __all__ = [
     'bag_modes',
     'link_fit',
     'moves',
+    'payload_fit',
 ]

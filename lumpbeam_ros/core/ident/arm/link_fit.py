@@ -31,9 +31,9 @@ Example::
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, fields, replace
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -294,20 +294,46 @@ def match_modes(measured_hz: np.ndarray, model_hz: np.ndarray) -> tuple[int, ...
 
 
 @dataclass(frozen=True)
-class _Data:
-    """The observations as the fit uses them.
+class FitData:
+    """The observations as a fit of the arm's model to them uses them.
 
     Attributes:
         qs: Each observation's final joint angles.
         measured: Each observation's modes by increasing frequency.
         labels: Each observation's label, for messages.
-        beta0: The damping each link's log factor is taken relative to.
     """
 
     qs: tuple[np.ndarray, ...]
     measured: tuple[tuple[MeasuredMode, ...], ...]
     labels: tuple[str, ...]
-    beta0: np.ndarray
+
+    @classmethod
+    def checked(cls, arm: ArmConfig, observations: Sequence[ModeObservation], fit: str) -> FitData:
+        """The observations, checked against the arm.
+
+        Args:
+            arm: The arm they were measured on.
+            observations: One per move (bag).
+            fit: What is fitted (``'link fit'``), for messages.
+
+        Raises:
+            LumpbeamError: No observations, angles for another arm, an observation without
+                modes, a bad measured mode.
+        """
+        if not observations:
+            raise LumpbeamError(f'{fit}: no measured modes to fit')
+        model = ArmModel.from_config(arm)
+        qs, measured, labels = [], [], []
+        for k, o in enumerate(observations):
+            where = o.label or f'observation {k + 1}'
+            qs.append(model.check_angles(o.joint_angles_rad, f'{where}: final joint angles'))
+            if not o.modes:
+                raise LumpbeamError(f'{where}: no mode measured')
+            for i, mode in enumerate(o.modes):
+                mode.check(f'{where}: mode {i + 1}')
+            measured.append(o.sorted_modes())
+            labels.append(where)
+        return cls(tuple(qs), tuple(measured), tuple(labels))
 
     @property
     def frequencies(self) -> list[np.ndarray]:
@@ -318,6 +344,89 @@ class _Data:
     def n_values(self) -> int:
         """Measured values: a frequency and a damping ratio per mode."""
         return 2 * sum(len(ms) for ms in self.measured)
+
+
+def match_all(data: FitData, all_modes: Sequence[Modes]) -> list[tuple[int, ...]]:
+    """Each observation's measured modes matched to the model's there (:func:`match_modes`).
+
+    Raises:
+        LumpbeamError: An observation with more modes than the model has.
+    """
+    matches = []
+    for f, m, label in zip(data.frequencies, all_modes, data.labels, strict=True):
+        match = match_modes(f, m.natural_frequency_hz)
+        if match is None:
+            raise LumpbeamError(
+                f'{label}: {f.size} modes measured, more than the arm model has '
+                f'({m.natural_frequency_hz.size})'
+            )
+        matches.append(match)
+    return matches
+
+
+def weighted_residuals(
+    data: FitData, all_modes: Sequence[Modes], matches: Sequence[tuple[int, ...]]
+) -> np.ndarray:
+    """Each matched mode's frequency and damping-ratio misfit over its std.
+
+    Args:
+        data: The observations.
+        all_modes: The model's modes at each observation's joint angles.
+        matches: Each observation's matching (:func:`match_all`).
+
+    Returns:
+        Two values per matched mode, observation by observation.
+    """
+    parts = []
+    for modes, ms, match in zip(all_modes, data.measured, matches, strict=True):
+        for mode, j in zip(ms, match, strict=True):
+            if j >= modes.natural_frequency_hz.size:
+                # The mode turned overdamped or vanished: as far off as it can be.
+                parts += [_FAR, _FAR]
+                continue
+            f = mode.natural_frequency_hz
+            df = modes.natural_frequency_hz[j] - f
+            dz = modes.damping_ratio[j] - mode.damping_ratio
+            f_std = math.hypot(mode.natural_frequency_hz_std, FREQUENCY_FLOOR * f)
+            parts += [df / f_std, dz / mode.damping_ratio_std]
+    return np.asarray(parts, dtype=float)
+
+
+_X = TypeVar('_X')
+Matches = list[tuple[int, ...]]
+
+
+def solve_matched(
+    start: _X,
+    solve: Callable[[_X, Matches], _X],
+    match: Callable[[_X], Matches],
+    fit: str,
+) -> tuple[_X, Matches]:
+    """Solves with the matching held, then matches again at the solution, until it settles.
+
+    Args:
+        start: The unknowns to start from.
+        solve: The solution from unknowns, the matching held.
+        match: The matching of measured to model modes at given unknowns.
+        fit: What is fitted (``'link fit'``), for messages.
+
+    Returns:
+        The solution and its matching.
+
+    Raises:
+        LumpbeamError: The matching still changes after :data:`_MAX_ROUNDS` solutions.
+    """
+    x, matches = start, match(start)
+    for _ in range(_MAX_ROUNDS):
+        x = solve(x, matches)
+        rematched = match(x)
+        if rematched == matches:
+            return x, matches
+        matches = rematched
+    raise LumpbeamError(
+        f'{fit}: the measured modes match different model modes at every solution; '
+        'check that the bags come from this arm'
+    )
 
 
 class LinkParameterFit:
@@ -332,6 +441,7 @@ class LinkParameterFit:
         self.arm = arm
         self.n_links = arm.n_joints
         self._evaluations = 0
+        self._beta0 = np.array([link.damping_beta for link in arm.links])
         self.result_: LinkFit | None = None
 
     def fit(self, observations: Sequence[ModeObservation]) -> LinkFit:
@@ -349,31 +459,21 @@ class LinkParameterFit:
                 bag with more modes than the model has, or data that leave a link's
                 stiffness or damping undetermined (configurations too alike).
         """
-        obs = self._checked(observations)
-        data = _Data(
-            qs=tuple(o.joint_angles_rad for o in obs),
-            measured=tuple(o.sorted_modes() for o in obs),
-            labels=tuple(o.label or f'observation {k + 1}' for k, o in enumerate(obs)),
-            beta0=self._beta_start(obs),
-        )
+        data = FitData.checked(self.arm, observations, 'link fit')
+        self._check_count(data)
+        self._beta0 = self._beta_start(data)
         n = self.n_links
         theta = np.zeros(2 * n)
         theta[:n] = self._common_start(data)
-        matches = self._match(theta, data)
-        for _ in range(_MAX_ROUNDS):
-            theta = self._solve(theta, data, matches)
-            rematched = self._match(theta, data)
-            if rematched == matches:
-                break
-            matches = rematched
-        else:
-            raise LumpbeamError(
-                'link fit: the measured modes match different model modes at every solution; '
-                'check that the bags come from this arm'
-            )
+        theta, matches = solve_matched(
+            theta,
+            lambda x, m: self._solve(x, data, m),
+            lambda x: self._match(x, data),
+            'link fit',
+        )
         residual = self._residuals(theta, data, matches)
         jac = self._jacobian(theta, data, matches)
-        self._check_rank(jac, len(obs))
+        self._check_rank(jac, len(data.qs))
         chi2 = float(residual @ residual)
         dof = residual.size - theta.size
         scale = math.sqrt(max(1.0, chi2 / dof)) if dof > 0 else 1.0
@@ -413,30 +513,18 @@ class LinkParameterFit:
             raise LumpbeamError('link fit: predict before fit')
         return self.result_.predict(q)
 
-    def _checked(self, observations: Sequence[ModeObservation]) -> list[ModeObservation]:
-        if not observations:
-            raise LumpbeamError('link fit: no measured modes to fit')
-        model = ArmModel.from_config(self.arm)
-        obs = []
-        for k, o in enumerate(observations):
-            where = o.label or f'observation {k + 1}'
-            q = model.check_angles(o.joint_angles_rad, f'{where}: final joint angles')
-            if not o.modes:
-                raise LumpbeamError(f'{where}: no mode measured')
-            for i, mode in enumerate(o.modes):
-                mode.check(f'{where}: mode {i + 1}')
-            obs.append(replace(o, joint_angles_rad=q))
-        total = sum(len(o.modes) for o in obs)
+    def _check_count(self, data: FitData) -> None:
+        """Refuses fewer measured modes than links."""
+        total = sum(len(ms) for ms in data.measured)
         if total < self.n_links:
             raise LumpbeamError(
-                f'link fit: {len(obs)} bag(s) give {total} mode(s) in all, but the '
+                f'link fit: {len(data.qs)} bag(s) give {total} mode(s) in all, but the '
                 f'{self.n_links} links need at least {self.n_links} (one frequency and one '
                 'damping ratio per unknown stiffness and damping): add bags whose moves end '
                 'in other configurations'
             )
-        return obs
 
-    def _beta_start(self, observations: Sequence[ModeObservation]) -> np.ndarray:
+    def _beta_start(self, data: FitData) -> np.ndarray:
         """The nominal betas; a link without damping starts at ``2 zeta / omega`` of the data.
 
         For stiffness-proportional damping every mode has ``zeta = beta omega / 2``.
@@ -444,24 +532,24 @@ class LinkParameterFit:
         betas = np.array([link.damping_beta for link in self.arm.links])
         guesses = [
             2.0 * m.damping_ratio / (2.0 * math.pi * m.natural_frequency_hz)
-            for obs in observations
-            for m in obs.modes
+            for modes in data.measured
+            for m in modes
         ]
-        data = float(np.median(guesses))
-        fallback = data if data > 0.0 else 1e-4
+        median = float(np.median(guesses))
+        fallback = median if median > 0.0 else 1e-4
         return np.where(betas > 0.0, betas, fallback)
 
-    def _arm(self, theta: np.ndarray, data: _Data) -> ArmConfig:
+    def _arm(self, theta: np.ndarray, data: FitData) -> ArmConfig:
         """The arm at log factors ``theta`` (stiffness factors, then damping factors)."""
         n = self.n_links
-        return scaled_arm(self.arm, np.exp(theta[:n]), data.beta0 * np.exp(theta[n:]))
+        return scaled_arm(self.arm, np.exp(theta[:n]), self._beta0 * np.exp(theta[n:]))
 
-    def _all_modes(self, theta: np.ndarray, data: _Data) -> list[Modes]:
+    def _all_modes(self, theta: np.ndarray, data: FitData) -> list[Modes]:
         model = ArmModel.from_config(self._arm(theta, data))
         self._evaluations += len(data.qs)
         return [arm_modes(model, q) for q in data.qs]
 
-    def _common_start(self, data: _Data) -> float:
+    def _common_start(self, data: FitData) -> float:
         """The common log stiffness factor whose matched frequencies fit best."""
         best, best_cost = 0.0, math.inf
         n = self.n_links
@@ -488,39 +576,17 @@ class LinkParameterFit:
             raise LumpbeamError("link fit: the arm cannot stand at the bags' joint angles")
         return best
 
-    def _match(self, theta: np.ndarray, data: _Data) -> list[tuple[int, ...]]:
-        matches = []
-        modes = self._all_modes(theta, data)
-        for f, m, label in zip(data.frequencies, modes, data.labels, strict=True):
-            match = match_modes(f, m.natural_frequency_hz)
-            if match is None:
-                raise LumpbeamError(
-                    f'{label}: {f.size} modes measured, more than the arm model has '
-                    f'({m.natural_frequency_hz.size})'
-                )
-            matches.append(match)
-        return matches
+    def _match(self, theta: np.ndarray, data: FitData) -> list[tuple[int, ...]]:
+        return match_all(data, self._all_modes(theta, data))
 
     def _residuals(
-        self, theta: np.ndarray, data: _Data, matches: list[tuple[int, ...]]
+        self, theta: np.ndarray, data: FitData, matches: list[tuple[int, ...]]
     ) -> np.ndarray:
-        """Each matched mode's frequency and damping-ratio misfit over its std."""
-        parts = []
-        all_modes = self._all_modes(theta, data)
-        for modes, ms, match in zip(all_modes, data.measured, matches, strict=True):
-            for mode, j in zip(ms, match, strict=True):
-                if j >= modes.natural_frequency_hz.size:
-                    # The mode turned overdamped or vanished: as far off as it can be.
-                    parts += [_FAR, _FAR]
-                    continue
-                f = mode.natural_frequency_hz
-                df = modes.natural_frequency_hz[j] - f
-                dz = modes.damping_ratio[j] - mode.damping_ratio
-                f_std = math.hypot(mode.natural_frequency_hz_std, FREQUENCY_FLOOR * f)
-                parts += [df / f_std, dz / mode.damping_ratio_std]
-        return np.asarray(parts, dtype=float)
+        return weighted_residuals(data, self._all_modes(theta, data), matches)
 
-    def _solve(self, theta: np.ndarray, data: _Data, matches: list[tuple[int, ...]]) -> np.ndarray:
+    def _solve(
+        self, theta: np.ndarray, data: FitData, matches: list[tuple[int, ...]]
+    ) -> np.ndarray:
         """Least squares in the log factors from ``theta``, the matching held."""
         bound = math.log(MAX_FACTOR)
 
@@ -550,7 +616,7 @@ class LinkParameterFit:
         return np.asarray(solution.x)
 
     def _jacobian(
-        self, theta: np.ndarray, data: _Data, matches: list[tuple[int, ...]]
+        self, theta: np.ndarray, data: FitData, matches: list[tuple[int, ...]]
     ) -> np.ndarray:
         """Central differences of the weighted residuals in the log factors."""
         columns = []

@@ -12,6 +12,9 @@ The file is plain YAML with one top-level ``arm`` mapping::
           mass_kg: 1.9         # or a list of n_segments segment masses
           damping_beta: 2.2e-4
           joint_mass_kg: 0.0
+          joint_limits_rad: [-3.1, 3.1]   # optional: the range of the link's joint
+
+:func:`write_arm_config` writes an arm back (the identified arm, ``--write-arm``).
 
 Every bad value is a :class:`~lumpbeam_ros.base.errors.ConfigError` naming the file and the key
 (``arm.links[1].ei_nm2``), printed by the command line as one line.
@@ -25,8 +28,9 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
+import yaml
 
-from lumpbeam_ros.base.errors import ConfigError
+from lumpbeam_ros.base.errors import ConfigError, LumpbeamError
 from lumpbeam_ros.base.paramfile import (
     check_known_keys,
     get_choice,
@@ -51,6 +55,7 @@ _LINK_KEYS = frozenset(
         'mass_kg',
         'damping_beta',
         'joint_mass_kg',
+        'joint_limits_rad',
     }
 )
 
@@ -68,6 +73,7 @@ class LinkConfig:
         ei_nm2: EI of each segment, N m^2, or ``None`` when the link is given by
             ``k_total_nm_per_rad``.
         k_total_nm_per_rad: The identified total stiffness k_tE (B.12), or ``None``.
+        joint_limits_rad: The range ``(low, high)`` of the link's joint, rad, or ``None``.
     """
 
     length_m: float
@@ -77,6 +83,7 @@ class LinkConfig:
     joint_mass_kg: float = 0.0
     ei_nm2: tuple[float, ...] | None = None
     k_total_nm_per_rad: float | None = None
+    joint_limits_rad: tuple[float, float] | None = None
 
     @property
     def segment_length_m(self) -> float:
@@ -142,6 +149,30 @@ class ArmConfig:
         """A copy with another payload."""
         return replace(self, payload_kg=float(payload_kg))
 
+    def check_within_limits(self, q: np.ndarray, what: str) -> None:
+        """Refuses joint angles outside a link's ``joint_limits_rad``.
+
+        Args:
+            q: Angles, rad, (n_joints,) or (samples, n_joints).
+            what: What the angles are, for the message (``'IN.csv'``).
+
+        Raises:
+            LumpbeamError: An angle outside its joint's range, naming the joint and the first
+                angle found outside.
+        """
+        angles = np.atleast_2d(np.asarray(q, dtype=float))
+        for j, link in enumerate(self.links):
+            if link.joint_limits_rad is None or j >= angles.shape[1]:
+                continue
+            low, high = link.joint_limits_rad
+            outside = np.flatnonzero((angles[:, j] < low) | (angles[:, j] > high))
+            if outside.size:
+                value = angles[outside[0], j]
+                raise LumpbeamError(
+                    f'{what}: joint_{j + 1} at {value:.6g} rad is outside its limits '
+                    f'[{low:.6g}, {high:.6g}] rad ({self.source or "the arm file"})'
+                )
+
 
 def _per_segment(
     value: Any, key: str, source: str | Path, n_segments: int, *, positive: bool
@@ -195,7 +226,22 @@ def _link(raw: Any, prefix: str, source: str | Path) -> LinkConfig:
         joint_mass_kg=get_float(params, f'{prefix}.joint_mass_kg', source, 0.0, non_negative=True),
         ei_nm2=ei,
         k_total_nm_per_rad=k_total,
+        joint_limits_rad=_limits(params, f'{prefix}.joint_limits_rad', source),
     )
+
+
+def _limits(params: Mapping[str, Any], key: str, source: str | Path) -> tuple[float, float] | None:
+    """A link's optional ``joint_limits_rad: [LOW, HIGH]``."""
+    if key not in params:
+        return None
+    value = params[key]
+    if not isinstance(value, Sequence) or isinstance(value, str) or len(value) != 2:
+        raise ConfigError(source, key, f'expected [LOW, HIGH] in rad, got {value!r}')
+    low = get_float({key: value[0]}, key, source)
+    high = get_float({key: value[1]}, key, source)
+    if not low < high:
+        raise ConfigError(source, key, f'LOW {low!r} must be below HIGH {high!r}')
+    return low, high
 
 
 def arm_from_mapping(document: Any, source: str | Path) -> ArmConfig:
@@ -228,6 +274,60 @@ def arm_from_mapping(document: Any, source: str | Path) -> ArmConfig:
         payload_kg=get_float(params, 'arm.payload_kg', source, 0.0, non_negative=True),
         source=str(source),
     )
+
+
+def _uniform(values: tuple[float, ...]) -> bool:
+    return all(v == values[0] for v in values)
+
+
+def link_to_mapping(link: LinkConfig) -> dict[str, Any]:
+    """One entry of ``arm.links`` that :func:`arm_from_mapping` reads back as ``link``."""
+    entry: dict[str, Any] = {'length_m': link.length_m, 'n_segments': link.n_segments}
+    if link.ei_nm2 is not None:
+        ei = link.ei_nm2
+        entry['ei_nm2'] = ei[0] if _uniform(ei) else list(ei)
+    else:
+        entry['k_total_nm_per_rad'] = link.k_total_nm_per_rad
+    masses = link.segment_masses_kg
+    entry['mass_kg'] = link.mass_kg if _uniform(masses) else list(masses)
+    entry['damping_beta'] = link.damping_beta
+    entry['joint_mass_kg'] = link.joint_mass_kg
+    if link.joint_limits_rad is not None:
+        entry['joint_limits_rad'] = list(link.joint_limits_rad)
+    return entry
+
+
+def arm_to_mapping(arm: ArmConfig) -> dict[str, Any]:
+    """The document of an arm file that :func:`arm_from_mapping` reads back as ``arm``."""
+    return {
+        'arm': {
+            'plane': arm.plane,
+            'payload_kg': arm.payload_kg,
+            'links': [link_to_mapping(link) for link in arm.links],
+        }
+    }
+
+
+def write_arm_config(path: str | Path, arm: ArmConfig, header: str = '') -> None:
+    """Writes an arm file that :func:`load_arm_config` reads back.
+
+    A uniform link's mass is written as its total (its segments' masses may then differ from
+    the read-back ones in the last bit).
+
+    Args:
+        path: Output YAML file.
+        arm: The arm.
+        header: Comment lines written first (without ``#``), e.g. where the values came from.
+
+    Raises:
+        LumpbeamError: The file cannot be written.
+    """
+    text = ''.join(f'# {line}\n' for line in header.splitlines())
+    text += yaml.safe_dump(arm_to_mapping(arm), sort_keys=False)
+    try:
+        Path(path).write_text(text, encoding='utf-8')
+    except OSError as exc:
+        raise LumpbeamError(f'{path}: cannot write the arm file: {exc.strerror}') from None
 
 
 def load_arm_config(path: str | Path) -> ArmConfig:

@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from arm_cases import small_arm
+from arm_cases import FINALS, observe_modes, small_arm
 
 from lumpbeam_lab.mujoco_arm import MujocoArm
 from lumpbeam_ros.base.errors import LumpbeamError
@@ -26,11 +26,6 @@ from lumpbeam_ros.core.model.arm.model import ArmModel
 from lumpbeam_ros.core.model.arm.statics import arm_modes
 
 TRUTH = small_arm(3)
-#: Final joint angles of the moves (the vertical arm's modes change with them).
-FINALS = ([0.3, -0.4, 0.5], [-0.4, 0.6, -0.3], [0.6, 0.2, 0.4], [-0.2, -0.7, 0.9])
-#: Relative standard deviations of the measured frequencies and damping ratios, mode k
-#: (1-based) times these: the contract's accuracy of multi-mode identification.
-F_REL, ZETA_REL = 1e-3, 0.05
 
 
 def nominal_of(truth, factors=(0.8, 1.2, 0.8), beta_factor=1.3):
@@ -38,27 +33,6 @@ def nominal_of(truth, factors=(0.8, 1.2, 0.8), beta_factor=1.3):
     n = truth.n_joints
     betas = np.array([link.damping_beta * beta_factor for link in truth.links])
     return scaled_arm(truth, np.array(factors[:n]), betas)
-
-
-def observe(truth, finals, n_modes, rng=None, modes_at=None):
-    """The truth's first ``n_modes`` at each final configuration, noisy when ``rng`` is given."""
-    model = ArmModel.from_config(truth)
-    out = []
-    for q in finals:
-        q = np.asarray(q, dtype=float)
-        f, zeta = modes_at(q) if modes_at else _ours(model, q)
-        measured = []
-        for k in range(n_modes):
-            f_std, z_std = F_REL * (k + 1) * f[k], ZETA_REL * (k + 1) * zeta[k]
-            df, dz = (f_std, z_std) * rng.standard_normal(2) if rng is not None else (0.0, 0.0)
-            measured.append(MeasuredMode(f[k] + df, f_std, zeta[k] + dz, z_std))
-        out.append(ModeObservation(q, tuple(measured), f'q={q.tolist()}'))
-    return out
-
-
-def _ours(model, q):
-    modes = arm_modes(model, q)
-    return modes.natural_frequency_hz, modes.damping_ratio
 
 
 def truth_values(truth):
@@ -75,7 +49,7 @@ def fitted_stds(fit):
 
 @pytest.fixture(scope='module')
 def exact_fit():
-    return LinkParameterFit(nominal_of(TRUTH)).fit(observe(TRUTH, FINALS[:3], 3))
+    return LinkParameterFit(nominal_of(TRUTH)).fit(observe_modes(TRUTH, FINALS[:3], 3))
 
 
 def test_exact_modes_give_the_truth_back_from_20_percent_off(exact_fit):
@@ -93,7 +67,7 @@ def test_the_fitted_arm_predicts_the_truths_modes_elsewhere(exact_fit):
 
 def test_noisy_modes_give_the_truth_within_3_std_and_5_percent():
     rng = np.random.default_rng(4)
-    fit = LinkParameterFit(nominal_of(TRUTH)).fit(observe(TRUTH, FINALS, 3, rng))
+    fit = LinkParameterFit(nominal_of(TRUTH)).fit(observe_modes(TRUTH, FINALS, 3, rng))
     truth, got, std = truth_values(TRUTH), fitted_values(fit), fitted_stds(fit)
     assert np.all(np.abs(got[0] - truth[0]) < 3 * std[0])
     assert np.all(np.abs(got[0] / truth[0] - 1) < 0.05)
@@ -119,7 +93,7 @@ def test_a_mode_missing_from_a_bag_is_matched_past():
 
 
 def test_a_bag_missing_its_second_mode_still_fits():
-    obs = observe(TRUTH, FINALS[:3], 3)
+    obs = observe_modes(TRUTH, FINALS[:3], 3)
     first = obs[0]
     obs[0] = ModeObservation(first.joint_angles_rad, (first.modes[0], first.modes[2]), 'gap')
     fit = LinkParameterFit(nominal_of(TRUTH)).fit(obs)
@@ -130,7 +104,7 @@ def test_a_bag_missing_its_second_mode_still_fits():
 def test_one_link_needs_one_bag_and_a_link_without_damping_starts_from_the_data():
     truth = small_arm(1)
     nominal = scaled_arm(truth, np.array([0.8]), np.array([0.0]))
-    fit = LinkParameterFit(nominal).fit(observe(truth, [[0.4]], 1))
+    fit = LinkParameterFit(nominal).fit(observe_modes(truth, [[0.4]], 1))
     assert fitted_values(fit) == pytest.approx(truth_values(truth), rel=1e-6)
     assert fit.dof == 0 and fit.std_scale == 1.0
 
@@ -147,17 +121,17 @@ def test_modes_from_mujoco_give_the_truth_back():
         lam = lam[np.argsort(np.abs(lam))]
         return np.abs(lam) / (2 * np.pi), -lam.real / np.abs(lam)
 
-    obs = observe(truth, finals, 2, modes_at=mujoco_modes)
+    obs = observe_modes(truth, finals, 2, modes_at=mujoco_modes)
     fit = LinkParameterFit(nominal_of(truth)).fit(obs)
     assert fitted_values(fit) == pytest.approx(truth_values(truth), rel=1e-5)
 
 
 def test_a_link_the_data_hardly_see_is_reported_uncertain():
     # The first mode alone at three configurations: the wrist's stiffness barely shows.
-    fit = LinkParameterFit(nominal_of(TRUTH)).fit(observe(TRUTH, FINALS, 1))
+    fit = LinkParameterFit(nominal_of(TRUTH)).fit(observe_modes(TRUTH, FINALS, 1))
     warnings = fit.warnings()
     assert any(line.startswith("link 3's stiffness is uncertain by") for line in warnings)
-    three = LinkParameterFit(nominal_of(TRUTH)).fit(observe(TRUTH, FINALS[:3], 3)).warnings()
+    three = LinkParameterFit(nominal_of(TRUTH)).fit(observe_modes(TRUTH, FINALS[:3], 3)).warnings()
     assert not any('stiffness' in line for line in three)
 
 
@@ -172,14 +146,14 @@ def test_damping_ratios_measured_too_loosely_are_reported_with_what_to_record(ex
             o.joint_angles_rad,
             tuple(replace(m, damping_ratio_std=m.damping_ratio_std / 10) for m in o.modes),
         )
-        for o in observe(TRUTH, FINALS[:3], 3)
+        for o in observe_modes(TRUTH, FINALS[:3], 3)
     ]
     assert LinkParameterFit(nominal_of(TRUTH)).fit(precise).warnings() == []
 
 
 def test_too_few_modes_for_the_links_is_refused_in_one_line():
     with pytest.raises(LumpbeamError, match=r'1 bag\(s\) give 2 mode\(s\).*at least 3') as err:
-        LinkParameterFit(nominal_of(TRUTH)).fit(observe(TRUTH, FINALS[:1], 2))
+        LinkParameterFit(nominal_of(TRUTH)).fit(observe_modes(TRUTH, FINALS[:1], 2))
     assert '\n' not in str(err.value)
 
 
@@ -187,7 +161,7 @@ def test_configurations_too_alike_leave_a_link_undetermined():
     # Two bags ending at the same angles give the first mode twice: two measurements of
     # one frequency cannot separate two links' stiffnesses.
     truth = small_arm(2)
-    obs = observe(truth, [FINALS[0][:2], FINALS[0][:2]], 1)
+    obs = observe_modes(truth, [FINALS[0][:2], FINALS[0][:2]], 1)
     with pytest.raises(LumpbeamError, match='do not determine link'):
         LinkParameterFit(nominal_of(truth)).fit(obs)
 
@@ -251,7 +225,7 @@ def test_a_frequency_measured_finer_than_the_model_matches_is_held_to_the_floor(
     # A first mode reported to 1e-9 claims no stiffness tighter than the linearized model's
     # own 1e-5: the std stays at the floor's size, and an error of a few floors is covered.
     one = small_arm(1)
-    (obs,) = observe(one, [[0.4]], 2)
+    (obs,) = observe_modes(one, [[0.4]], 2)
     fine = [replace(m, natural_frequency_hz_std=1e-9 * m.natural_frequency_hz) for m in obs.modes]
     off = replace(fine[0], natural_frequency_hz=fine[0].natural_frequency_hz * (1 + 2e-5))
     fit = LinkParameterFit(nominal_of(one)).fit([replace(obs, modes=(off, fine[1]))])

@@ -2,11 +2,16 @@
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
-from lumpbeam_ros.base.errors import ConfigError
-from lumpbeam_ros.core.model.arm.config import arm_from_mapping, load_arm_config
+from lumpbeam_ros.base.errors import ConfigError, LumpbeamError
+from lumpbeam_ros.core.model.arm.config import (
+    arm_from_mapping,
+    load_arm_config,
+    write_arm_config,
+)
 
 LINK = {
     'length_m': 1.2,
@@ -83,6 +88,10 @@ def test_mass_list_is_per_segment_and_horizontal_has_no_gravity():
         ({'damping_beta': -1e-4}, 'arm.links[1].damping_beta', 'negative'),
         ({'joint_mass_kg': -1.0}, 'arm.links[1].joint_mass_kg', 'negative'),
         ({'stiffness': 1.0}, 'arm.links[1].stiffness', 'unknown key'),
+        ({'joint_limits_rad': 3.0}, 'arm.links[1].joint_limits_rad', '[LOW, HIGH]'),
+        ({'joint_limits_rad': [1.0]}, 'arm.links[1].joint_limits_rad', '[LOW, HIGH]'),
+        ({'joint_limits_rad': [1.0, -1.0]}, 'arm.links[1].joint_limits_rad', 'below'),
+        ({'joint_limits_rad': [-1.0, 'up']}, 'arm.links[1].joint_limits_rad', 'number'),
     ],
 )
 def test_a_bad_link_value_is_one_line_naming_file_and_key(changes, key, words):
@@ -125,3 +134,44 @@ def test_missing_and_broken_files(tmp_path):
 def test_the_example_configurations_load(name, joints):
     arm = load_arm_config(Path(__file__).resolve().parents[4] / 'config' / name)
     assert arm.n_joints == joints
+
+
+@pytest.mark.parametrize(
+    'changes',
+    [
+        {},
+        {'ei_nm2': [4000.0, 3000.0, 2000.0, 1000.5], 'mass_kg': [0.4, 0.3, 0.2, 0.1]},
+        {'ei_nm2': None, 'k_total_nm_per_rad': 1234.5, 'joint_limits_rad': [-2.5, 1.25]},
+    ],
+    ids=['uniform', 'lists', 'k_total and limits'],
+)
+def test_a_written_arm_reads_back_the_same(tmp_path, changes):
+    arm = arm_from_mapping(_doc(**changes), 'f')
+    path = tmp_path / 'out.yaml'
+    write_arm_config(path, arm, header='fitted\nfrom two bags')
+    assert path.read_text().startswith('# fitted\n# from two bags\n')
+    again = load_arm_config(path)
+    assert again.plane == arm.plane and again.payload_kg == arm.payload_kg
+    for read, written in zip(again.links, arm.links, strict=True):
+        assert read.segment_masses_kg == pytest.approx(written.segment_masses_kg, rel=1e-15)
+        assert read.spring_stiffness() == pytest.approx(written.spring_stiffness(), rel=1e-15)
+        assert (read.damping_beta, read.joint_limits_rad) == (
+            written.damping_beta,
+            written.joint_limits_rad,
+        )
+
+
+def test_an_arm_file_that_cannot_be_written_is_one_line(tmp_path):
+    arm = arm_from_mapping(_doc(), 'f')
+    with pytest.raises(LumpbeamError, match='cannot write the arm file'):
+        write_arm_config(tmp_path / 'no' / 'such' / 'dir.yaml', arm)
+
+
+def test_angles_outside_a_joints_limits_are_refused_naming_the_joint():
+    arm = arm_from_mapping(_doc(joint_limits_rad=[-1.0, 1.0]), 'arm.yaml')
+    arm.check_within_limits(np.array([[5.0, 0.5], [-5.0, -1.0]]), 'IN.csv')
+    with pytest.raises(LumpbeamError) as info:
+        arm.check_within_limits(np.array([[0.0, 0.5], [0.0, 1.2]]), 'IN.csv')
+    assert str(info.value) == (
+        'IN.csv: joint_2 at 1.2 rad is outside its limits [-1, 1] rad (arm.yaml)'
+    )
