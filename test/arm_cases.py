@@ -6,6 +6,7 @@ from lumpbeam_lab.mujoco_arm import beam_as_arm
 from lumpbeam_ros.core.ident.arm.link_fit import MeasuredMode, ModeObservation
 from lumpbeam_ros.core.model.arm.config import ArmConfig, arm_from_mapping
 from lumpbeam_ros.core.model.arm.drive import SmoothMotion
+from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
 from lumpbeam_ros.core.model.arm.model import ArmModel
 from lumpbeam_ros.core.model.arm.statics import arm_modes
 from lumpbeam_ros.core.model.parameters import BeamParameters
@@ -104,3 +105,12 @@ def modes_of(model, q):
     """The model's frequencies and damping ratios at rest at q."""
     modes = arm_modes(model, q)
     return modes.natural_frequency_hz, modes.damping_ratio
+
+
+def minimum_jerk(start, end, duration, before=0.0, after=0.0, step=1e-3):
+    """A rest-to-rest move sampled every ``step``, with rests before and after it."""
+    t = np.arange(round((before + duration + after) / step) + 1) * step
+    s = np.clip((t - before) / duration, 0.0, 1.0)
+    path = 10 * s**3 - 15 * s**4 + 6 * s**5
+    start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    return JointTrajectory(t, start + np.outer(path, end - start))

@@ -15,9 +15,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from lumpbeam_ros.apps.cli.output import non_negative_float, positive_float
+from lumpbeam_ros.apps.cli.output import non_negative_float, positive_float, positive_int
 from lumpbeam_ros.base.interface import CAMERA_INFO, TIP_POSE, TRACKER_POINT
 from lumpbeam_ros.core.records.units import AXES, DEFAULT_START, UNITS
+from lumpbeam_ros.core.shaping.choices import DEFAULT_MAX_MODES, SHAPER_NAMES
 
 Subparsers = argparse._SubParsersAction
 
@@ -82,8 +83,6 @@ TRACKER_NOISE_M = 15e-6
 TRACKER_CLOCK_OFFSET_S = 7.3e-3
 TRACKER_POSE = (1.2, -3.0, 0.35, 4.0, -8.0, 100.0)
 
-#: The shapers of ``lumpbeam shape`` (``shaping.shapers.SHAPERS``).
-SHAPER_NAMES = ('zv', 'zvd', 'ei')
 
 TRACK_DESCRIPTION = """\
 Tracks the tip in camera footage and writes OUT, a rosbag2 bag (MCAP) with /tip_pose.
@@ -370,6 +369,31 @@ def add_shape(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         '--json', metavar='FILE', help='write the impulses and the time added as JSON'
+    )
+    model = parser.add_argument_group("shaping by an arm's model (doc/arm.md)")
+    model.add_argument(
+        '--arm',
+        metavar='FILE',
+        help="shape each move (a stretch between rests) for the first modes of this arm's "
+        'model at its final angles, in place of --frequency-hz or --params',
+    )
+    model.add_argument(
+        '--payload-kg',
+        type=non_negative_float,
+        metavar='M',
+        help="with --arm: the payload at the last link's free end, kg (default: the file's)",
+    )
+    model.add_argument(
+        '--max-modes',
+        type=positive_int,
+        metavar='N',
+        help=f'with --arm: modes shaped per move, slowest first (default {DEFAULT_MAX_MODES})',
+    )
+    model.add_argument(
+        '--tune',
+        action='store_true',
+        help="with --arm: tune each move's impulses on the model's simulation of that move "
+        '(fast moves through large angles, which no fixed shaper cancels)',
     )
 
 
@@ -686,17 +710,6 @@ def add_demo(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def workers_count(text: str) -> int:
-    """Argument type of ``--workers``: a whole number, 1 or more."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'not a whole number: {text!r}') from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f'must be 1 or more, got {text!r}')
-    return value
-
-
 @_subcommand(
     'campaign',
     help='analyze (and diagnose) many bags on a Dask cluster',
@@ -721,7 +734,7 @@ def add_campaign(parser: argparse.ArgumentParser) -> None:
         help='seconds to wait for --scheduler to answer (10)',
     )
     parser.add_argument(
-        '--workers', type=workers_count, default=2, metavar='N', help='local cluster workers (2)'
+        '--workers', type=positive_int, default=2, metavar='N', help='local cluster workers (2)'
     )
     parser.add_argument('--config', help='beam parameter file (default: config/paper_beam.yaml)')
     parser.add_argument('--identifier-config', help='identifier parameter file')

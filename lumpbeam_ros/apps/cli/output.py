@@ -7,7 +7,7 @@ import math
 
 from lumpbeam_ros.apps.json_output import write_json
 
-__all__ = ['non_negative_float', 'positive_float', 'write_json']
+__all__ = ['non_negative_float', 'positive_float', 'positive_int', 'write_json']
 
 
 def _bounded_float(text: str, allow_zero: bool) -> float:
@@ -49,3 +49,24 @@ def non_negative_float(text: str) -> float:
         argparse.ArgumentTypeError: Not a non-negative finite number.
     """
     return _bounded_float(text, allow_zero=True)
+
+
+def positive_int(text: str) -> int:
+    """Argument type: a whole number, 1 or more.
+
+    Args:
+        text: The option's value.
+
+    Returns:
+        The number.
+
+    Raises:
+        argparse.ArgumentTypeError: Not a whole number, or below 1.
+    """
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'not a whole number: {text!r}') from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f'must be 1 or more, got {text!r}')
+    return value

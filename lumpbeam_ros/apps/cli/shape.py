@@ -1,4 +1,8 @@
-"""``lumpbeam shape IN OUT``: a joint trajectory convolved with an input shaper."""
+"""``lumpbeam shape IN OUT``: a joint trajectory convolved with an input shaper.
+
+With ``--arm FILE``, each move is shaped for the modes of the arm's model at its own final
+angles (and with ``--tune``, on the model's simulation of it).
+"""
 
 from __future__ import annotations
 
@@ -50,6 +54,19 @@ def modes_from_options(args: argparse.Namespace) -> list[Mode]:
 
 def run(args: argparse.Namespace) -> int:
     """Designs the shaper, shapes the trajectory, writes it; prints what vibration is left."""
+    if args.arm is not None:
+        return run_by_model(args)
+    given = [
+        option
+        for option, value in (
+            ('--payload-kg', args.payload_kg),
+            ('--max-modes', args.max_modes),
+            ('--tune', args.tune or None),
+        )
+        if value is not None
+    ]
+    if given:
+        raise LumpbeamError(f'{", ".join(given)}: only with --arm FILE')
     modes = modes_from_options(args)
     impulses = design_shaper(args.shaper, modes)
     trajectory = read_trajectory_csv(args.input)
@@ -83,6 +100,58 @@ def run(args: argparse.Namespace) -> int:
                 'duration_added_s': impulses.duration_s,
                 'shaper': args.shaper,
                 'modes': summaries,
+            },
+        )
+    return 0
+
+
+def run_by_model(args: argparse.Namespace) -> int:
+    """Shapes each move for the arm model's modes at its end; prints a line per move.
+
+    Raises:
+        LumpbeamError: Modes given as well, a bad arm file or trajectory, a trajectory for
+            another number of joints or outside a joint's limits.
+    """
+    from lumpbeam_ros.core.model.arm.config import load_arm_config
+    from lumpbeam_ros.core.shaping.choices import DEFAULT_MAX_MODES
+    from lumpbeam_ros.core.shaping.workspace import WorkspaceShaper
+
+    if args.frequency_hz or args.damping_ratio or args.params is not None:
+        raise LumpbeamError(
+            '--arm shapes each move for the modes of the model: not with --frequency-hz, '
+            '--damping-ratio or --params'
+        )
+    arm = load_arm_config(args.arm)
+    if args.payload_kg is not None:
+        arm = arm.with_payload(args.payload_kg)
+    trajectory = read_trajectory_csv(args.input)
+    max_modes = DEFAULT_MAX_MODES if args.max_modes is None else args.max_modes
+    shaper = WorkspaceShaper(arm, args.shaper, max_modes, tune=args.tune)
+    shaped, moves = shaper.shape(trajectory)
+    write_trajectory_csv(args.output, shaped)
+    print(
+        f'{args.input}: {trajectory.joint_count} joints, {len(moves)} move(s) over '
+        f'{trajectory.duration_s:.3f} s; {args.shaper.upper()} for the first {max_modes} '
+        f"mode(s) of {args.arm} at each move's end{', tuned' if args.tune else ''}"
+    )
+    for k, move in enumerate(moves, start=1):
+        modes = ', '.join(f'{m.frequency_hz:.4g} Hz' for m in move.modes)
+        print(
+            f'  move {k}: {move.start_s:.3f}-{move.end_s:.3f} s, modes {modes}: '
+            f'{move.impulses.time_s.size} impulses, {move.impulses.duration_s:.4f} s added; '
+            f'predicted residual {1e3 * move.predicted_residual_unshaped_m:.4g} mm unshaped, '
+            f'{1e3 * move.predicted_residual_shaped_m:.4g} mm shaped '
+            f'({100 * move.reduction:.2f} % less)'
+        )
+    print(f'wrote {args.output}: {shaped.time_s.size} samples over {shaped.duration_s:.3f} s')
+    if args.json:
+        write_json(
+            args.json,
+            {
+                'moves': [move.as_json() for move in moves],
+                'duration_added_s': sum(move.impulses.duration_s for move in moves),
+                'shaper': args.shaper,
+                'tuned': args.tune,
             },
         )
     return 0

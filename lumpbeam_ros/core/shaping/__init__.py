@@ -2,11 +2,14 @@
 
 __all__ = [
     'apply',
+    'choices',
     'estimate',
     'extra_insensitive',
     'impulses',
     'loop',
     'modes_file',
     'shapers',
+    'tune',
     'vibration',
+    'workspace',
 ]

@@ -45,19 +45,19 @@ def _count(span_s: float, step_s: float) -> int:
     return count
 
 
-def shaped_times(trajectory: JointTrajectory, impulses: Impulses) -> np.ndarray:
+def shaped_times(trajectory: JointTrajectory, added_s: float) -> np.ndarray:
     """The sample times of the shaped trajectory.
 
-    From the input's first time to its last plus the shaper's duration. An input evenly
-    sampled at 1 kHz or finer keeps its grid (the last interval may be shorter, to end on
-    the last time); any other input gives evenly spaced times at 1 kHz, or at the input's
-    median interval if finer.
+    From the input's first time to its last plus ``added_s`` (the shapers' duration). An
+    input evenly sampled at 1 kHz or finer keeps its grid (the last interval may be shorter,
+    to end on the last time); any other input gives evenly spaced times at 1 kHz, or at the
+    input's median interval if finer.
 
     Raises:
         LumpbeamError: The shaped trajectory would exceed :data:`MAX_SAMPLES` samples.
     """
     start = float(trajectory.time_s[0])
-    span = trajectory.duration_s + impulses.duration_s
+    span = trajectory.duration_s + added_s
     step = _even_step(trajectory.time_s)
     if step is not None and step <= MAX_STEP_S:
         times = start + np.arange(_count(span, step)) * step
@@ -101,7 +101,7 @@ def shape_trajectory(trajectory: JointTrajectory, impulses: Impulses) -> JointTr
     Raises:
         LumpbeamError: The shaped trajectory would be too long (see :func:`shaped_times`).
     """
-    times = shaped_times(trajectory, impulses)
+    times = shaped_times(trajectory, impulses.duration_s)
     step = _even_step(trajectory.time_s)
     delay = impulses.time_s - impulses.time_s[0]
     if step is not None and step <= MAX_STEP_S:

@@ -20,6 +20,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.core.shaping.choices import SHAPER_NAMES
 from lumpbeam_ros.core.shaping.extra_insensitive import ei_shaper
 from lumpbeam_ros.core.shaping.impulses import Impulses, Mode
 
@@ -45,11 +46,9 @@ def zvd_shaper(mode: Mode) -> Impulses:
 
 
 #: The shapers by the names the command line and the node take.
-SHAPERS: dict[str, Callable[[Mode], Impulses]] = {
-    'zv': zv_shaper,
-    'zvd': zvd_shaper,
-    'ei': ei_shaper,
-}
+SHAPERS: dict[str, Callable[[Mode], Impulses]] = dict(
+    zip(SHAPER_NAMES, (zv_shaper, zvd_shaper, ei_shaper), strict=True)
+)
 
 
 def design_shaper(kind: str, modes: Sequence[Mode]) -> Impulses:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from lumpbeam_ros.base.interface import SHAPER_NODE
 from lumpbeam_ros.base.schema import Bounds, ParameterSchema, ParameterSpec
+from lumpbeam_ros.core.shaping.choices import DEFAULT_MAX_MODES, SHAPER_NAMES
 
 SHAPER_SCHEMA = ParameterSchema(
     node=SHAPER_NODE,
@@ -43,7 +44,7 @@ SHAPER_SCHEMA = ParameterSchema(
             'string',
             'zv',
             'the shaper for well-known frequencies (and for source parameters)',
-            choices=('zv', 'zvd', 'ei'),
+            choices=SHAPER_NAMES,
         ),
         ParameterSpec(
             'robust_shaper',
@@ -65,7 +66,7 @@ SHAPER_SCHEMA = ParameterSchema(
         ParameterSpec(
             'max_modes',
             'int',
-            2,
+            DEFAULT_MAX_MODES,
             'cancel at most this many identified modes (the first ones, by frequency)',
             '',
             Bounds(1, 8),

@@ -4,6 +4,8 @@ import json
 
 import numpy as np
 import pytest
+import yaml
+from arm_cases import minimum_jerk, small_arm_document
 
 from lumpbeam_ros.apps.cli.main import main
 from lumpbeam_ros.core.model.arm.joint_trajectory import (
@@ -158,3 +160,83 @@ def test_a_non_number_is_a_usage_error(tmp_path, move, capsys):
         main(['shape', str(move), str(tmp_path / 'o.csv'), '--frequency-hz', 'fast'])
     assert caught.value.code == 2
     assert "invalid float value: 'fast'" in capsys.readouterr().err
+
+
+@pytest.fixture(scope='module')
+def arm_files(tmp_path_factory):
+    """small_arm(2)'s file and a two-move trajectory for it (out, rest, back)."""
+    root = tmp_path_factory.mktemp('shape_arm')
+    arm = root / 'arm.yaml'
+    arm.write_text(yaml.safe_dump(small_arm_document(2)))
+    out = minimum_jerk([0.0, 0.0], [0.5, -0.8], 0.3, before=0.1, after=0.4)
+    back = minimum_jerk([0.5, -0.8], [-0.2, 0.6], 0.25, after=0.2)
+    t = np.concatenate([out.time_s, out.time_s[-1] + 1e-3 + back.time_s])
+    moves = root / 'moves.csv'
+    write_trajectory_csv(moves, JointTrajectory(t, np.vstack([out.angles_rad, back.angles_rad])))
+    return arm, moves
+
+
+@pytest.mark.parametrize('tune', [False, True], ids=['untuned', 'tuned'])
+def test_each_move_is_shaped_by_the_arms_model(tmp_path, arm_files, capsys, tune):
+    arm, moves = arm_files
+    out, report = tmp_path / 'shaped.csv', tmp_path / 'shape.json'
+    argv = ['shape', str(moves), str(out), '--arm', str(arm), '--json', str(report)]
+    assert main(argv + (['--tune'] if tune else [])) == 0
+    data = json.loads(report.read_text())
+    assert len(data['moves']) == 2 and data['tuned'] is tune
+    first, second = data['moves']
+    assert first['final_q'] == pytest.approx([0.5, -0.8])
+    assert len(first['modes']) == 2
+    for move in data['moves']:
+        assert move['predicted_residual_shaped_m'] < 0.1 * move['predicted_residual_unshaped_m']
+    shaped = read_trajectory_csv(out)
+    added = first['duration_added_s'] + second['duration_added_s']
+    assert data['duration_added_s'] == pytest.approx(added)
+    assert shaped.time_s[-1] == pytest.approx(read_trajectory_csv(moves).time_s[-1] + added)
+    printed = capsys.readouterr().out
+    assert 'move 2: 0.801-1.051 s' in printed and '% less)' in printed
+
+
+def test_the_payload_option_changes_the_modes(tmp_path, arm_files):
+    arm, moves = arm_files
+    modes = []
+    for payload in ('0', '2'):
+        report = tmp_path / f'{payload}.json'
+        argv = ['shape', str(moves), str(tmp_path / 'o.csv'), '--arm', str(arm)]
+        assert (
+            main([*argv, '--payload-kg', payload, '--max-modes', '1', '--json', str(report)]) == 0
+        )
+        (mode,) = json.loads(report.read_text())['moves'][0]['modes']
+        modes.append(mode['natural_frequency_hz'])
+    assert modes[1] < 0.8 * modes[0]
+
+
+@pytest.mark.parametrize(
+    ('options', 'problem'),
+    [
+        (['--tune'], '--tune: only with --arm FILE'),
+        (['--payload-kg', '1', '--max-modes', '1'], '--payload-kg, --max-modes: only with --arm'),
+        (['--arm', 'ARM', '--frequency-hz', '2'], 'not with --frequency-hz, --damping-ratio'),
+        (['--arm', 'missing.yaml'], 'missing.yaml: no such file'),
+        (['--arm', 'ARM3'], 'the trajectory has 2 joints, the arm 3'),
+        (
+            ['--arm', 'LIMITED'],
+            'joint_2 at -0.503636 rad is outside its limits [-0.5, 1] rad',
+        ),
+    ],
+)
+def test_bad_input_by_the_model_is_one_line(tmp_path, arm_files, capsys, options, problem):
+    arm, moves = arm_files
+    three = tmp_path / 'three.yaml'
+    three.write_text(yaml.safe_dump(small_arm_document(3)))
+    document = small_arm_document(2)
+    document['arm']['links'][1]['joint_limits_rad'] = [-0.5, 1.0]
+    limited = tmp_path / 'limited.yaml'
+    limited.write_text(yaml.safe_dump(document))
+    names = {'ARM': str(arm), 'ARM3': str(three), 'LIMITED': str(limited)}
+    out = tmp_path / 'o.csv'
+    assert main(['shape', str(moves), str(out), *(names.get(o, o) for o in options)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith('lumpbeam shape: error: ') and problem in err, err
+    assert err.count('\n') == 1
+    assert not out.exists()

@@ -65,7 +65,7 @@ def test_shaped_move_starts_and_ends_at_rest_at_exactly_the_same_angles(rate_hz,
 def test_an_even_input_at_1_khz_or_finer_keeps_its_grid(rate_hz):
     move = _move(rate_hz=rate_hz)
     impulses = design_shaper('zv', [Mode(3.0, 0.0)])
-    times = shaped_times(move, impulses)
+    times = shaped_times(move, impulses.duration_s)
     assert np.allclose(times[: move.time_s.size], move.time_s, rtol=0, atol=1e-12)
     steps = np.diff(times)
     assert np.allclose(steps[:-1], 1 / rate_hz, rtol=1e-9, atol=0)
@@ -77,7 +77,7 @@ def test_an_even_input_at_1_khz_or_finer_keeps_its_grid(rate_hz):
 def test_other_inputs_are_resampled_evenly_at_1_khz_or_their_median_interval(times):
     move = JointTrajectory(times, times * 2)
     impulses = design_shaper('zv', [Mode(3.0, 0.0)])
-    steps = np.diff(shaped_times(move, impulses))
+    steps = np.diff(shaped_times(move, impulses.duration_s))
     step = min(1e-3, float(np.median(np.diff(times))))
     # Evenly spaced, the step shrunk just enough to end on the last time.
     assert np.ptp(steps) < 1e-12

@@ -32,6 +32,7 @@ deflections' by their series.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -416,7 +417,8 @@ class DeflectionSolver:
             # Each sweep shrinks the error by about the ratio of its change to the last one's
             # (the first change, from the guess, says nothing of that ratio), so this sweep's
             # deflections are off by about that ratio times its change.
-            if change < self.tol or change * change < self.tol * last_change:
+            # (Its square root, not the change squared: a change near 1e155 would overflow.)
+            if change < self.tol or change < math.sqrt(self.tol * last_change):
                 return d, d_dot, u
             last_change = change if sweep else 0.0
             previous = d
