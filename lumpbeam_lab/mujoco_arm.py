@@ -27,6 +27,7 @@ import mujoco.rollout
 import numpy as np
 
 from lumpbeam_ros.core.model.arm.config import ArmConfig, arm_from_mapping
+from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
 from lumpbeam_ros.core.model.parameters import BeamParameters
 
 Drive = Callable[[float], tuple[np.ndarray, np.ndarray]]
@@ -349,3 +350,47 @@ def mujoco_drop_test(
         float(abs(first) / (2.0 * math.pi)),
         float(-first.real / abs(first)),
     )
+
+
+def mujoco_residual(
+    config: ArmConfig, trajectory: JointTrajectory, window_s: float, sample_every: float = 2e-3
+) -> float:
+    """A move's residual vibration in MuJoCo: the tip's RMS distance from MuJoCo's own rest.
+
+    The arm starts at MuJoCo's static equilibrium at the first row and follows the cubic
+    spline of the rows (what the arm's model follows for a dense trajectory), run in MuJoCo's
+    own loop at a step within RK4's stability on the arm's fastest pole; the window opens at
+    the last row.
+
+    Args:
+        config: The arm (the truth).
+        trajectory: The commanded move, rest to rest.
+        window_s: The window after the move, s.
+        sample_every: The tip's sampling interval, s.
+
+    Returns:
+        The RMS distance over the window, m.
+    """
+    from scipy.interpolate import CubicSpline
+
+    from lumpbeam_ros.core.model.arm.residual import residual_rms
+
+    start, end = trajectory.time_s[0], trajectory.time_s[-1]
+    probe = MujocoArm(config)
+    probe.equilibrium(trajectory.angles_rad[-1])
+    rest_x, rest_z, _ = probe.tip_pose()
+    fastest = float(np.max(np.abs(probe.modal_eigenvalues())))
+    step = sample_every / max(20, math.ceil(sample_every * fastest / 2.0))
+    spline = CubicSpline(trajectory.time_s - start, trajectory.angles_rad, axis=0)
+    duration = end - start
+
+    def drives(times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        moving = (times <= duration)[:, np.newaxis]
+        clipped = np.minimum(times, duration)
+        q = np.where(moving, spline(clipped), trajectory.angles_rad[-1])
+        return q, np.where(moving, spline(clipped, 1), 0.0)
+
+    arm = MujocoArm(config, step)
+    arm.equilibrium(trajectory.angles_rad[0])
+    run = arm.rollout(drives, duration + window_s, sample_every)
+    return residual_rms(run['t'], run['x'], run['z'], (rest_x, rest_z), duration, window_s)

@@ -1,26 +1,45 @@
-"""Input shaping: a 10,000-point trajectory shaped, against ``scipy.signal.fftconvolve``.
+"""Input shaping's speed: a long trajectory shaped, and an arm's move tuned by its model.
+
+``shape_zvd_*``: a 10,000-point trajectory shaped, against ``scipy.signal.fftconvolve``.
 
 Ours sums one linear interpolation of each joint per impulse
 (:func:`~lumpbeam_ros.core.shaping.apply.shape_trajectory`). The baseline convolves the same 1 kHz
 samples, held at their last value for the shaper's duration, with the impulse train placed
 on the nearest 1 kHz sample (so it differs from ours by the impulses' rounding, reported as
 ``max_difference_rad``). Both are timed per joint, best of several runs.
+
+``shape_tuned_3link_1s``: one 1 s move of ``config/arm_3link.yaml`` (every joint, a minimum
+jerk through 0.8 to 1.4 rad) shaped by
+:class:`~lumpbeam_ros.core.shaping.workspace.WorkspaceShaper` for the model's first two modes
+at its end, tuned (``--tune``) against untuned in the same run, in CPU seconds: the target
+is a tuned move in under 1 s of CPU.
 """
 
 from __future__ import annotations
+
+import time
+from pathlib import Path
 
 import numpy as np
 from scipy.signal import fftconvolve
 
 from lumpbeam_lab.bench.bench_result import BenchResult, best_time
+from lumpbeam_lab.shaping_loop import minimum_jerk
+from lumpbeam_ros.core.model.arm.config import load_arm_config
 from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
 from lumpbeam_ros.core.shaping.apply import shape_trajectory
 from lumpbeam_ros.core.shaping.impulses import Impulses, Mode
 from lumpbeam_ros.core.shaping.shapers import design_shaper
+from lumpbeam_ros.core.shaping.workspace import WorkspaceShaper
 
 BASELINE = 'scipy.signal.fftconvolve'
 STEP_S = 1e-3
 JOINTS = 3
+ARM_FILE = Path(__file__).resolve().parents[2] / 'config' / 'arm_3link.yaml'
+#: The bench's move of the three-link arm: start, end (rad), duration (s).
+TUNED_MOVE = ((0.0, 0.5, -0.5), (0.8, -0.6, 0.9), 1.0)
+#: A tuned 1 s move must take less CPU than this, s.
+TUNED_CPU_TARGET_S = 1.0
 
 
 def _trajectory(points: int) -> JointTrajectory:
@@ -68,6 +87,35 @@ def shaping_speed(name: str, modes: list[Mode], points: int, repeat: int) -> Ben
     )
 
 
+def tuned_move(repeat: int) -> BenchResult:
+    """The three-link arm's move shaped by its model: tuned against untuned, CPU seconds."""
+    arm = load_arm_config(ARM_FILE)
+    start, end, duration = TUNED_MOVE
+    move = minimum_jerk(np.array(start), np.array(end), duration)
+    untuned_shaper = WorkspaceShaper(arm, 'zvd', 2)
+    untuned_s, untuned = best_time(
+        lambda: untuned_shaper.shape_move(move), repeat, time.process_time
+    )
+    tuner = WorkspaceShaper(arm, 'zvd', 2, tune=True)
+    tuned_s, tuned = best_time(lambda: tuner.shape_move(move), repeat, time.process_time)
+    return BenchResult(
+        name='shape_tuned_3link_1s',
+        value=tuned_s,
+        unit='CPU s',
+        baseline='the same move shaped untuned (modes, ZVD, both predictions)',
+        baseline_value=untuned_s,
+        ratio=untuned_s / tuned_s,
+        details={
+            'unshaped_residual_m': tuned.predicted_residual_unshaped_m,
+            'untuned_residual_m': untuned.predicted_residual_shaped_m,
+            'tuned_residual_m': tuned.predicted_residual_shaped_m,
+            'tuned_reduction': tuned.reduction,
+            'target': f'{"pass" if tuned_s < TUNED_CPU_TARGET_S else "FAIL"} '
+            f'(a tuned 1 s move in < {TUNED_CPU_TARGET_S:g} s of CPU)',
+        },
+    )
+
+
 def run(quick: bool = False) -> list[BenchResult]:
     """Runs the shaping suite.
 
@@ -75,7 +123,8 @@ def run(quick: bool = False) -> list[BenchResult]:
         quick: 1,000 points, one run each.
 
     Returns:
-        A ZVD shaper for one mode (3 impulses), then for two modes (9 impulses).
+        A ZVD shaper for one mode (3 impulses), then for two modes (9 impulses), then the
+        three-link arm's move tuned.
     """
     points, repeat = (1_000, 1) if quick else (10_000, 20)
     one = [Mode(2.0, 0.02)]
@@ -83,4 +132,5 @@ def run(quick: bool = False) -> list[BenchResult]:
     return [
         shaping_speed(f'shape_zvd_1mode_{points}pts', one, points, repeat),
         shaping_speed(f'shape_zvd_2modes_{points}pts', two, points, repeat),
+        tuned_move(1 if quick else 3),
     ]

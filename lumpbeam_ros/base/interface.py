@@ -62,6 +62,8 @@ TIP_POSE_TRUTH = '/tip_pose_truth'
 JOINT_STATES = '/joint_states'
 JOINT_TRAJECTORY = '/joint_trajectory'
 JOINT_TRAJECTORY_SHAPED = '/joint_trajectory_shaped'
+#: The identified arm: its links (or payload) fitted to every ring-down so far.
+ARM_PARAMS = '/arm_params'
 
 #: Every topic of the interface with its message type.
 TOPIC_TYPES: dict[str, str] = {
@@ -83,6 +85,7 @@ TOPIC_TYPES: dict[str, str] = {
     JOINT_STATES: JOINT_STATE_TYPE,
     JOINT_TRAJECTORY: JOINT_TRAJECTORY_TYPE,
     JOINT_TRAJECTORY_SHAPED: JOINT_TRAJECTORY_TYPE,
+    ARM_PARAMS: DIAGNOSTIC_ARRAY,
 }
 
 #: Topics that stay absolute in a namespace: the graph-wide ones.
@@ -92,6 +95,8 @@ GLOBAL_TOPICS = (CLOCK, DIAGNOSTICS)
 
 #: The status on ``/beam_params``.
 IDENTIFIER_STATUS = 'lumpbeam/identifier'
+#: The status on ``/arm_params``.
+ARM_STATUS = 'lumpbeam/arm'
 #: The status on ``/model_discrepancy``.
 DIAGNOSIS_STATUS = 'lumpbeam/diagnosis'
 #: The camera node's status on ``/diagnostics``.

@@ -9,7 +9,11 @@ publishes one DiagnosticStatus ``lumpbeam/identifier`` (doc/interfaces.md, 'Topi
 
 On an arm (once ``/joint_states`` arrives) the free vibration is each move's ring-down: it
 starts where the joints stop (:class:`~lumpbeam_ros.core.ident.ring_down.RestTracker`) in place
-of a load release, and the tip is taken along its swing.
+of a load release, and the tip is taken along its swing. Given ``arm_config``, each ring-down
+that has lasted ``arm_fit_after_s`` joins the arm's fit
+(:class:`~lumpbeam_ros.core.ident.arm.learner.ArmLearner`): the links (or with ``fit_payload``
+the payload) fitted to every ring-down so far are published on ``/arm_params`` (status
+``lumpbeam/arm``, latched).
 
 Parameters: :data:`~lumpbeam_ros.nodes.params.identifier_params.IDENTIFIER_SCHEMA`
 (``doc/parameters.md``). Run it with the package's settings, on sim time when a bag is
@@ -36,6 +40,8 @@ from std_msgs.msg import Float64
 
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.base.interface import (
+    ARM_PARAMS,
+    ARM_STATUS,
     BASE_FRAME,
     BEAM_PARAMS,
     IDENTIFIER_STATUS,
@@ -44,8 +50,9 @@ from lumpbeam_ros.base.interface import (
     TIP_POSE,
 )
 from lumpbeam_ros.core.bagio.convert import joint_state_values, pose_values
+from lumpbeam_ros.core.ident.arm.learner import ArmEstimate, ArmLearner
 from lumpbeam_ros.core.ident.assembly import FitState
-from lumpbeam_ros.core.ident.identification import Identification
+from lumpbeam_ros.core.ident.identification import Identification, Status
 from lumpbeam_ros.core.ident.identify import identify_live
 from lumpbeam_ros.core.ident.ring_down import RestTracker
 from lumpbeam_ros.core.ident.settings import (
@@ -54,6 +61,7 @@ from lumpbeam_ros.core.ident.settings import (
     config_from_parameters,
 )
 from lumpbeam_ros.core.ident.window import SlidingWindow
+from lumpbeam_ros.core.model.arm.config import load_arm_config
 from lumpbeam_ros.core.model.parameters import BeamParameters, load_beam_config
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node, spin_live
@@ -95,6 +103,15 @@ class IdentifierNode(SchemaNode):
         subscription(self, PoseStamped, TIP_POSE, self._on_pose)
         subscription(self, Float64, TIP_LOAD, self._on_load)
         subscription(self, JointState, JOINT_STATES, self._on_joint_state)
+        self.learner: ArmLearner | None = None
+        self.arm_updates = 0
+        if values['arm_config']:
+            self.learner = ArmLearner(
+                load_arm_config(str(values['arm_config'])),
+                bool(values['fit_payload']),
+                float(values['arm_fit_after_s']),
+            )
+            self._arm_output = publisher(self, DiagnosticArray, ARM_PARAMS)
         self.create_timer(1.0 / self.config.publish_rate_hz, self._on_timer)
 
     def _on_pose(self, msg: PoseStamped) -> None:
@@ -117,6 +134,8 @@ class IdentifierNode(SchemaNode):
             self._resets = counts.resets
             self._state = None
             self.joints.clear()
+            if self.learner is not None:
+                self.learner.clear()
             self.get_logger().warning(
                 'tip pose stamps jumped back (a looping bag?): window emptied',
                 throttle_duration_sec=WARN_PERIOD_S,
@@ -150,6 +169,28 @@ class IdentifierNode(SchemaNode):
             self.window.snapshot(), self.beam, self.config, self._state, self.joints
         )
         self._output.publish(self.diagnostics(result))
+        if self.learner is not None:
+            estimate = self.learner.offer(self.joints.current, result)
+            if estimate is not None:
+                self._publish_arm(estimate)
+
+    def _publish_arm(self, estimate: ArmEstimate) -> None:
+        """Publishes the arm's fit on ``/arm_params`` and logs it."""
+        status = DiagnosticStatus(
+            level=bytes([int(estimate.status)]),
+            name=ARM_STATUS,
+            message=estimate.message,
+            hardware_id=self.hardware_id,
+            values=[KeyValue(key=k, value=v) for k, v in estimate.key_values()],
+        )
+        msg = DiagnosticArray(status=[status])
+        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.header.frame_id = BASE_FRAME
+        self._arm_output.publish(msg)
+        self.arm_updates += 1
+        logger = self.get_logger()
+        log = logger.info if estimate.status == Status.OK else logger.warning
+        log(f'{ARM_PARAMS}: {estimate.message}')
 
     def diagnostics(self, result: Identification) -> DiagnosticArray:
         """The ``/beam_params`` message of one identification (doc/interfaces.md, 'Topics').
@@ -202,7 +243,7 @@ def main(args: Sequence[str] | None = None) -> int:
     return run_node(
         IDENTIFIER_SCHEMA.node,
         IdentifierNode,
-        lambda node: {BEAM_PARAMS: node.updates},
+        lambda node: {BEAM_PARAMS: node.updates, ARM_PARAMS: node.arm_updates},
         args,
         run=spin_live,
     )

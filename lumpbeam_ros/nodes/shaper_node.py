@@ -8,10 +8,15 @@ later. The shaper cancels:
 - ``source: beam_params``: the modes of the latest valid ``/beam_params`` estimate (status
   ``lumpbeam/identifier``; up to ``max_modes``; ``shaper``, or ``robust_shaper`` when an
   identified frequency's relative standard deviation exceeds ``robust_above``);
-- ``source: parameters``: one mode fixed by ``frequency_hz`` and ``damping_ratio``.
+- ``source: parameters``: one mode fixed by ``frequency_hz`` and ``damping_ratio``;
+- ``source: model``: each move of the trajectory, for the first ``max_modes`` modes of the
+  arm's model at that move's end (:class:`~lumpbeam_ros.core.shaping.workspace.WorkspaceShaper`,
+  ``tune`` as ``lumpbeam shape --tune``), the arm being ``arm_config``'s until a status
+  ``lumpbeam/arm`` of level OK on ``/arm_params`` gives the identified links (or payload).
 
-An invalid estimate (level ERROR, a value missing or not finite, a standard deviation larger
-than its value) never makes a shaper: the node keeps the last good one and warns (throttled).
+An invalid estimate or arm (level ERROR, or WARN for the arm; a value missing or not finite,
+a standard deviation larger than its value) never makes a shaper: the node keeps the last
+good one and warns (throttled).
 Until it has a first one it publishes nothing, and warns for each trajectory dropped: a
 consumer of ``/joint_trajectory_shaped`` relies on the commands being shaped, and an unshaped
 move published there would ring while claiming not to; the unshaped command stays on
@@ -35,17 +40,22 @@ from typing import Unpack
 from diagnostic_msgs.msg import DiagnosticArray
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
 
-from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.base.errors import ConfigError, LumpbeamError
 from lumpbeam_ros.base.interface import (
+    ARM_PARAMS,
+    ARM_STATUS,
     BEAM_PARAMS,
     IDENTIFIER_STATUS,
     JOINT_TRAJECTORY,
     JOINT_TRAJECTORY_SHAPED,
 )
+from lumpbeam_ros.core.ident.arm.learner import arm_from_status
+from lumpbeam_ros.core.model.arm.config import ArmConfig, load_arm_config
 from lumpbeam_ros.core.shaping.apply import shape_trajectory
 from lumpbeam_ros.core.shaping.estimate import choose_shaper, estimate_from_status
 from lumpbeam_ros.core.shaping.impulses import Impulses, Mode
 from lumpbeam_ros.core.shaping.shapers import design_shaper
+from lumpbeam_ros.core.shaping.workspace import WorkspaceShaper
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
 from lumpbeam_ros.nodes.params.shaper_params import SHAPER_SCHEMA
@@ -82,11 +92,47 @@ class ShaperNode(SchemaNode):
         self._unshaped_first = bool(values['unshaped_until_estimate'])
         self._output = publisher(self, JointTrajectoryMsg, JOINT_TRAJECTORY_SHAPED)
         subscription(self, JointTrajectoryMsg, JOINT_TRAJECTORY, self._on_trajectory)
+        self.workspace: WorkspaceShaper | None = None
         if values['source'] == 'parameters':
             mode = Mode(float(values['frequency_hz']), float(values['damping_ratio']))
             self._adopt(str(values['shaper']), [mode])
+        elif values['source'] == 'model':
+            if not values['arm_config']:
+                raise ConfigError(
+                    f'{self.get_name()} parameters', 'arm_config', 'needed with source model'
+                )
+            self.nominal = load_arm_config(str(values['arm_config']))
+            self._adopt_arm(self.nominal, f'the arm file {values["arm_config"]}')
+            subscription(self, DiagnosticArray, ARM_PARAMS, self._on_arm)
         else:
             subscription(self, DiagnosticArray, BEAM_PARAMS, self._on_params)
+
+    def _adopt_arm(self, arm: ArmConfig, source: str) -> None:
+        values = self.parameter_values
+        self.workspace = WorkspaceShaper(
+            arm,
+            str(values['shaper']),
+            int(values['max_modes']),
+            tune=bool(values['tune']),
+            predict=False,
+        )
+        self.description = f'{str(values["shaper"]).upper()} by the model of {source}'
+        self.get_logger().info(f'shaping each move with {self.description}')
+
+    def _on_arm(self, msg: DiagnosticArray) -> None:
+        for status in msg.status:
+            if status.name != ARM_STATUS:
+                continue
+            pairs = {kv.key: kv.value for kv in status.values}
+            try:
+                arm = arm_from_status(status.level[0], pairs, self.nominal)
+            except LumpbeamError as exc:
+                self.get_logger().warning(
+                    f'{ARM_PARAMS}: arm not taken ({exc}): keeping {self.description}',
+                    throttle_duration_sec=WARN_PERIOD_S,
+                )
+                continue
+            self._adopt_arm(arm, f'{ARM_PARAMS} ({status.message})')
 
     def _adopt(self, kind: str, modes: Sequence[Mode]) -> None:
         impulses = design_shaper(kind, modes)
@@ -130,7 +176,9 @@ class ShaperNode(SchemaNode):
     def _on_trajectory(self, msg: JointTrajectoryMsg) -> None:
         try:
             trajectory = trajectory_from_msg(msg)
-            if self.impulses is None:
+            if self.workspace is not None:
+                shaped, _ = self.workspace.shape(trajectory)
+            elif self.impulses is None:
                 if not self._unshaped_first:
                     self._drop('no valid estimate yet: nothing published')
                     return

@@ -38,3 +38,17 @@ def test_the_rollout_in_mujocos_loop_is_the_step_by_step_run(monkeypatch):
     assert got['x'] == pytest.approx(expected['x'], abs=1e-12)
     assert got['z'] == pytest.approx(expected['z'], abs=1e-12)
     assert float(got['wall_s']) > 0.0 and float(got['cpu_s']) >= 0.0
+
+
+def test_a_moves_residual_in_mujoco_is_the_arm_models():
+    from arm_cases import minimum_jerk
+
+    from lumpbeam_ros.core.model.arm.model import ArmModel
+    from lumpbeam_ros.core.shaping.workspace import predicted_residual
+
+    config = small_arm(2)
+    move = minimum_jerk([0.0, 0.0], [0.3, -0.4], 0.4)
+    ours = predicted_residual(ArmModel.from_config(config), move)
+    theirs = mujoco_arm.mujoco_residual(config, move, 1.0)
+    assert ours > 1e-3
+    assert theirs == pytest.approx(ours, rel=0.01)

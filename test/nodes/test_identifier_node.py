@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from arm_cases import small_arm, write_move_bag
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import PoseStamped
 from harness import ros_env
@@ -18,14 +19,18 @@ from std_msgs.msg import Float64
 
 from lumpbeam_ros.apps.cli.analyze import read_window
 from lumpbeam_ros.base.errors import ConfigError, LumpbeamError
+from lumpbeam_ros.base.interface import ARM_PARAMS, ARM_STATUS
 from lumpbeam_ros.base.interface import IDENTIFIER_STATUS as STATUS_NAME
 from lumpbeam_ros.base.resources import config_path
 from lumpbeam_ros.core.bagio import read_tip_poses
 from lumpbeam_ros.core.bagio.convert import pitch_to_quaternion
+from lumpbeam_ros.core.bagio.series import read_joint_states
+from lumpbeam_ros.core.ident.arm.link_fit import link_stiffness_total, scaled_arm
 from lumpbeam_ros.core.ident.bag_analysis import analyze_bag
 from lumpbeam_ros.core.ident.identify import identify
 from lumpbeam_ros.core.ident.settings import IdentifierConfig
 from lumpbeam_ros.core.model import rules
+from lumpbeam_ros.core.model.arm.config import write_arm_config
 from lumpbeam_ros.core.model.chain import LumpedChain
 from lumpbeam_ros.core.model.modes import chain_modes
 from lumpbeam_ros.core.model.parameters import BeamParameters, DropTestConfig
@@ -34,6 +39,7 @@ from lumpbeam_ros.core.shaping.estimate import estimate_from_status
 from lumpbeam_ros.core.synthetic.drop_test import SynthOptions, write_drop_test_bag
 from lumpbeam_ros.nodes.identifier_node import IdentifierNode
 from lumpbeam_ros.nodes.lifecycle import live_spinner, spin_events
+from lumpbeam_ros.nodes.msgtypes import topic_qos
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -456,3 +462,47 @@ def test_a_realtime_priority_refused_by_the_system_is_a_warning_and_the_node_run
     finally:
         node.destroy_node()
     assert 'realtime_priority 40: not permitted' in capfd.readouterr().err
+
+
+def test_an_arm_file_makes_the_node_fit_the_links_after_each_ring_down(ros_graph, tmp_path):
+    """/arm_params: the link fitted to a ring-down, from an arm file 20 % off, latched."""
+    truth = small_arm(1)
+    bag = write_move_bag(tmp_path / 'bag', truth, [0.5], record_s=6.0)
+    nominal = scaled_arm(truth, np.array([0.8]), np.array([1.3e-3]))
+    arm_file = tmp_path / 'nominal.yaml'
+    write_arm_config(arm_file, nominal)
+    overrides = {'publish_rate_hz': 1.0, 'arm_config': str(arm_file), 'arm_fit_after_s': 4.0}
+    node = IdentifierNode(context=ros_graph.context, parameter_overrides=overrides)
+    ros_graph.add_node(node)
+    arm_params = ros_graph.collect(ARM_PARAMS, DiagnosticArray, topic_qos(ARM_PARAMS))
+    joints, poses = read_joint_states(bag), read_tip_poses(bag)
+    for t, q, x, z in zip(poses.t, joints.angles, poses.x, poses.z, strict=True):
+        node._on_joint_state(_joint_state(float(t), q))
+        node._on_pose(_pose(float(t), float(z), x=float(x)))
+        if abs(t - round(t)) < 1e-6:
+            node._on_timer()  # once a second, as the timer would
+    node._on_timer()
+    assert ros_graph.spin_until(lambda: bool(arm_params), 10.0)
+    # One fit: the ring-down was taken once, after it had lasted 4 s.
+    (status,) = [s for msg in arm_params for s in msg.status]
+    assert status.name == ARM_STATUS and status.level == b'\x00', status.message
+    values = {kv.key: kv.value for kv in status.values}
+    assert values['ring_downs'] == '1' and node.arm_updates == 1
+    k, k_std = (
+        float(values['link_1_k_total_nm_per_rad']),
+        float(values['link_1_k_total_nm_per_rad_std']),
+    )
+    want = link_stiffness_total(truth.links[0])
+    assert abs(k - want) < max(4 * k_std, 1e-3 * want) and k_std < 0.01 * want
+    assert float(values['link_1_damping_beta']) == pytest.approx(
+        truth.links[0].damping_beta, rel=0.1
+    )
+
+
+def test_a_bad_arm_file_stops_the_node_in_one_line(ros_graph, tmp_path):
+    with pytest.raises(ConfigError, match='missing.yaml') as caught:
+        IdentifierNode(
+            context=ros_graph.context,
+            parameter_overrides={'arm_config': str(tmp_path / 'missing.yaml')},
+        )
+    assert '\n' not in str(caught.value)

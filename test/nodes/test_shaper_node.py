@@ -4,22 +4,30 @@ import math
 
 import numpy as np
 import pytest
+from arm_cases import minimum_jerk, small_arm
 from builtin_interfaces.msg import Duration
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
 from trajectory_msgs.msg import JointTrajectoryPoint
 
 from lumpbeam_ros.base.errors import ConfigError, LumpbeamError
-from lumpbeam_ros.base.interface import BEAM_PARAMS, IDENTIFIER_STATUS
+from lumpbeam_ros.base.interface import ARM_PARAMS, ARM_STATUS, BEAM_PARAMS, IDENTIFIER_STATUS
 from lumpbeam_ros.base.interface import JOINT_TRAJECTORY as IN
 from lumpbeam_ros.base.interface import JOINT_TRAJECTORY_SHAPED as OUT
+from lumpbeam_ros.core.ident.arm.learner import arm_from_status, link_key
+from lumpbeam_ros.core.ident.arm.link_fit import link_stiffness_total, scaled_arm
+from lumpbeam_ros.core.model.arm.config import load_arm_config, write_arm_config
 from lumpbeam_ros.core.shaping.apply import shape_trajectory
 from lumpbeam_ros.core.shaping.impulses import Mode
 from lumpbeam_ros.core.shaping.shapers import design_shaper
+from lumpbeam_ros.core.shaping.workspace import WorkspaceShaper
+from lumpbeam_ros.nodes.msgtypes import topic_qos
 from lumpbeam_ros.nodes.shaper_node import ShaperNode
 from lumpbeam_ros.nodes.trajectory_messages import trajectory_from_msg
 
 OK, ERROR = 0, 2
+TRUTH = small_arm(2)
+NOMINAL = scaled_arm(TRUTH, np.array([0.8, 1.2]), np.array([1.3e-3, 1.2e-3]))
 
 
 def _command(times=(0.0, 0.1, 0.2), names=('joint_1', 'joint_2'), positions=None):
@@ -172,6 +180,8 @@ def test_bad_trajectories_are_dropped(ros_graph, command):
         ({'frequency_hz': 0.0}, ConfigError, 'frequency_hz: must be positive'),
         ({'damping_ratio': 1.0}, ConfigError, 'damping_ratio: must be in [0, 1)'),
         ({'shaper': 'zvdd'}, ConfigError, 'shaper: must be one of'),
+        ({'source': 'model'}, ConfigError, 'arm_config: needed with source model'),
+        ({'source': 'model', 'arm_config': 'missing.yaml'}, ConfigError, 'missing.yaml'),
         (
             {'source': 'parameters', 'shaper': 'ei', 'damping_ratio': 0.7},
             LumpbeamError,
@@ -183,3 +193,80 @@ def test_bad_parameters_stop_the_node_in_one_line(ros_graph, overrides, error, p
     with pytest.raises(error) as caught:
         ShaperNode(context=ros_graph.context, parameter_overrides=overrides)
     assert problem in str(caught.value) and '\n' not in str(caught.value)
+
+
+@pytest.fixture
+def arm_file(tmp_path):
+    path = tmp_path / 'arm.yaml'
+    write_arm_config(path, NOMINAL)
+    return path
+
+
+def _arm_status(level=OK, arm=None, **changes):
+    """A ``lumpbeam/arm`` status of the links of ``arm`` (the truth by default)."""
+    arm = TRUTH if arm is None else arm
+    values = {}
+    for i, link in enumerate(arm.links, start=1):
+        values[link_key(i, 'k_total_nm_per_rad')] = link_stiffness_total(link)
+        values[link_key(i, 'k_total_nm_per_rad_std')] = 1e-3 * link_stiffness_total(link)
+        values[link_key(i, 'damping_beta')] = link.damping_beta
+        values[link_key(i, 'damping_beta_std')] = 0.05 * link.damping_beta
+    values.update(changes)
+    status = DiagnosticStatus(level=bytes([level]), name=ARM_STATUS, message='fitted')
+    status.values = [KeyValue(key=k, value=repr(v)) for k, v in values.items()]
+    status.values.append(KeyValue(key='ring_downs', value='3'))
+    return DiagnosticArray(status=[status])
+
+
+def _move_command():
+    """A move of small_arm(2) to (0.5, -0.8) in 0.3 s, named in reverse order."""
+    move = minimum_jerk([0.0, 0.0], [0.5, -0.8], 0.3, step=5e-3)
+    positions = move.angles_rad[:, ::-1]
+    return _command(times=move.time_s, names=('joint_2', 'joint_1'), positions=positions)
+
+
+def _model_shaped(command, arm):
+    shaped, _ = WorkspaceShaper(arm, 'zv', 2, predict=False).shape(trajectory_from_msg(command))
+    return shaped
+
+
+def test_the_model_shapes_each_move_with_the_latest_identified_arm(ros_graph, arm_file):
+    got = ros_graph.collect(OUT, JointTrajectoryMsg)
+    node = _start(ros_graph, source='model', arm_config=str(arm_file))
+    command = _move_command()
+    # Before /arm_params: the arm file's model.
+    _send(ros_graph, IN, command)
+    assert ros_graph.spin_until(lambda: len(got) >= 1, 10.0)
+    from_file = load_arm_config(arm_file)
+    _assert_is(got[0], _model_shaped(command, from_file), command)
+    # A WARN status and bad values keep it.
+    latched = topic_qos(ARM_PARAMS)
+    for bad in (
+        _arm_status(level=1),
+        _arm_status(link_1_damping_beta=math.nan),
+        _arm_status(link_2_k_total_nm_per_rad_std=1e9),
+    ):
+        ros_graph.publish(ARM_PARAMS, bad, latched)
+        ros_graph.spin_for(0.3)
+    assert 'arm file' in node.description
+    # An OK one: the identified arm shapes the next move.
+    ros_graph.publish(ARM_PARAMS, _arm_status(), latched)
+    assert ros_graph.spin_until(lambda: ARM_PARAMS in node.description, 10.0)
+    before = len(got)
+    ros_graph.publish(IN, command)
+    assert ros_graph.spin_until(lambda: len(got) > before, 10.0)
+    expected = _model_shaped(command, from_file)
+    # Other modes: another shaper, another duration.
+    assert trajectory_from_msg(got[-1]).duration_s != pytest.approx(expected.duration_s)
+    identified = arm_from_status(
+        OK, {kv.key: kv.value for kv in _arm_status().status[0].values}, from_file
+    )
+    _assert_is(got[-1], _model_shaped(command, identified), command)
+
+
+def test_a_command_for_another_arm_is_dropped(ros_graph, arm_file):
+    got = ros_graph.collect(OUT, JointTrajectoryMsg)
+    node = _start(ros_graph, source='model', arm_config=str(arm_file))
+    _send(ros_graph, IN, _command(names=('joint_1', 'wrist')))
+    assert ros_graph.spin_until(lambda: node.dropped >= 1, 10.0)
+    assert got == []

@@ -6,9 +6,10 @@ defaults, used for synthetic bags and by the player when a bag has none:
 - images and camera info: best effort, volatile, keep last :data:`SENSOR_DEPTH`: a late
   frame is worth less than the next one and must never stall a 180 fps stream, but a
   reader's history must cover the moments its process is off the CPU;
-- ``/tip_load``: reliable, transient local, keep last 1. It changes rarely (a drop), so a
-  node that starts after the last change still needs the current load; a transient-local
-  publisher also serves volatile subscribers, so nobody is excluded;
+- ``/tip_load`` and ``/arm_params``: reliable, transient local, keep last 1. They change
+  rarely (a drop, a ring-down fitted), so a node that starts after the last change still
+  needs the current value; a transient-local publisher also serves volatile subscribers,
+  so nobody is excluded;
 - everything else (poses, ``/beam_params``, ``/clock``): reliable, volatile, keep last
   :data:`STREAM_DEPTH`. Nothing of these may be lost: a reliable keep-last writer drops its
   oldest sample for a reader that has not acknowledged it once the history is full, and a
@@ -30,7 +31,7 @@ from rosbags.interfaces import (
     QosTime,
 )
 
-from lumpbeam_ros.base.interface import CAMERA_INFO_TYPE, IMAGE_TYPE, TIP_LOAD
+from lumpbeam_ros.base.interface import ARM_PARAMS, CAMERA_INFO_TYPE, IMAGE_TYPE, TIP_LOAD
 
 #: How rosbag2 writes an infinite duration (``RMW_DURATION_INFINITE``).
 INFINITE = QosTime(2147483647, 4294967295)
@@ -50,7 +51,7 @@ STREAM_DEPTH = 400
 SENSOR_DEPTH = 60
 
 SENSOR_TYPES = (IMAGE_TYPE, CAMERA_INFO_TYPE)
-LATCHED_TOPICS = (TIP_LOAD,)
+LATCHED_TOPICS = (TIP_LOAD, ARM_PARAMS)
 
 
 def profile(reliable: bool, transient_local: bool, depth: int) -> Qos:

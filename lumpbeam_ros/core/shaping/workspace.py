@@ -34,7 +34,7 @@ from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.core.ident.arm.moves import Move, find_moves
 from lumpbeam_ros.core.model.arm.config import ArmConfig
 from lumpbeam_ros.core.model.arm.drive import SampledMotion
-from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
+from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory, default_joint_names
 from lumpbeam_ros.core.model.arm.model import ArmModel
 from lumpbeam_ros.core.model.arm.residual import WINDOW_S, arm_residual
 from lumpbeam_ros.core.model.arm.simulate import simulate_arm
@@ -154,6 +154,8 @@ class WorkspaceShaper:
         shaper: ``'zv'``, ``'zvd'`` or ``'ei'``.
         max_modes: Modes shaped per move (the first, slowest ones).
         tune: Tune each move's impulses on the model's simulation of it.
+        predict: Simulate each move to predict its residuals (the shaper node, which needs
+            only the command, leaves them NaN when untuned).
     """
 
     def __init__(
@@ -162,6 +164,7 @@ class WorkspaceShaper:
         shaper: str = 'zvd',
         max_modes: int = DEFAULT_MAX_MODES,
         tune: bool = False,
+        predict: bool = True,
     ):
         if max_modes < 1:
             raise LumpbeamError(f'max modes must be 1 or more, got {max_modes}')
@@ -170,6 +173,7 @@ class WorkspaceShaper:
         self.shaper = shaper
         self.max_modes = max_modes
         self.tune = tune
+        self.predict = predict
 
     def shape(self, trajectory: JointTrajectory) -> tuple[JointTrajectory, list[ShapedMove]]:
         """Shapes every move of ``trajectory``.
@@ -183,21 +187,39 @@ class WorkspaceShaper:
             each move's shaping, in time order.
 
         Raises:
-            LumpbeamError: A trajectory for another number of joints, angles outside a
+            LumpbeamError: A trajectory for another number of joints or naming other joints
+                than ``joint_1`` ... ``joint_n`` (in any order), angles outside a
                 joint's limits, a move whose final configuration has no underdamped mode, or
                 a shaped trajectory too long.
         """
-        if trajectory.joint_count != self.arm.n_joints:
-            raise LumpbeamError(
-                f'the trajectory has {trajectory.joint_count} joints, the arm '
-                f'{self.arm.n_joints} ({self.arm.source or "the arm file"})'
-            )
+        trajectory = self._in_joint_order(trajectory)
         self.arm.check_within_limits(trajectory.angles_rad, 'the trajectory')
         shaped_moves = [
             self.shape_move(move_trajectory(trajectory, move), k)
             for k, move in enumerate(trajectory_moves(trajectory), start=1)
         ]
         return assemble(trajectory, shaped_moves), shaped_moves
+
+    def _in_joint_order(self, trajectory: JointTrajectory) -> JointTrajectory:
+        """The trajectory's columns as the arm's joints, ``joint_1`` first (names any order).
+
+        Raises:
+            LumpbeamError: Another number of joints, or names that are not the arm's.
+        """
+        n = self.arm.n_joints
+        if trajectory.joint_count != n:
+            raise LumpbeamError(
+                f'the trajectory has {trajectory.joint_count} joints, the arm {n} '
+                f'({self.arm.source or "the arm file"})'
+            )
+        names = default_joint_names(n)
+        given = trajectory.joint_names or names
+        if given == names:
+            return trajectory
+        if sorted(given) != sorted(names):
+            raise LumpbeamError(f'the trajectory names {list(given)}, the arm {list(names)}')
+        order = [given.index(name) for name in names]
+        return JointTrajectory(trajectory.time_s, trajectory.angles_rad[:, order], names)
 
     def shape_move(self, move: JointTrajectory, number: int = 1) -> ShapedMove:
         """Shapes one move (rest to rest) for the modes at its last row.
@@ -212,6 +234,16 @@ class WorkspaceShaper:
         final = move.angles_rad[-1]
         modes = model_modes(self.model, final, self.max_modes, f'move {number}')
         impulses = design_shaper(self.shaper, modes)
+        if not (self.predict or self.tune):
+            return ShapedMove(
+                float(move.time_s[0]),
+                float(move.time_s[-1]),
+                np.array(final),
+                modes,
+                impulses,
+                math.nan,
+                math.nan,
+            )
         unshaped = predicted_residual(self.model, move)
         shaped = predicted_residual(self.model, shape_trajectory(move, impulses))
         if self.tune:

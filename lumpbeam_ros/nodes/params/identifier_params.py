@@ -7,7 +7,7 @@ declared there once.
 from __future__ import annotations
 
 from lumpbeam_ros.base.interface import IDENTIFIER_NODE
-from lumpbeam_ros.base.schema import ParameterSchema, ParameterSpec
+from lumpbeam_ros.base.schema import Bounds, ParameterSchema, ParameterSpec
 from lumpbeam_ros.core.ident.settings import IDENTIFIER_SETTINGS
 from lumpbeam_ros.nodes.realtime import REALTIME_PRIORITY
 
@@ -20,6 +20,29 @@ _NODE = (
         "beam parameter file (as config/paper_beam.yaml); empty: the package's paper_beam.yaml",
     ),
     ParameterSpec('hardware_id', 'string', 'beam', 'DiagnosticStatus.hardware_id of /beam_params'),
+    ParameterSpec(
+        'arm_config',
+        'string',
+        '',
+        'arm file (as config/arm_3link.yaml): given, the links are fitted again after every '
+        "ring-down, from the file's values, and published on /arm_params; empty: no arm fit",
+    ),
+    ParameterSpec(
+        'fit_payload',
+        'bool',
+        False,
+        'with arm_config: fit the payload mass instead of the links (the links as the file '
+        'gives them)',
+    ),
+    ParameterSpec(
+        'arm_fit_after_s',
+        'double',
+        3.0,
+        "with arm_config: a ring-down's modes join the arm's fit once the joints have been at "
+        'rest this long',
+        's',
+        Bounds(0.1, 600.0),
+    ),
     REALTIME_PRIORITY,
 )
 

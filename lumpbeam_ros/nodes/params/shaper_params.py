@@ -20,8 +20,23 @@ SHAPER_SCHEMA = ParameterSchema(
             'string',
             'beam_params',
             'beam_params: the modes identified live on /beam_params; parameters: one mode '
-            'fixed by frequency_hz and damping_ratio',
-            choices=('beam_params', 'parameters'),
+            'fixed by frequency_hz and damping_ratio; model: each trajectory shaped for the '
+            "modes of arm_config's model at its end, with the latest links on /arm_params",
+            choices=('beam_params', 'parameters', 'model'),
+        ),
+        ParameterSpec(
+            'arm_config',
+            'string',
+            '',
+            'arm file (as config/arm_3link.yaml) of source model: its values until /arm_params '
+            'gives identified ones',
+        ),
+        ParameterSpec(
+            'tune',
+            'bool',
+            False,
+            "source model: tune each move's impulses on the model's simulation of it (about a "
+            'second of CPU per move)',
         ),
         ParameterSpec(
             'frequency_hz',
@@ -43,7 +58,7 @@ SHAPER_SCHEMA = ParameterSchema(
             'shaper',
             'string',
             'zv',
-            'the shaper for well-known frequencies (and for source parameters)',
+            'the shaper for well-known frequencies (and for sources parameters and model)',
             choices=SHAPER_NAMES,
         ),
         ParameterSpec(

@@ -4,7 +4,7 @@ from lumpbeam_lab.bench.shaping import run
 
 def test_quick_suite_measures_against_fftconvolve():
     assert 'shaping' in available_suites()
-    one, two = run(quick=True)
+    one, two, tuned = run(quick=True)
     assert one.baseline == 'scipy.signal.fftconvolve' and one.unit == 'ms per joint'
     assert one.value > 0 and one.baseline_value > 0
     assert one.ratio == one.baseline_value / one.value
@@ -12,3 +12,9 @@ def test_quick_suite_measures_against_fftconvolve():
     # Both compute the same convolution, up to the baseline's impulses rounded to 1 ms.
     assert one.details['max_difference_rad'] < 0.01
     assert two.details['max_difference_rad'] < 0.01
+
+    # The arm's move: tuned against untuned in CPU seconds, and what the tuning bought.
+    assert tuned.unit == 'CPU s' and tuned.ratio == tuned.baseline_value / tuned.value
+    assert tuned.details['tuned_residual_m'] < tuned.details['untuned_residual_m']
+    assert tuned.details['tuned_reduction'] > 0.99
+    assert tuned.details['target'].split()[0] in ('pass', 'FAIL')

@@ -2,6 +2,7 @@
 
 __all__ = [
     'bag_modes',
+    'learner',
     'link_fit',
     'moves',
     'payload_fit',

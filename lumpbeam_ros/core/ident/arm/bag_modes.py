@@ -48,15 +48,7 @@ def bag_observation(bag: str | Path, arm: ArmConfig, config: IdentifierConfig) -
             f'{bag}: no ring-down after the last move: no mode stands out of the noise in '
             f'{TIP_POSE}'
         )
-    modes = tuple(
-        MeasuredMode(
-            m.natural_frequency_hz.value,
-            m.natural_frequency_hz.std,
-            m.damping_ratio.value,
-            m.damping_ratio.std,
-        )
-        for m in analysis.modes
-    )
+    modes = tuple(MeasuredMode.of(m) for m in analysis.modes)
     return ModeObservation(np.asarray(analysis.rest.angles_rad), modes, str(bag))
 
 

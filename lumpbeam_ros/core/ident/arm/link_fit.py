@@ -39,6 +39,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from lumpbeam_ros.base.errors import LumpbeamError
+from lumpbeam_ros.core.ident.identification import IdentifiedMode
 from lumpbeam_ros.core.model.arm.config import ArmConfig, LinkConfig
 from lumpbeam_ros.core.model.arm.model import ArmModel
 from lumpbeam_ros.core.model.arm.statics import arm_modes
@@ -83,6 +84,16 @@ class MeasuredMode:
     natural_frequency_hz_std: float
     damping_ratio: float
     damping_ratio_std: float
+
+    @classmethod
+    def of(cls, mode: IdentifiedMode) -> MeasuredMode:
+        """A mode as the identification gives it (its std NaN where it has none)."""
+        return cls(
+            mode.natural_frequency_hz.value,
+            mode.natural_frequency_hz.std,
+            mode.damping_ratio.value,
+            mode.damping_ratio.std,
+        )
 
     @classmethod
     def from_json(cls, entry: Mapping[str, Any], where: str) -> MeasuredMode:
