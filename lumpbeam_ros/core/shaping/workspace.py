@@ -249,7 +249,7 @@ class WorkspaceShaper:
         if self.tune:
             from lumpbeam_ros.core.shaping.tune import tune_impulses
 
-            tuned = tune_impulses(self.model, move, impulses)
+            tuned = tune_impulses(self.model, move, impulses, len(modes))
             residual = predicted_residual(self.model, shape_trajectory(move, tuned))
             if residual < shaped:
                 impulses, shaped = tuned, residual

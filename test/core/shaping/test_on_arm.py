@@ -24,14 +24,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.interpolate import CubicSpline
 
-from lumpbeam_lab.mujoco_arm import MujocoArm
+from lumpbeam_lab.mujoco_arm import mujoco_residual
 from lumpbeam_ros.core.model.arm.config import ArmConfig, load_arm_config
 from lumpbeam_ros.core.model.arm.drive import SampledMotion
 from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
 from lumpbeam_ros.core.model.arm.model import ArmModel
-from lumpbeam_ros.core.model.arm.residual import WINDOW_S, arm_residual, residual_rms
+from lumpbeam_ros.core.model.arm.residual import WINDOW_S, arm_residual
 from lumpbeam_ros.core.model.arm.simulate import simulate_arm
 from lumpbeam_ros.core.model.arm.statics import arm_modes
 from lumpbeam_ros.core.shaping.apply import shape_trajectory
@@ -85,41 +84,14 @@ class Residuals:
     mujoco: float
 
 
-def _mujoco_step(config: ArmConfig, q: np.ndarray) -> float:
-    """MuJoCo's step: within RK4's stability bound on the fastest pole, a divisor of OUTPUT_S.
-
-    The rotary link's stiff, overdamped segment modes reach |lambda| = 3.7e4 1/s: RK4 at
-    1e-4 s (the arm tests' step) is unstable there (|lambda h| > 2.78), so the step is cut.
-    """
-    probe = MujocoArm(config)
-    probe.equilibrium(q)
-    fastest = float(np.max(np.abs(probe.modal_eigenvalues())))
-    return OUTPUT_S / max(20, int(np.ceil(OUTPUT_S * fastest / 2.0)))
-
-
 def _simulate(config: ArmConfig, trajectory: JointTrajectory) -> Residuals:
     model = ArmModel.from_config(config)
     motion = SampledMotion(trajectory)
     end = float(trajectory.time_s[-1])
     t = np.arange(round((end + WINDOW_S) / OUTPUT_S) + 1) * OUTPUT_S
     ours = arm_residual(model, simulate_arm(model, motion, t), end)
-    # MuJoCo follows the spline simulate_arm integrates a dense trajectory through, taken
-    # at every step's midpoint (as MujocoArm.run asks for it) in one vectorized call.
-    step = _mujoco_step(config, trajectory.angles_rad[-1])
-    spline = CubicSpline(trajectory.time_s, trajectory.angles_rad, axis=0)
-    mid = (np.arange(round(t[-1] / step) + 2) + 0.5) * step
-    moving = (mid <= end)[:, np.newaxis]
-    q = np.where(moving, spline(np.minimum(mid, end)), trajectory.angles_rad[-1])
-    q_dot = np.where(moving, spline(np.minimum(mid, end), 1), 0.0)
-    mujoco_arm = MujocoArm(config, step)
-    mujoco_arm.equilibrium(trajectory.angles_rad[0])
-    run = mujoco_arm.run(
-        lambda time: (q[int(time / step)], q_dot[int(time / step)]), t[-1], OUTPUT_S
-    )
-    mujoco_arm.equilibrium(trajectory.angles_rad[-1])
-    rest_x, rest_z, _ = mujoco_arm.tip_pose()
-    theirs = residual_rms(run['t'], run['x'], run['z'], (rest_x, rest_z), end)
-    return Residuals(ours, theirs)
+    # MuJoCo follows the spline simulate_arm integrates a dense trajectory through.
+    return Residuals(ours, mujoco_residual(config, trajectory, WINDOW_S, OUTPUT_S))
 
 
 _UNSHAPED: dict[str, Residuals] = {}
