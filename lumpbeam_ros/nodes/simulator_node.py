@@ -17,7 +17,9 @@ commanded angles), ``/tip_pose_predicted`` (the last link's free end) and the wh
 it was, when it names a joint the arm does not have or not every joint once, has a point
 without one position per joint, a position or time that is not finite, times that do not
 increase, or a first point at time 0 away from the joints' angles. A command stamped 0 (or
-in the past) starts at the node's present, one stamped in the future at its stamp.
+in the past) starts at the node's present, one stamped in the future at its stamp. With
+``adopt_identified`` the arm's links (or payload) of each ``/arm_params`` status of level OK
+replace the file's from the next simulation on.
 Parameters: :data:`~lumpbeam_ros.nodes.params.simulator_params.SIMULATOR_SCHEMA`
 (``doc/parameters.md``); their defaults are the values of ``config/simulator.yaml``, where
 each is documented.
@@ -55,6 +57,8 @@ from visualization_msgs.msg import MarkerArray
 
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.base.interface import (
+    ARM_PARAMS,
+    ARM_STATUS,
     BASE_FRAME,
     BEAM_MARKERS,
     BEAM_PARAMS,
@@ -73,6 +77,7 @@ from lumpbeam_ros.core.bagio.convert import (
 )
 from lumpbeam_ros.core.bagio.tipseries import TipSeries
 from lumpbeam_ros.core.bagio.typestore import serialize
+from lumpbeam_ros.core.ident.arm.learner import arm_from_status
 from lumpbeam_ros.core.model.adopt import adopt_identified
 from lumpbeam_ros.core.model.arm.config import load_arm_config
 from lumpbeam_ros.core.model.arm.model import ArmModel
@@ -520,13 +525,7 @@ class ArmSimulation:
         accepted: Commands followed.
         refused: Commands refused.
         last_refusal: Why the last one was refused.
-        joint_states_published: Messages published on ``/joint_states``.
-
-    Raises:
-        ConfigError: The arm or camera file is missing or malformed.
-    """
-
-    name = 'arm'
+XX
 
     def __init__(self, node: SimulatorNode, values: Mapping[str, Any]):
         self.node = node
@@ -548,6 +547,10 @@ class ArmSimulation:
         self._samples: ArmMotion | None = None  # the samples being published
         self._joints_out = publisher(node, JointState, JOINT_STATES)
         subscription(node, JointTrajectoryMsg, values['arm_commands'], self._on_command)
+        self.config = config
+        self.adopted = 0
+        if values['adopt_identified']:
+            subscription(node, DiagnosticArray, ARM_PARAMS, self._on_arm_params)
         self.description = (
             f'{config.n_joints}-link arm ({self.model.chain.n} segments) from '
             f'{values["arm_config"]}, following {values["arm_commands"]}'
@@ -600,6 +603,22 @@ class ArmSimulation:
         return 'the arm mode takes its parameters at start only'
 
     # -- its input ----------------------------------------------------------------------------
+
+    def _on_arm_params(self, msg: DiagnosticArray) -> None:
+        """Adopts the identified arm: the next command (or ring-down extension) simulates it."""
+        for status in msg.status:
+            if status.name != ARM_STATUS:
+                continue
+            pairs = {kv.key: kv.value for kv in status.values}
+            try:
+                arm = arm_from_status(_level(status), pairs, self.config)
+                model = ArmModel.from_config(arm)
+            except LumpbeamError as exc:
+                self.node.warn(f'{ARM_PARAMS}: arm not adopted ({exc}): keeping the last one')
+                continue
+            self.model = self.stream.model = model
+            self.adopted += 1
+            self.node.get_logger().info(f'adopted the arm of {ARM_PARAMS} ({status.message})')
 
     def _on_command(self, msg: JointTrajectoryMsg) -> None:
         now = self.node.now()

@@ -80,7 +80,8 @@ SIMULATOR_SCHEMA = ParameterSchema(
             'adopt_identified',
             'bool',
             False,
-            'adopt k_tE and the damping ratio from /beam_params (status OK only)',
+            'adopt k_tE and the damping ratio from /beam_params (status OK only); an arm '
+            '(arm_config): its links or payload from /arm_params (status OK only)',
             read_only=False,
         ),
         ParameterSpec(
