@@ -525,7 +525,14 @@ class ArmSimulation:
         accepted: Commands followed.
         refused: Commands refused.
         last_refusal: Why the last one was refused.
-XX
+        joint_states_published: Messages published on ``/joint_states``.
+        adopted: Identified arms adopted from ``/arm_params``.
+
+    Raises:
+        ConfigError: The arm or camera file is missing or malformed.
+    """
+
+    name = 'arm'
 
     def __init__(self, node: SimulatorNode, values: Mapping[str, Any]):
         self.node = node
