@@ -75,10 +75,16 @@ class RestWindow:
         phi_eq: The rest's segment angles.
         operator: Maps ``s`` at the move's end to the stacked ``x`` then ``z`` deviations at
             the window's samples, shape (2 samples, 2 n).
+        eigenvalues: Those of ``A``.
+        vectors: Its eigenvectors (columns).
+        coordinates: Their inverse: ``s`` to the eigen coordinates.
     """
 
     phi_eq: np.ndarray
     operator: np.ndarray
+    eigenvalues: np.ndarray
+    vectors: np.ndarray
+    coordinates: np.ndarray
 
     @classmethod
     def at(cls, model: ArmModel, q: np.ndarray, window_s: float = WINDOW_S) -> RestWindow:
@@ -99,11 +105,24 @@ class RestWindow:
         t = np.arange(0.0, window_s + 1e-9, WINDOW_STEP_S)
         growth = np.exp(np.outer(t, eigenvalues))  # (samples, 2n)
         rows = [np.real((out[axis] * growth) @ coordinates) for axis in range(2)]
-        return cls(phi_eq, np.vstack(rows))
+        return cls(phi_eq, np.vstack(rows), eigenvalues, vectors, coordinates)
+
+    def state(self, phi: np.ndarray, phi_dot: np.ndarray) -> np.ndarray:
+        """``s = [phi - phi_eq, phi']``."""
+        return np.concatenate([phi - self.phi_eq, phi_dot])
+
+    def held(self, state: np.ndarray, elapsed_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``e^(A t) s`` and ``A e^(A t) s`` for each ``t`` of ``elapsed_s`` (columns)."""
+        modal = self.coordinates @ state
+        growth = np.exp(np.outer(self.eigenvalues, elapsed_s)) * modal[:, None]
+        return (
+            np.real(self.vectors @ growth),
+            np.real(self.vectors @ (self.eigenvalues[:, None] * growth)),
+        )
 
     def deviations(self, phi: np.ndarray, phi_dot: np.ndarray) -> np.ndarray:
         """The tip's ``x`` then ``z`` deviations over the window from the state at its start, m."""
-        return np.asarray(self.operator @ np.concatenate([phi - self.phi_eq, phi_dot]))
+        return np.asarray(self.operator @ self.state(phi, phi_dot))
 
     @property
     def samples(self) -> int:
@@ -122,6 +141,29 @@ class _Parameters:
         self._logits = np.log(inner / (1.0 - inner))
         self.size = inner.size + untuned.time_s.size
 
+    def lti_jacobian(self, window: RestWindow, unshaped_end: np.ndarray) -> np.ndarray:
+        """The misfit's Jacobian at the start, were the move linear and time-invariant.
+
+        Then each delayed copy ``A_i u(t - t_i)`` of the move leaves at the shaped move's end
+        ``A_i e^(A (T - t_i)) s_u``, ``s_u`` the unshaped move's state at its own end, and
+        the misfit is ``R sum_i A_i e^(A (T - t_i)) s_u`` (``R`` the window's operator): its
+        derivatives in the log amplitudes and the time logits are exact sums, no simulation.
+        A fast move is not linear; Broyden's updates correct the difference step by step.
+        """
+        start = self.impulses(np.zeros(self.size))
+        states, rates = window.held(unshaped_end, self.duration_s - start.time_s)
+        copies, slopes = window.operator @ states, window.operator @ rates
+        amplitude = start.amplitude
+        linear = copies @ amplitude
+        inner = self._logits.size
+        jacobian = np.empty((linear.size, self.size))
+        for k in range(1, inner + 1):
+            t = start.time_s[k]
+            # d t_k / d logit = t_k (1 - t_k / T); e^(A (T - t_k)) falls with t_k.
+            jacobian[:, k - 1] = -amplitude[k] * slopes[:, k] * t * (1.0 - t / self.duration_s)
+        jacobian[:, inner:] = amplitude * (copies - linear[:, None])
+        return jacobian
+
     def impulses(self, x: np.ndarray) -> Impulses:
         inner = self._logits.size
         fractions = 1.0 / (1.0 + np.exp(-(self._logits + x[:inner])))
@@ -139,13 +181,15 @@ class _Misfit:
         self.move = move
         self.window = window
         self.simulations = 0
+        self.end_state = np.zeros(0)
 
     def __call__(self, impulses: Impulses) -> np.ndarray:
         shaped = shape_trajectory(self.move, impulses)
         t = np.array([shaped.time_s[0], shaped.time_s[-1]])
         self.simulations += 1
         motion = simulate_arm(self.model, SampledMotion(shaped), t)
-        return self.window.deviations(motion.phi[-1], motion.phi_dot[-1])
+        self.end_state = self.window.state(motion.phi[-1], motion.phi_dot[-1])
+        return np.asarray(self.window.operator @ self.end_state)
 
 
 def _differences(
@@ -166,6 +210,7 @@ def _descend(
     target: float,
     limit: int,
     start: tuple[np.ndarray, np.ndarray] | None = None,
+    jacobian: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Levenberg-Marquardt in ``parameters``' unknowns, Broyden's Jacobian.
 
@@ -175,6 +220,8 @@ def _descend(
         target: Squared misfit at which to stop.
         limit: Simulations (counted by ``misfit``) after which to stop.
         start: The unknowns to start from and their misfit (default: the starting shaper).
+        jacobian: A first Jacobian to start from (default: by differences); when it stops
+            helping, one by differences replaces it.
 
     Returns:
         The unknowns reached and their misfit.
@@ -184,9 +231,14 @@ def _descend(
         f = misfit(parameters.impulses(x))
     else:
         x, f = start
-    stalled, fresh = _PATIENCE, False
-    jacobian = np.zeros((f.size, x.size))
-    damping = 0.0
+    if jacobian is None:
+        stalled, fresh = _PATIENCE, False
+        jacobian = np.zeros((f.size, x.size))
+        damping = 0.0
+    else:
+        stalled, fresh = 0, False
+        jacobian = jacobian.copy()
+        damping = 1e-3 * float(np.max(np.diag(jacobian.T @ jacobian)))
     while misfit.simulations < limit and float(f @ f) > target:
         if stalled >= _PATIENCE:
             # Broyden's Jacobian has drifted, or the last fresh one has run out of steps.
@@ -285,13 +337,15 @@ def tune_impulses(
         return untuned
     misfit = _Misfit(model, move, RestWindow.at(model, move.angles_rad[-1]))
     unshaped = misfit(Impulses(np.zeros(1), np.ones(1)))
+    unshaped_end = misfit.end_state
     target = GOOD_ENOUGH**2 * float(unshaped @ unshaped)
     # Each start gets a short descent; the best then gets what is left.
     best: tuple[_Parameters, np.ndarray, np.ndarray] | None = None
     for start in starts(untuned, modes):
         parameters = _Parameters(start)
         limit = min(max_simulations, misfit.simulations + parameters.size + _PER_START)
-        x, f = _descend(misfit, parameters, target, limit)
+        first = parameters.lti_jacobian(misfit.window, unshaped_end)
+        x, f = _descend(misfit, parameters, target, limit, jacobian=first)
         if best is None or float(f @ f) < float(best[2] @ best[2]):
             best = parameters, x, f
         if float(f @ f) <= target or misfit.simulations >= max_simulations:

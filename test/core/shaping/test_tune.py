@@ -10,7 +10,15 @@ from lumpbeam_ros.core.model.arm.residual import rest_tip
 from lumpbeam_ros.core.model.arm.simulate import simulate_arm
 from lumpbeam_ros.core.shaping.impulses import Impulses, Mode
 from lumpbeam_ros.core.shaping.shapers import design_shaper
-from lumpbeam_ros.core.shaping.tune import WINDOW_STEP_S, RestWindow, tune_impulses
+from lumpbeam_ros.core.shaping.tune import (
+    WINDOW_STEP_S,
+    RestWindow,
+    _differences,
+    _Misfit,
+    _Parameters,
+    tune_impulses,
+)
+from lumpbeam_ros.core.shaping.workspace import model_modes
 
 MODEL = ArmModel.from_config(small_arm(2))
 
@@ -43,3 +51,20 @@ def test_the_tuning_keeps_to_its_budget_and_its_bounds(budget):
     tuned = tune_impulses(MODEL, move, untuned, max_simulations=budget)
     assert tuned.time_s[0] == 0.0 and tuned.duration_s == pytest.approx(untuned.duration_s)
     assert np.all(tuned.amplitude > 0) and tuned.amplitude.sum() == pytest.approx(1.0)
+
+
+def test_the_linear_time_invariant_jacobian_is_the_differences_on_a_slow_small_move():
+    # A slow small move is nearly linear and time-invariant: the cheap Jacobian (no
+    # simulation) is then the one by differences (one simulation per unknown).
+    move = minimum_jerk([0.0, 0.0], [0.05, -0.05], 0.8)
+    window = RestWindow.at(MODEL, move.angles_rad[-1])
+    misfit = _Misfit(MODEL, move, window)
+    misfit(Impulses(np.zeros(1), np.ones(1)))
+    unshaped_end = misfit.end_state
+    modes = model_modes(MODEL, move.angles_rad[-1], 2, 'move')
+    parameters = _Parameters(design_shaper('zvd', modes))
+    cheap = parameters.lti_jacobian(window, unshaped_end)
+    x = np.zeros(parameters.size)
+    f = misfit(parameters.impulses(x))
+    exact = _differences(misfit, parameters, x, f)
+    assert np.linalg.norm(cheap - exact) < 0.05 * np.linalg.norm(exact)
