@@ -13,11 +13,18 @@ jerk through 0.8 to 1.4 rad) shaped by
 :class:`~lumpbeam_ros.core.shaping.workspace.WorkspaceShaper` for the model's first two modes
 at its end, tuned (``--tune``) against untuned in the same run, in CPU seconds: the target
 is a tuned move in under 1 s of CPU.
+
+``shaper_model_latency``: what the shaper node with ``source: model`` spends on one
+``/joint_trajectory`` (the same move as a command of 100 points), untuned: the model's
+modes at its end, the shaper, the shaped command; its p99 over many runs against the fixed
+shaper's (``source: parameters``, the impulses given) in the same run. The target is a p99
+under 20 ms.
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -40,6 +47,8 @@ ARM_FILE = Path(__file__).resolve().parents[2] / 'config' / 'arm_3link.yaml'
 TUNED_MOVE = ((0.0, 0.5, -0.5), (0.8, -0.6, 0.9), 1.0)
 #: A tuned 1 s move must take less CPU than this, s.
 TUNED_CPU_TARGET_S = 1.0
+#: The shaper node's processing of a command by the model must stay under this at p99, ms.
+LATENCY_TARGET_MS = 20.0
 
 
 def _trajectory(points: int) -> JointTrajectory:
@@ -116,6 +125,44 @@ def tuned_move(repeat: int) -> BenchResult:
     )
 
 
+def _percentile_ms(function: Callable[[], object], runs: int, q: float) -> float:
+    """The ``q`` percentile of ``runs`` wall times of ``function``, ms."""
+    times = []
+    for _ in range(runs):
+        start = time.perf_counter()
+        function()
+        times.append(time.perf_counter() - start)
+    return float(np.percentile(times, q)) * 1e3
+
+
+def model_latency(runs: int) -> BenchResult:
+    """The shaper node's work on one command with ``source: model``, untuned, p99 in ms."""
+    arm = load_arm_config(ARM_FILE)
+    start, end, duration = TUNED_MOVE
+    fine = minimum_jerk(np.array(start), np.array(end), duration)
+    command = JointTrajectory(fine.time_s[::10], fine.angles_rad[::10])
+    shaper = WorkspaceShaper(arm, 'zv', 2, predict=False)
+    _, moves = shaper.shape(command)
+    impulses = moves[0].impulses
+    ours = _percentile_ms(lambda: shaper.shape(command), runs, 99)
+    fixed = _percentile_ms(lambda: shape_trajectory(command, impulses), runs, 99)
+    return BenchResult(
+        name='shaper_model_latency',
+        value=ours,
+        unit='ms p99',
+        baseline='the fixed shaper (source parameters) on the same command',
+        baseline_value=fixed,
+        ratio=fixed / ours,
+        details={
+            'points': int(command.time_s.size),
+            'runs': runs,
+            'p50_ms': _percentile_ms(lambda: shaper.shape(command), runs, 50),
+            'target': f'{"pass" if ours < LATENCY_TARGET_MS else "FAIL"} '
+            f'(p99 < {LATENCY_TARGET_MS:g} ms)',
+        },
+    )
+
+
 def run(quick: bool = False) -> list[BenchResult]:
     """Runs the shaping suite.
 
@@ -124,7 +171,7 @@ def run(quick: bool = False) -> list[BenchResult]:
 
     Returns:
         A ZVD shaper for one mode (3 impulses), then for two modes (9 impulses), then the
-        three-link arm's move tuned.
+        three-link arm's move tuned, then the shaper node's work by the model.
     """
     points, repeat = (1_000, 1) if quick else (10_000, 20)
     one = [Mode(2.0, 0.02)]
@@ -133,4 +180,5 @@ def run(quick: bool = False) -> list[BenchResult]:
         shaping_speed(f'shape_zvd_1mode_{points}pts', one, points, repeat),
         shaping_speed(f'shape_zvd_2modes_{points}pts', two, points, repeat),
         tuned_move(1 if quick else 3),
+        model_latency(10 if quick else 200),
     ]

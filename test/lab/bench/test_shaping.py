@@ -4,7 +4,7 @@ from lumpbeam_lab.bench.shaping import run
 
 def test_quick_suite_measures_against_fftconvolve():
     assert 'shaping' in available_suites()
-    one, two, tuned = run(quick=True)
+    one, two, tuned, latency = run(quick=True)
     assert one.baseline == 'scipy.signal.fftconvolve' and one.unit == 'ms per joint'
     assert one.value > 0 and one.baseline_value > 0
     assert one.ratio == one.baseline_value / one.value
@@ -18,3 +18,6 @@ def test_quick_suite_measures_against_fftconvolve():
     assert tuned.details['tuned_residual_m'] < tuned.details['untuned_residual_m']
     assert tuned.details['tuned_reduction'] > 0.99
     assert tuned.details['target'].split()[0] in ('pass', 'FAIL')
+    # The shaper node's work by the model: a p99 against the fixed shaper's.
+    assert latency.unit == 'ms p99' and latency.value > 0 and latency.baseline_value > 0
+    assert latency.details['points'] == 101

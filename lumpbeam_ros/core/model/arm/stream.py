@@ -124,8 +124,8 @@ class ArmStream:
             LumpbeamError: Unknown or missing joint names, the wrong number of positions,
                 no point, NaN, times that do not increase, a start before the last sample
                 produced, a command longer than ``history_s`` or starting more than that after
-                the last sample, a jump at time 0, or a simulation that failed; the stream is
-                then unchanged.
+                the last sample, a position outside a joint's ``joint_limits_rad``, a jump at
+                time 0, or a simulation that failed; the stream is then unchanged.
         """
         trajectory = self._checked(names, times_s, positions, start_s)
         times, angles = trajectory.time_s, trajectory.angles_rad
@@ -200,6 +200,7 @@ class ArmStream:
                 f'more than the history simulated ({self.history_s:g} s)'
             )
         order = [names.index(n) for n in self.joint_names]
+        self.model.config.check_within_limits(positions[:, order], 'the command')
         absolute = start_s + times
         if absolute.size == 1:
             return JointTrajectory(

@@ -124,3 +124,18 @@ def test_a_restart_holds_the_joints_at_rest_from_the_new_time(model):
     assert got['t'][0] == pytest.approx(2.0) and np.allclose(np.diff(got['t']), 1 / RATE)
     np.testing.assert_allclose(got['q'], 0.0)  # before the command's start: its first row
     assert np.ptp(got['tip_z']) < 1e-9  # at rest
+
+
+def test_a_command_outside_a_joints_limits_is_refused_whatever_the_names_order():
+    from dataclasses import replace
+
+    arm = small_arm(2)
+    limited = replace(
+        arm, links=(arm.links[0], replace(arm.links[1], joint_limits_rad=(-0.5, 0.5)))
+    )
+    stream = ArmStream(ArmModel.from_config(limited), RATE, ring_down_s=0.2)
+    stream.command(['joint_1', 'joint_2'], [0.1], [[0.9, 0.4]], start_s=0.0)
+    before = stream.motion
+    with pytest.raises(LumpbeamError, match=r'the command: joint_2 at 0\.6 rad is outside'):
+        stream.command(['joint_2', 'joint_1'], [0.1, 0.2], [[0.4, 0.9], [0.6, 0.9]], start_s=0.5)
+    assert stream.motion is before
