@@ -243,6 +243,12 @@ def test_the_live_graph_is_served_and_the_port_is_free_at_once_after(ros_graph):
     try:
         wanted = {'/tip_pose': 'geometry_msgs/msg/PoseStamped'}
         channels, payloads = asyncio.run(_watch(port, wanted=wanted))
+    except TimeoutError:
+        done.set()
+        _stop(process)
+        pytest.fail(
+            f'no /tip_pose served in 20 s; the viewer said: {process.stderr.read()[-3000:]}'
+        )
     finally:
         done.set()
         publisher.join(5)
