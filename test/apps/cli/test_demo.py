@@ -22,9 +22,10 @@ def test_demo_runs_the_graph_end_to_end(demo_results, mcap_doctor):
     assert rows['stiffness_total_nm_per_rad']['paper'] == 3899.1
     # The simulator predicted what the camera sees. The data hide a 15 ms camera latency: once
     # the live diagnosis has named it and the simulator adopted it during the replay, the
-    # prediction is the 20 um noise from then on. Adopted after the replay (a slow machine),
-    # the whole prediction is shifted by the one lag that aligns it best (the latency plus
-    # the /tip_load delivery delay: a Float64 has no stamp) and leaves a few times the noise.
+    # prediction is the 20 um noise from then on. Adopted at the replay's end (a slow
+    # machine), the prediction before it is shifted by the one lag that aligns it best (the
+    # latency plus the /tip_load delivery delay: a Float64 has no stamp) and leaves a few
+    # times the noise.
     assert abs(summary['prediction_lag_s']) < 0.1 and summary['prediction_rms_m'] > 1e-3
     live = summary['live_diagnosis']
     after = live.get('prediction_after_rms_m')
@@ -32,7 +33,13 @@ def test_demo_runs_the_graph_end_to_end(demo_results, mcap_doctor):
     # much of the latency (the live-latency test below), and the rest stays in the gap.
     late_s = live['window_s'][0] + 1.0 - 2.0  # pre_release_s before the 2 s release
     if after is None or not math.isfinite(after):
-        assert summary['prediction_rms_aligned_m'] < 100e-6
+        # Adopted at the replay's very end (too little after it to measure): the span before
+        # the adoption is shifted by one lag. Over the whole record no one lag aligns both
+        # sides of an adoption (seen in a run adopted 0.2 s before the end: 1.3 mm aligned
+        # overall, 62 um before it).
+        # Never adopted: the whole record is one span.
+        before = live.get('prediction_before_aligned_rms_m', summary['prediction_rms_aligned_m'])
+        assert before < 100e-6
     elif abs(late_s) <= 0.002:
         # The simulator dates the release on its own clock, which may be a /clock tick off:
         # that lag stays in both spans, and the adoption moved the prediction by the latency.
