@@ -24,6 +24,7 @@ import numpy as np
 
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.core.ident.arm.link_fit import (
+    MAX_FACTOR,
     LinkEstimate,
     LinkParameterFit,
     MeasuredMode,
@@ -31,7 +32,7 @@ from lumpbeam_ros.core.ident.arm.link_fit import (
     link_stiffness_total,
     scaled_arm,
 )
-from lumpbeam_ros.core.ident.arm.payload_fit import PayloadFit
+from lumpbeam_ros.core.ident.arm.payload_fit import MAX_PAYLOAD, PayloadFit, moving_mass_kg
 from lumpbeam_ros.core.ident.identification import Identification, Status
 from lumpbeam_ros.core.ident.ring_down import JointRest
 from lumpbeam_ros.core.model.arm.config import ArmConfig
@@ -40,6 +41,9 @@ from lumpbeam_ros.core.model.arm.config import ArmConfig
 RING_DOWNS_KEY = 'ring_downs'
 #: Ring-downs kept (the oldest are forgotten past it).
 MAX_RING_DOWNS = 50
+#: The largest ``damping_beta`` taken from ``/arm_params``, s: a spring's damper ``c = beta k``
+#: with beta a second damps every mode above 0.3 Hz past critical.
+MAX_BETA_S = 1.0
 
 
 def link_key(i: int, name: str) -> str:
@@ -209,23 +213,35 @@ def arm_from_status(level: int, values: Mapping[str, str], nominal: ArmConfig) -
         The arm with the published links (or payload).
 
     Raises:
-        LumpbeamError: A level other than OK, a value missing, not finite, negative where it
-            cannot be, a std larger than its value, or links for another arm.
+        LumpbeamError: A level other than OK, a value missing, not finite, a std larger than
+            its value, a value the fits cannot give (a stiffness more than
+            :data:`~lumpbeam_ros.core.ident.arm.link_fit.MAX_FACTOR` times the file's either
+            way, a damping_beta outside [0, :data:`MAX_BETA_S`], a payload negative or above
+            :data:`~lumpbeam_ros.core.ident.arm.payload_fit.MAX_PAYLOAD` moving masses), or
+            links for another arm.
     """
     if level != int(Status.OK):
         raise LumpbeamError(f'level {level}, not OK: not determined yet')
     if 'payload_kg' in values:
         payload, _ = _figure(values, 'payload_kg')
-        if payload < 0.0:
-            raise LumpbeamError(f'payload_kg {payload!r} is negative')
+        heaviest = MAX_PAYLOAD * moving_mass_kg(nominal)
+        if not 0.0 <= payload <= heaviest:
+            raise LumpbeamError(
+                f'payload_kg {payload!r} is outside [0, {heaviest:.6g}] kg (what the fit can give)'
+            )
         return nominal.with_payload(payload)
     factors, betas = [], []
     for i, link in enumerate(nominal.links, start=1):
         k, _ = _figure(values, link_key(i, 'k_total_nm_per_rad'))
         beta, _ = _figure(values, link_key(i, 'damping_beta'))
-        if k <= 0.0 or beta < 0.0:
-            raise LumpbeamError(f'link {i}: k_total {k!r} or damping_beta {beta!r} out of range')
-        factors.append(k / link_stiffness_total(link))
+        factor = k / link_stiffness_total(link)
+        # The link fit's own bounds: a value past them did not come from it.
+        if not (1.0 / MAX_FACTOR <= factor <= MAX_FACTOR) or not 0.0 <= beta <= MAX_BETA_S:
+            raise LumpbeamError(
+                f'link {i}: k_total {k!r} N m/rad is not within {MAX_FACTOR:g} times the arm '
+                f"file's, or damping_beta {beta!r} s is outside [0, {MAX_BETA_S:g}]"
+            )
+        factors.append(factor)
         betas.append(beta)
     if link_key(nominal.n_joints + 1, 'k_total_nm_per_rad') in values:
         raise LumpbeamError(f"links for more than the arm file's {nominal.n_joints}")

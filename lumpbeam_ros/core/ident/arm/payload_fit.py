@@ -52,8 +52,8 @@ UNDETERMINED_ABOVE = 0.1
 NEGATIVE_BEYOND_STD = 2.0
 #: A reduced chi^2 above this is a model that does not match the modes with any payload.
 POOR_MATCH_ABOVE = 10.0
-#: The largest payload tried, in moving masses of the arm.
-_MAX_PAYLOAD = 100.0
+#: The largest payload fitted, in moving masses of the arm.
+MAX_PAYLOAD = 100.0
 #: Payloads, in moving masses, whose matched frequencies are compared for the start.
 _START_PAYLOADS = np.concatenate([[0.0], np.geomspace(1e-3, 10.0, 41)])
 
@@ -201,7 +201,7 @@ class PayloadFit:
         self, payload_kg: float, data: FitData, matches: Sequence[tuple[int, ...]]
     ) -> float:
         """Least squares in the payload from ``payload_kg``, kept non-negative."""
-        high = _MAX_PAYLOAD * self.scale_kg
+        high = MAX_PAYLOAD * self.scale_kg
 
         def residuals(x: np.ndarray) -> np.ndarray:
             try:

@@ -119,7 +119,9 @@ def _good_values():
         ({'link_1_k_total_nm_per_rad_std': '1e9'}, 'larger than the value'),
         ({'link_2_damping_beta': None}, 'link_2_damping_beta missing'),
         ({'link_3_k_total_nm_per_rad': '5'}, 'more than the arm file'),
-        ({'link_1_k_total_nm_per_rad': '-5', 'link_1_k_total_nm_per_rad_std': '1'}, 'range'),
+        ({'link_1_k_total_nm_per_rad': '-5', 'link_1_k_total_nm_per_rad_std': '1'}, '10 times'),
+        ({'link_1_k_total_nm_per_rad': '1e300', 'link_1_k_total_nm_per_rad_std': '1'}, '10 times'),
+        ({'link_2_damping_beta': '5.0', 'link_2_damping_beta_std': '0.1'}, 'outside'),
     ],
 )
 def test_a_bad_status_is_refused_in_one_line(change, words):
@@ -130,9 +132,10 @@ def test_a_bad_status_is_refused_in_one_line(change, words):
     assert '\n' not in str(info.value)
 
 
-def test_a_negative_payload_is_refused():
-    with pytest.raises(LumpbeamError, match='negative'):
-        arm_from_status(0, {'payload_kg': '-0.5', 'payload_kg_std': '0.1'}, NOMINAL)
+@pytest.mark.parametrize('payload', ['-0.5', '1e300'])
+def test_a_payload_no_fit_gives_is_refused(payload):
+    with pytest.raises(LumpbeamError, match=r'is outside \[0, '):
+        arm_from_status(0, {'payload_kg': payload, 'payload_kg_std': '0.1'}, NOMINAL)
 
 
 def test_bad_settings_and_a_clear():
