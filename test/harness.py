@@ -236,3 +236,32 @@ def held_domain_id() -> Iterator[int]:
     """A domain id held for one test (the ``ros_domain_id`` fixture, ``test/conftest.py``)."""
     with claim_test_domain() as claim:
         yield claim.domain_id
+
+
+def arm_status_msg(arm: Any, level: int = 0, **changes: float) -> Any:
+    """A ``/arm_params`` message of ``arm``'s links as the identifier encodes them.
+
+    Each link's k_total and damping_beta with 0.1 % and 5 % stds, three ring-downs;
+    ``changes`` replace KeyValues (``link_1_damping_beta=nan``).
+    """
+    from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+
+    from lumpbeam_ros.base.interface import ARM_STATUS
+    from lumpbeam_ros.core.ident.arm.learner import ArmEstimate
+    from lumpbeam_ros.core.ident.arm.link_fit import LinkEstimate, link_stiffness_total
+    from lumpbeam_ros.core.ident.identification import Status
+
+    links = tuple(
+        LinkEstimate(
+            link_stiffness_total(link),
+            1e-3 * link_stiffness_total(link),
+            link.damping_beta,
+            0.05 * link.damping_beta,
+        )
+        for link in arm.links
+    )
+    values = dict(ArmEstimate(Status(level), 'fitted', 3, links=links).key_values())
+    values.update({k: repr(float(v)) for k, v in changes.items()})
+    status = DiagnosticStatus(level=bytes([level]), name=ARM_STATUS, message='fitted')
+    status.values = [KeyValue(key=k, value=v) for k, v in values.items()]
+    return DiagnosticArray(status=[status])

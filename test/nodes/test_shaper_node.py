@@ -7,15 +7,16 @@ import pytest
 from arm_cases import minimum_jerk, small_arm
 from builtin_interfaces.msg import Duration
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from harness import arm_status_msg
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
 from trajectory_msgs.msg import JointTrajectoryPoint
 
 from lumpbeam_ros.base.errors import ConfigError, LumpbeamError
-from lumpbeam_ros.base.interface import ARM_PARAMS, ARM_STATUS, BEAM_PARAMS, IDENTIFIER_STATUS
+from lumpbeam_ros.base.interface import ARM_PARAMS, BEAM_PARAMS, IDENTIFIER_STATUS
 from lumpbeam_ros.base.interface import JOINT_TRAJECTORY as IN
 from lumpbeam_ros.base.interface import JOINT_TRAJECTORY_SHAPED as OUT
-from lumpbeam_ros.core.ident.arm.learner import arm_from_status, link_key
-from lumpbeam_ros.core.ident.arm.link_fit import link_stiffness_total, scaled_arm
+from lumpbeam_ros.core.ident.arm.learner import arm_from_status
+from lumpbeam_ros.core.ident.arm.link_fit import scaled_arm
 from lumpbeam_ros.core.model.arm.config import load_arm_config, write_arm_config
 from lumpbeam_ros.core.shaping.apply import shape_trajectory
 from lumpbeam_ros.core.shaping.impulses import Mode
@@ -202,22 +203,6 @@ def arm_file(tmp_path):
     return path
 
 
-def _arm_status(level=OK, arm=None, **changes):
-    """A ``lumpbeam/arm`` status of the links of ``arm`` (the truth by default)."""
-    arm = TRUTH if arm is None else arm
-    values = {}
-    for i, link in enumerate(arm.links, start=1):
-        values[link_key(i, 'k_total_nm_per_rad')] = link_stiffness_total(link)
-        values[link_key(i, 'k_total_nm_per_rad_std')] = 1e-3 * link_stiffness_total(link)
-        values[link_key(i, 'damping_beta')] = link.damping_beta
-        values[link_key(i, 'damping_beta_std')] = 0.05 * link.damping_beta
-    values.update(changes)
-    status = DiagnosticStatus(level=bytes([level]), name=ARM_STATUS, message='fitted')
-    status.values = [KeyValue(key=k, value=repr(v)) for k, v in values.items()]
-    status.values.append(KeyValue(key='ring_downs', value='3'))
-    return DiagnosticArray(status=[status])
-
-
 def _move_command():
     """A move of small_arm(2) to (0.5, -0.8) in 0.3 s, named in reverse order."""
     move = minimum_jerk([0.0, 0.0], [0.5, -0.8], 0.3, step=5e-3)
@@ -242,15 +227,15 @@ def test_the_model_shapes_each_move_with_the_latest_identified_arm(ros_graph, ar
     # A WARN status and bad values keep it.
     latched = topic_qos(ARM_PARAMS)
     for bad in (
-        _arm_status(level=1),
-        _arm_status(link_1_damping_beta=math.nan),
-        _arm_status(link_2_k_total_nm_per_rad_std=1e9),
+        arm_status_msg(TRUTH, level=1),
+        arm_status_msg(TRUTH, link_1_damping_beta=math.nan),
+        arm_status_msg(TRUTH, link_2_k_total_nm_per_rad_std=1e9),
     ):
         ros_graph.publish(ARM_PARAMS, bad, latched)
         ros_graph.spin_for(0.3)
     assert 'arm file' in node.description
     # An OK one: the identified arm shapes the next move.
-    ros_graph.publish(ARM_PARAMS, _arm_status(), latched)
+    ros_graph.publish(ARM_PARAMS, arm_status_msg(TRUTH), latched)
     assert ros_graph.spin_until(lambda: ARM_PARAMS in node.description, 10.0)
     before = len(got)
     ros_graph.publish(IN, command)
@@ -259,7 +244,7 @@ def test_the_model_shapes_each_move_with_the_latest_identified_arm(ros_graph, ar
     # Other modes: another shaper, another duration.
     assert trajectory_from_msg(got[-1]).duration_s != pytest.approx(expected.duration_s)
     identified = arm_from_status(
-        OK, {kv.key: kv.value for kv in _arm_status().status[0].values}, from_file
+        OK, {kv.key: kv.value for kv in arm_status_msg(TRUTH).status[0].values}, from_file
     )
     _assert_is(got[-1], _model_shaped(command, identified), command)
 

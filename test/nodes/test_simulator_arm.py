@@ -4,18 +4,17 @@ import numpy as np
 import pytest
 import yaml
 from builtin_interfaces.msg import Duration
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
+from harness import arm_status_msg
 from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
 from trajectory_msgs.msg import JointTrajectoryPoint
 from visualization_msgs.msg import MarkerArray
 
-from lumpbeam_ros.base.interface import ARM_PARAMS, ARM_STATUS
+from lumpbeam_ros.base.interface import ARM_PARAMS
 from lumpbeam_ros.core.bagio.convert import quaternion_to_pitch
-from lumpbeam_ros.core.ident.arm.learner import link_key
-from lumpbeam_ros.core.ident.arm.link_fit import link_stiffness_total, scaled_arm
+from lumpbeam_ros.core.ident.arm.link_fit import scaled_arm
 from lumpbeam_ros.core.model.arm.config import load_arm_config
 from lumpbeam_ros.core.model.arm.drive import SampledMotion
 from lumpbeam_ros.core.model.arm.joint_trajectory import JointTrajectory
@@ -152,19 +151,6 @@ def test_follows_a_command_as_the_offline_simulation_under_sim_time(ros_graph, a
     np.testing.assert_allclose(joints[-1].position, q[0], atol=1e-12)
 
 
-def _arm_status(arm, level=0, **changes):
-    values = {}
-    for i, link in enumerate(arm.links, start=1):
-        values[link_key(i, 'k_total_nm_per_rad')] = link_stiffness_total(link)
-        values[link_key(i, 'k_total_nm_per_rad_std')] = 1e-3 * link_stiffness_total(link)
-        values[link_key(i, 'damping_beta')] = link.damping_beta
-        values[link_key(i, 'damping_beta_std')] = 0.05 * link.damping_beta
-    values.update(changes)
-    status = DiagnosticStatus(level=bytes([level]), name=ARM_STATUS, message='fitted')
-    status.values = [KeyValue(key=k, value=repr(float(v))) for k, v in values.items()]
-    return DiagnosticArray(status=[status])
-
-
 def test_the_identified_arm_is_adopted_only_when_asked_and_valid(ros_graph, arm_file):
     nominal = load_arm_config(arm_file)
     identified = scaled_arm(nominal, np.array([1.3, 0.7]), np.array([2e-3, 1e-3]))
@@ -172,14 +158,14 @@ def test_the_identified_arm_is_adopted_only_when_asked_and_valid(ros_graph, arm_
     idle = _start(ros_graph, arm_file)
     node = _start(ros_graph, arm_file, adopt_identified=True)
     for bad in (
-        _arm_status(identified, level=1),
-        _arm_status(identified, link_1_damping_beta=float('nan')),
-        _arm_status(identified, link_2_k_total_nm_per_rad_std=1e9),
+        arm_status_msg(identified, level=1),
+        arm_status_msg(identified, link_1_damping_beta=float('nan')),
+        arm_status_msg(identified, link_2_k_total_nm_per_rad_std=1e9),
     ):
         ros_graph.publish(ARM_PARAMS, bad, latched)
         ros_graph.spin_for(0.3)
     assert node.arm.adopted == 0
-    ros_graph.publish(ARM_PARAMS, _arm_status(identified), latched)
+    ros_graph.publish(ARM_PARAMS, arm_status_msg(identified), latched)
     assert ros_graph.spin_until(lambda: node.arm.adopted == 1, 10.0)
     ros_graph.spin_for(0.3)
     assert idle.arm.adopted == 0
