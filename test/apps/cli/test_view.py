@@ -26,6 +26,8 @@ websockets = pytest.importorskip('websockets')
 
 #: Foxglove WebSocket v1: a server's binary message opcode for message data.
 MESSAGE_DATA = 0x01
+#: The status a Foxglove SDK server answers a subscription to a channel it does not know with.
+UNKNOWN_CHANNEL = re.compile(r'Unknown channel ID: (\d+)')
 WANTED = {
     '/tip_pose': 'geometry_msgs/msg/PoseStamped',
     '/beam_markers': 'visualization_msgs/msg/MarkerArray',
@@ -92,7 +94,19 @@ async def _watch(port, timeout_s=20.0, wanted=WANTED):
             frame = await asyncio.wait_for(ws.recv(), deadline - loop.time())
             if isinstance(frame, str):
                 message = json.loads(frame)
-                if message['op'] == 'advertise':
+                unknown = message['op'] == 'status' and UNKNOWN_CHANNEL.match(message['message'])
+                if unknown:
+                    # The SDK sends a live channel's advertisement before it records the
+                    # channel as advertised (ConnectedClient::advertise_channels), so an
+                    # answer fast enough is refused: ask once more, as a robust client does.
+                    channel_id = int(unknown.group(1))
+                    request = [
+                        {'id': i, 'channelId': channel_id}
+                        for i, t in subscriptions.items()
+                        if channels[t]['id'] == channel_id
+                    ]
+                    await ws.send(json.dumps({'op': 'subscribe', 'subscriptions': request}))
+                elif message['op'] == 'advertise':
                     channels.update({c['topic']: c for c in message['channels']})
                     if not subscriptions and set(wanted) <= set(channels):
                         subscriptions = {i: t for i, t in enumerate(wanted, start=1)}
