@@ -21,9 +21,10 @@ Until it has a first one it publishes nothing, and warns for each trajectory dro
 consumer of ``/joint_trajectory_shaped`` relies on the commands being shaped, and an unshaped
 move published there would ring while claiming not to; the unshaped command stays on
 ``/joint_trajectory`` for whoever wants it. ``unshaped_until_estimate: true`` forwards it
-unshaped instead (a first move that rings to be identified). A trajectory that cannot be
-shaped (fewer than 2 points, times that do not increase, positions missing or not finite) is
-dropped with a throttled warning.
+unshaped instead (a first move that rings to be identified); with ``source: model`` it
+forwards every move unshaped until the first identified arm, the file's model shaping none.
+A trajectory that cannot be shaped (fewer than 2 points, times that do not increase,
+positions missing or not finite) is dropped with a throttled warning.
 
 Parameters: :data:`~lumpbeam_ros.nodes.params.shaper_params.SHAPER_SCHEMA`
     (``doc/parameters.md``)::
@@ -102,7 +103,8 @@ class ShaperNode(SchemaNode):
                     f'{self.get_name()} parameters', 'arm_config', 'needed with source model'
                 )
             self.nominal = load_arm_config(str(values['arm_config']))
-            self._adopt_arm(self.nominal, f'the arm file {values["arm_config"]}')
+            if not self._unshaped_first:
+                self._adopt_arm(self.nominal, f'the arm file {values["arm_config"]}')
             subscription(self, DiagnosticArray, ARM_PARAMS, self._on_arm)
         else:
             subscription(self, DiagnosticArray, BEAM_PARAMS, self._on_params)

@@ -255,3 +255,27 @@ def test_a_command_for_another_arm_is_dropped(ros_graph, arm_file):
     _send(ros_graph, IN, _command(names=('joint_1', 'wrist')))
     assert ros_graph.spin_until(lambda: node.dropped >= 1, 10.0)
     assert got == []
+
+
+def test_the_model_shapes_nothing_before_the_first_identified_arm_when_asked(ros_graph, arm_file):
+    # The moves before it ring, for the identifier to learn from; the file's model is unused.
+    got = ros_graph.collect(OUT, JointTrajectoryMsg)
+    node = _start(
+        ros_graph, source='model', arm_config=str(arm_file), unshaped_until_estimate=True
+    )
+    command = _move_command()
+    _send(ros_graph, IN, command)
+    assert ros_graph.spin_until(lambda: len(got) >= 1, 10.0)
+    _assert_is(got[0], trajectory_from_msg(command), command)
+    ros_graph.publish(ARM_PARAMS, arm_status_msg(TRUTH, level=1), topic_qos(ARM_PARAMS))
+    ros_graph.spin_for(0.3)
+    assert node.workspace is None  # a WARN status is no identified arm
+    ros_graph.publish(ARM_PARAMS, arm_status_msg(TRUTH), topic_qos(ARM_PARAMS))
+    assert ros_graph.spin_until(lambda: ARM_PARAMS in node.description, 10.0)
+    before = len(got)  # the command may have gone out twice (_send)
+    ros_graph.publish(IN, command)
+    assert ros_graph.spin_until(lambda: len(got) > before, 10.0)
+    identified = arm_from_status(
+        OK, {kv.key: kv.value for kv in arm_status_msg(TRUTH).status[0].values}, NOMINAL
+    )
+    _assert_is(got[-1], _model_shaped(command, identified), command)

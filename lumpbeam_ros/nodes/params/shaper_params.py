@@ -90,8 +90,9 @@ SHAPER_SCHEMA = ParameterSchema(
             'unshaped_until_estimate',
             'bool',
             False,
-            'until the first valid estimate, publish each trajectory unshaped (with a '
-            'warning) instead of nothing',
+            'until the first valid estimate (source model: the first identified arm, the '
+            "file's model unused), publish each trajectory unshaped (with a warning) instead "
+            'of nothing',
         ),
     ),
 )
