@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.apps.cli.main import main
-from lumpbeam_ros.apps.demo import arm_loop
+from lumpbeam_ros.apps.demo import arm_graph, arm_loop
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.base.interface import IDENTIFIER_STATUS, JOINT_TRAJECTORY_TYPE
 from lumpbeam_ros.base.resources import config_path
@@ -23,7 +23,7 @@ def test_the_moves_go_out_and_back_from_rest():
     out, back = arm_loop.the_moves(arm)
     for move, start, end in ((out, 0.0, arm_loop.MOVE_RAD), (back, arm_loop.MOVE_RAD, 0.0)):
         assert move.joint_names == ('joint_1', 'joint_2', 'joint_3')
-        assert move.time_s[-1] == pytest.approx(arm_loop.HOLD_S + arm_loop.MOVE_S)
+        assert move.time_s[-1] == pytest.approx(arm_graph.HOLD_S + arm_loop.MOVE_S)
         assert move.angles_rad[0, 0] == move.angles_rad[1, 0] == start  # held, then moves
         assert move.angles_rad[-1, 0] == end
         assert not move.angles_rad[:, 1:].any()  # the other joints stay at 0
