@@ -188,9 +188,11 @@ class IdentifierNode(SchemaNode):
         msg.header.frame_id = BASE_FRAME
         self._arm_output.publish(msg)
         self.arm_updates += 1
-        logger = self.get_logger()
-        log = logger.info if estimate.status == Status.OK else logger.warning
-        log(f'{ARM_PARAMS}: {estimate.message}')
+        # rclpy ties a severity to each call site: one call for both levels raises.
+        if estimate.status == Status.OK:
+            self.get_logger().info(f'{ARM_PARAMS}: {estimate.message}')
+        else:
+            self.get_logger().warning(f'{ARM_PARAMS}: {estimate.message}')
 
     def diagnostics(self, result: Identification) -> DiagnosticArray:
         """The ``/beam_params`` message of one identification (doc/interfaces.md, 'Topics').

@@ -25,8 +25,10 @@ from lumpbeam_ros.base.resources import config_path
 from lumpbeam_ros.core.bagio import read_tip_poses
 from lumpbeam_ros.core.bagio.convert import pitch_to_quaternion
 from lumpbeam_ros.core.bagio.series import read_joint_states
+from lumpbeam_ros.core.ident.arm.learner import ArmEstimate
 from lumpbeam_ros.core.ident.arm.link_fit import link_stiffness_total, scaled_arm
 from lumpbeam_ros.core.ident.bag_analysis import analyze_bag
+from lumpbeam_ros.core.ident.identification import Status
 from lumpbeam_ros.core.ident.identify import identify
 from lumpbeam_ros.core.ident.settings import IdentifierConfig
 from lumpbeam_ros.core.model import rules
@@ -506,3 +508,20 @@ def test_a_bad_arm_file_stops_the_node_in_one_line(ros_graph, tmp_path):
             parameter_overrides={'arm_config': str(tmp_path / 'missing.yaml')},
         )
     assert '\n' not in str(caught.value)
+
+
+def test_arm_fits_undetermined_then_determined_are_both_published(ros_graph, tmp_path):
+    # A WARN fit then an OK one (two ring-downs of a two-link arm): rclpy refuses a call site
+    # that changes severity, which once stopped the node at its first OK fit.
+    arm_file = tmp_path / 'arm.yaml'
+    write_arm_config(arm_file, small_arm(2))
+    node = IdentifierNode(
+        context=ros_graph.context, parameter_overrides={'arm_config': str(arm_file)}
+    )
+    ros_graph.add_node(node)
+    arm_params = ros_graph.collect(ARM_PARAMS, DiagnosticArray, topic_qos(ARM_PARAMS))
+    for count, level in enumerate((Status.WARN, Status.OK, Status.WARN), start=1):
+        node._publish_arm(ArmEstimate(level, f'fit at {level.name}', 1))
+        assert ros_graph.spin_until(lambda n=count: len(arm_params) == n, 10.0)
+    assert [m.status[0].level for m in arm_params] == [b'\x01', b'\x00', b'\x01']
+    assert node.arm_updates == 3

@@ -671,7 +671,10 @@ def add_bench(parser: argparse.ArgumentParser) -> None:
 def add_demo(parser: argparse.ArgumentParser) -> None:
     """Declares ``lumpbeam demo``."""
     parser.add_argument(
-        '--out', type=Path, help='output folder (default results, with --arm results/arm)'
+        '--out',
+        type=Path,
+        help='output folder (default results, with --arm results/arm, with --workspace '
+        'results/workspace)',
     )
     parser.add_argument(
         '--duration', type=positive_float, default=12.0, help='record length, s (default 12)'
@@ -706,7 +709,14 @@ def add_demo(parser: argparse.ArgumentParser) -> None:
         metavar='FILE',
         help='the input-shaping loop on a simulated flexible arm instead of the drop test: an '
         'unshaped move rings, its modes are identified live, the move back is shaped '
-        '(arm file; default config/arm_rotary.yaml)',
+        '(arm file; default config/arm_rotary.yaml, with --workspace config/arm_2link.yaml)',
+    )
+    parser.add_argument(
+        '--workspace',
+        action='store_true',
+        help='with or without --arm: a two-link arm whose links are 20%% off its file visits '
+        'five configurations; the identifier learns the links from the first ring-downs, '
+        'the later moves are shaped by the learned model',
     )
 
 

@@ -1,12 +1,14 @@
-"""``lumpbeam demo [--out DIR] [--arm [FILE]]``: the pipeline on the built-in experiment.
+"""``lumpbeam demo [--out DIR] [--arm [FILE]] [--workspace]``: the built-in experiments.
 
-Without ``--arm`` the synthetic drop test; with it the input-shaping loop on an arm.
+Without ``--arm`` the synthetic drop test; with it the input-shaping loop on an arm; with
+``--workspace`` the arm learned live and shaped across its workspace.
 """
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
 from lumpbeam_ros.apps.cli.output import write_json
 
@@ -30,10 +32,10 @@ def run(args: argparse.Namespace) -> int:
             f'--domain-id must be in {DOMAIN_IDS.start}..{DOMAIN_IDS.stop - 1}, '
             f'got {args.domain_id}'
         )
-    args.out = output_folder(args.out, args.arm is not None)
+    args.out = output_folder(args.out, args.arm is not None, args.workspace)
     if args.out.exists() and not args.out.is_dir():
         raise LumpbeamError(f'--out {args.out} is a file, not a folder')
-    if args.arm is not None:
+    if args.arm is not None or args.workspace:
         return _run_arm(args)
     from lumpbeam_ros.apps.demo.run import HIDDEN_EFFECT
     from lumpbeam_ros.core.synthetic.drop_test import parse_effects
@@ -57,15 +59,18 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-#: Where the demos write when ``--out`` is not given: the two never share a folder.
+#: Where the demos write when ``--out`` is not given: no two share a folder.
 DEFAULT_OUT = Path('results')
 ARM_OUT = DEFAULT_OUT / 'arm'
+WORKSPACE_OUT = DEFAULT_OUT / 'workspace'
 
 
-def output_folder(out: Path | None, arm: bool) -> Path:
-    """``--out``, or the demo's own folder under ``results/`` (the arm's in ``results/arm``)."""
+def output_folder(out: Path | None, arm: bool, workspace: bool = False) -> Path:
+    """``--out``, or the demo's own folder under ``results/`` (``arm``, ``workspace``)."""
     if out is not None:
         return out
+    if workspace:
+        return WORKSPACE_OUT
     return ARM_OUT if arm else DEFAULT_OUT
 
 
@@ -82,18 +87,32 @@ BEAM_ONLY = {
 
 
 def _run_arm(args: argparse.Namespace) -> int:
-    """Runs the arm demo (``--arm``); refuses the drop test's options beside it."""
-    from lumpbeam_ros.apps.demo.arm_loop import ArmDemoOptions, run_arm_demo
+    """Runs an arm demo (``--arm``, ``--workspace``); refuses the drop test's options."""
     from lumpbeam_ros.base.errors import LumpbeamError
     from lumpbeam_ros.base.resources import config_path
 
     given = [name for name, default in BEAM_ONLY.items() if getattr(args, name) != default]
     if given:
         option = '--' + given[0].replace('_', '-')
-        raise LumpbeamError(f'{option} is an option of the drop-test demo, not of --arm')
-    arm = Path(args.arm) if args.arm else config_path('arm_rotary.yaml')
-    options = ArmDemoOptions(arm_config=arm, out=args.out, domain_id=args.domain_id)
-    result = run_arm_demo(options, echo=lambda line: print(line, flush=True))
+        which = '--workspace' if args.workspace else '--arm'
+        raise LumpbeamError(f'{option} is an option of the drop-test demo, not of {which}')
+    echo = lambda line: print(line, flush=True)  # noqa: E731
+    summary: dict[str, Any]
+    if args.workspace:
+        from lumpbeam_ros.apps.demo.workspace_loop import (
+            WorkspaceDemoOptions,
+            run_workspace_demo,
+        )
+
+        arm = Path(args.arm) if args.arm else config_path('arm_2link.yaml')
+        options = WorkspaceDemoOptions(arm_config=arm, out=args.out, domain_id=args.domain_id)
+        summary = run_workspace_demo(options, echo=echo).summary
+    else:
+        from lumpbeam_ros.apps.demo.arm_loop import ArmDemoOptions, run_arm_demo
+
+        arm = Path(args.arm) if args.arm else config_path('arm_rotary.yaml')
+        arm_options = ArmDemoOptions(arm_config=arm, out=args.out, domain_id=args.domain_id)
+        summary = run_arm_demo(arm_options, echo=echo).summary
     if args.json is not None:
-        write_json(args.json, result.summary)
+        write_json(args.json, summary)
     return 0

@@ -6,11 +6,14 @@
 :mod:`~lumpbeam_ros.apps.demo.accounting` counts what they published against what was
 recorded; :mod:`~lumpbeam_ros.apps.demo.recording` reads the recording back;
 :mod:`~lumpbeam_ros.apps.demo.summary` draws and tabulates the results;
-:mod:`~lumpbeam_ros.apps.demo.arm_loop` is ``lumpbeam demo --arm``.
+:mod:`~lumpbeam_ros.apps.demo.arm_graph` is the arm demos' graph and driver;
+:mod:`~lumpbeam_ros.apps.demo.arm_loop` is ``lumpbeam demo --arm``,
+:mod:`~lumpbeam_ros.apps.demo.workspace_loop` ``lumpbeam demo --workspace``.
 """
 
 __all__ = [
     'accounting',
+    'arm_graph',
     'arm_loop',
     'graph',
     'live_diagnosis',
@@ -18,4 +21,5 @@ __all__ = [
     'run',
     'steps',
     'summary',
+    'workspace_loop',
 ]

@@ -104,6 +104,7 @@ def minimum_jerk(start: np.ndarray, end: np.ndarray, duration_s: float) -> Joint
     s = t / duration_s
     s = 10 * s**3 - 15 * s**4 + 6 * s**5
     angles = np.vstack([start, start + np.outer(s, end - start)])
+    angles[-1] = end  # exactly, not to the rounding of start + (end - start)
     names = default_joint_names(start.size)
     return JointTrajectory(np.concatenate([[0.0], HOLD_S + t]), angles, names)
 

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from lumpbeam_ros.base.errors import LumpbeamError
-from lumpbeam_ros.base.interface import TIP_POSE
+from lumpbeam_ros.base.interface import JOINT_STATES, TIP_POSE
 from lumpbeam_ros.core.bagio import read_tip_poses
 from lumpbeam_ros.core.bagio.series import read_joint_states
 from lumpbeam_ros.core.ident.arm.moves import Move, find_moves
@@ -98,15 +98,19 @@ def move_residuals(
 
 
 def bag_move_residuals(
-    bag: str | Path, arm: ArmConfig, topic: str = TIP_POSE, window_s: float = WINDOW_S
+    bag: str | Path,
+    arm: ArmConfig,
+    topic: str = TIP_POSE,
+    window_s: float = WINDOW_S,
+    joints_topic: str = JOINT_STATES,
 ) -> list[MoveResidual]:
-    """:func:`move_residuals` of a recorded arm: ``/joint_states`` and a tip pose topic.
+    """:func:`move_residuals` of a recorded arm: a joint state topic and a tip pose topic.
 
     Raises:
-        BagError: No ``/joint_states`` or no such pose topic.
+        BagError: No such joint state topic or no such pose topic.
         LumpbeamError: As :func:`move_residuals`.
     """
-    joints = read_joint_states(bag)
+    joints = read_joint_states(bag, joints_topic)
     poses = read_tip_poses(bag, topic)
     return move_residuals(arm, joints.t, joints.angles, poses.t, poses.x, poses.z, window_s)
 

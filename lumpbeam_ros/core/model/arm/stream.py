@@ -21,12 +21,18 @@ A command names every joint once (any order), its times from start increase stri
 positions are finite, and its first point at time 0 (if any) is where the joints are: a
 servo cannot jump. Anything else is refused with a :class:`~lumpbeam_ros.base.errors.LumpbeamError`
 naming the problem, and the stream is left as it was.
+
+The history is kept in seconds from an *origin* (the anchor when the history restarts), not
+in the clock's seconds: a stamp of today's clock (1.8e9 s) carries only 2.4e-7 s of
+resolution, and 1 kHz samples moved onto it step by jittering intervals whose rates, splined,
+shook a shaped move's tip by 0.7 mm.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 
@@ -70,9 +76,11 @@ class ArmStream:
         self.rate_hz = float(rate_hz)
         self.ring_down_s = float(ring_down_s)
         self.history_s = float(history_s)
+        self._origin = 0.0  # the clock's time of the history's time 0
         self._times: np.ndarray | None = None  # the history's rows since the anchor
         self._angles: np.ndarray | None = None
         self._motion: ArmMotion | None = None  # anchor first, then grid stamps
+        self._clock_motion: ArmMotion | None = None  # the same at the clock's times
         self._last_k: int | None = None  # the last grid index produced
         self._first_k = 0  # the grid index of the simulation's first stamp
         self._offset = 0  # 1 when the anchor (the simulation's first time) is off the grid
@@ -85,12 +93,12 @@ class ArmStream:
     @property
     def anchor_s(self) -> float:
         """When the arm was last at rest (the history's start), s; NaN before a command."""
-        return math.nan if self._times is None else float(self._times[0])
+        return math.nan if self._times is None else self._origin + float(self._times[0])
 
     @property
     def motion(self) -> ArmMotion | None:
         """The current simulation: the anchor, then the grid stamps up to its end."""
-        return self._motion
+        return self._clock_motion
 
     def held_angles(self, t: float) -> np.ndarray:
         """The commanded joint angles at ``t`` (the last ones after the history's end).
@@ -100,6 +108,11 @@ class ArmStream:
         """
         if self._times is None or self._angles is None:
             raise LumpbeamError('arm stream: no command yet')
+        return self._held_at(t - self._origin)
+
+    def _held_at(self, t: float) -> np.ndarray:
+        """:meth:`held_angles` at ``t`` in the history's seconds."""
+        assert self._times is not None and self._angles is not None
         return np.array([np.interp(t, self._times, a) for a in self._angles.T])
 
     def command(
@@ -127,38 +140,40 @@ class ArmStream:
                 the last sample, a position outside a joint's ``joint_limits_rad``, a jump at
                 time 0, or a simulation that failed; the stream is then unchanged.
         """
-        trajectory = self._checked(names, times_s, positions, start_s)
-        times, angles = trajectory.time_s, trajectory.angles_rad
+        command = self._checked(names, times_s, positions, start_s)
+        origin = start_s if self._times is None else self._origin
+        start = start_s - origin  # in the history's seconds: the command's rows keep their own
+        times, angles = start + command.time_s, command.angles_rad
         if self._times is not None and self._angles is not None:
-            held = self.held_angles(start_s)
-            if times[0] == start_s and np.max(np.abs(angles[0] - held)) > JUMP_TOLERANCE_RAD:
+            held = self._held_at(start)
+            if times[0] == start and np.max(np.abs(angles[0] - held)) > JUMP_TOLERANCE_RAD:
                 raise LumpbeamError(
                     f'the first point at time 0 is {np.max(np.abs(angles[0] - held)):.3g} rad '
                     'from where the joints are: a servo cannot jump (start it at a later time)'
                 )
             anchor = float(self._times[0])
-            if start_s - anchor > self.history_s:
+            if start - anchor > self.history_s:
                 # Re-anchored at rest at the held angles, from the next stamp due.
-                anchor = start_s
+                anchor = start
                 if self._last_k is not None:
-                    anchor = min(start_s, max(anchor, (self._last_k + 1) / self.rate_hz))
-            keep = (self._times > anchor) & (self._times < start_s)
-            head_t = np.concatenate([[anchor], self._times[keep], [start_s]])
-            head_q = np.vstack([self.held_angles(anchor), self._angles[keep], held])
-            if times[0] == start_s or anchor == start_s:
+                    anchor = min(start, max(anchor, (self._last_k + 1) / self.rate_hz - origin))
+            keep = (self._times > anchor) & (self._times < start)
+            head_t = np.concatenate([[anchor], self._times[keep], [start]])
+            head_q = np.vstack([self._held_at(anchor), self._angles[keep], held])
+            if times[0] == start or anchor == start:
                 head_t, head_q = head_t[:-1], head_q[:-1]
             times = np.concatenate([head_t, times])
             angles = np.vstack([head_q, angles])
-        elif times[0] > start_s:  # the first command: the arm at rest at its first point
-            times = np.concatenate([[start_s], times])
+        elif times[0] > start:  # the first command: the arm at rest at its first point
+            times = np.concatenate([[start], times])
             angles = np.vstack([angles[:1], angles])
-        self._simulate(times, angles, float(times[-1]) + self.ring_down_s)
-        return trajectory
+        self._simulate(times, angles, float(times[-1]) + self.ring_down_s, origin)
+        return JointTrajectory(start_s + command.time_s, command.angles_rad, self.joint_names)
 
     def _checked(
         self, names: Sequence[str], times_s: Sequence[float], positions: np.ndarray, start_s: float
     ) -> JointTrajectory:
-        """The command in the arm's joint order at absolute times, or why not."""
+        """The command in the arm's joint order, its times from its start, or why not."""
         names = list(names)
         unknown = [n for n in names if n not in self.joint_names]
         if unknown:
@@ -201,30 +216,42 @@ class ArmStream:
             )
         order = [names.index(n) for n in self.joint_names]
         self.model.config.check_within_limits(positions[:, order], 'the command')
-        absolute = start_s + times
-        if absolute.size == 1:
+        if times.size == 1:
             return JointTrajectory(
-                np.array([absolute[0], absolute[0] + 1.0]), positions[[0, 0]][:, order]
+                np.array([times[0], times[0] + 1.0]), positions[[0, 0]][:, order]
             )
-        return JointTrajectory(absolute, positions[:, order], self.joint_names)
+        return JointTrajectory(times, positions[:, order], self.joint_names)
 
-    def _simulate(self, times: np.ndarray, angles: np.ndarray, end_s: float) -> None:
-        """Simulates the history from its anchor to ``end_s`` and keeps it on success."""
+    def _simulate(self, times: np.ndarray, angles: np.ndarray, end: float, origin: float) -> None:
+        """Simulates the history from its anchor to ``end`` and keeps it on success.
+
+        Args:
+            times: The history's rows, s from ``origin``; the first is the anchor.
+            angles: Their angles, rad.
+            end: Where the simulation ends, s from ``origin``.
+            origin: The clock's time of the times' 0, s.
+        """
         if times.size == 1:
             times, angles = np.append(times, times[0] + 1.0), np.vstack([angles, angles])
-        history = JointTrajectory(times, angles, self.joint_names)
-        anchor = float(times[0])
+        # Kept from the anchor on: the history's seconds stay small.
+        anchor = origin + float(times[0])
+        history = JointTrajectory(times - times[0], angles, self.joint_names)
+        end -= float(times[0])
         first = math.ceil(anchor * self.rate_hz - _GRID_SLACK)
-        last = math.floor(end_s * self.rate_hz + _GRID_SLACK)
-        grid = np.arange(first, last + 1) / self.rate_hz
+        last = math.floor((anchor + end) * self.rate_hz + _GRID_SLACK)
+        # The grid in the history's seconds: one rounding of the clock's, then exact steps.
+        lead = first / self.rate_hz - anchor
         # The anchor is the first output time (the arm at rest there); an anchor between two
         # stamps is simulated but never produced.
-        on_grid = abs(first / self.rate_hz - anchor) * self.rate_hz < _GRID_SLACK
-        t_eval = np.concatenate([[anchor], grid[1:] if on_grid else grid])
+        on_grid = abs(lead) * self.rate_hz < _GRID_SLACK
+        grid = (0.0 if on_grid else lead) + np.arange(last - first + 1) / self.rate_hz
+        t_eval = np.concatenate([[0.0], grid[1:] if on_grid else grid])
         motion = simulate_arm(self.model, SampledMotion(history), t_eval)
         if not (np.all(np.isfinite(motion.phi)) and np.all(np.isfinite(motion.tip_z))):
             raise LumpbeamError('the simulation gave non-finite angles')
+        self._origin = anchor
         self._times, self._angles, self._motion = history.time_s, history.angles_rad, motion
+        self._clock_motion = replace(motion, t=anchor + motion.t)
         self._first_k, self._offset = first, 0 if on_grid else 1
 
     def advance_to(self, now: float) -> ArmMotion:
@@ -240,7 +267,7 @@ class ArmStream:
         if motion is None:
             return _empty(self.model)
         newest = math.floor(now * self.rate_hz + _GRID_SLACK)
-        if newest / self.rate_hz > float(motion.t[-1]) - 1.0 / self.rate_hz:
+        if newest / self.rate_hz > self._origin + float(motion.t[-1]) - 1.0 / self.rate_hz:
             self._extend(now)
             motion = self._motion
             assert motion is not None
@@ -253,7 +280,7 @@ class ArmStream:
             return _empty(self.model)
         self._last_k = int(keys[index[-1] - self._offset])
         return ArmMotion(
-            motion.t[index],
+            keys[index - self._offset] / self.rate_hz,  # the stamps, on the clock's grid
             motion.q[index],
             motion.phi[index],
             motion.phi_dot[index],
@@ -266,12 +293,13 @@ class ArmStream:
         """Simulates further (or re-anchors at rest) so the span reaches past ``now``."""
         assert self._times is not None and self._angles is not None
         end = now + self.ring_down_s
-        if now - float(self._times[0]) > self.history_s and now >= float(self._times[-1]):
+        if now - self.anchor_s > self.history_s and now >= self._origin + float(self._times[-1]):
             # At rest from the next stamp on: no stamp is skipped.
             start = now if self._last_k is None else (self._last_k + 1) / self.rate_hz
-            self._simulate(np.array([start]), self.held_angles(start)[None, :], end)
+            held = self.held_angles(start)[None, :]
+            self._simulate(np.zeros(1), held, end - start, start)
         else:
-            self._simulate(self._times, self._angles, end)
+            self._simulate(self._times, self._angles, end - self._origin, self._origin)
 
     def restart_at(self, t: float) -> None:
         """Restarts at rest at ``t`` with the joints held where they are (a clock that jumped).
@@ -285,7 +313,7 @@ class ArmStream:
         if self._times is None:
             return
         held = self.held_angles(t)
-        self._simulate(np.array([t]), held[None, :], t + self.ring_down_s)
+        self._simulate(np.zeros(1), held[None, :], self.ring_down_s, t)
         self._last_k = None
 
 

@@ -39,7 +39,8 @@ def test_samples_are_the_offline_simulation_of_the_move(model):
     # Every stamp once, on the grid, from the anchor on.
     assert np.allclose(np.diff(got['t']), 1 / RATE) and got['t'][0] == pytest.approx(10.0)
     assert got['t'][-1] > 11.0
-    offline = simulate_arm(model, SampledMotion(JointTrajectory(10.0 + t, q)), got['t'])
+    # Simulated in seconds from the anchor (10 s): the command's rows as it gave them.
+    offline = simulate_arm(model, SampledMotion(JointTrajectory(t, q)), got['t'] - 10.0)
     np.testing.assert_allclose(got['q'], offline.q, atol=1e-12)
     assert np.max(np.abs(got['tip_z'] - offline.tip_z)) < 1e-7
     assert np.ptp(got['tip_z']) > 0.05
@@ -139,3 +140,20 @@ def test_a_command_outside_a_joints_limits_is_refused_whatever_the_names_order()
     with pytest.raises(LumpbeamError, match=r'the command: joint_2 at 0\.6 rad is outside'):
         stream.command(['joint_2', 'joint_1'], [0.1, 0.2], [[0.4, 0.9], [0.6, 0.9]], start_s=0.5)
     assert stream.motion is before
+
+
+@pytest.mark.parametrize('clock_s', [0.0, 1.7959e9])
+def test_a_dense_command_on_todays_clock_is_simulated_as_at_time_zero(model, clock_s):
+    # 1 kHz rows moved onto a clock of 1.8e9 s (2.4e-7 s resolution) stepped by jittering
+    # intervals, whose splined rates shook a fast move's tip by a fraction of a millimetre.
+    t = np.arange(0.0, 0.5 + 1e-9, 1e-3)
+    s = t / 0.5
+    q = np.outer(10 * s**3 - 15 * s**4 + 6 * s**5, [1.0, -1.2])
+    start = clock_s + 0.25  # on the 100 Hz grid at 0, off it on the clock
+    stream = ArmStream(model, RATE, ring_down_s=1.0)
+    stream.command(['joint_1', 'joint_2'], t, q, start_s=start)
+    got = _drain(stream, start, start + 1.2)
+    offline = simulate_arm(model, SampledMotion(JointTrajectory(t, q)), got['t'] - start)
+    # Its stamps still carry the clock's 2.4e-7 s: 0.2 um at the tip's speed, not 0.5 mm.
+    assert np.max(np.abs(got['tip_z'] - offline.tip_z)) < 1e-6
+    assert np.all(np.diff(got['t']) > 0.0)
