@@ -15,8 +15,9 @@ later. The shaper cancels:
   ``lumpbeam/arm`` of level OK on ``/arm_params`` gives the identified links (or payload).
 
 An invalid estimate or arm (level ERROR, or WARN for the arm; a value missing or not finite,
-a standard deviation larger than its value) never makes a shaper: the node keeps the last
-good one and warns (throttled).
+a standard deviation larger than its value, a mode no shaper can serve:
+:class:`~lumpbeam_ros.core.shaping.limits.ShapingLimits` with ``max_added_s``) never makes a
+shaper: the node keeps the last good one and warns (throttled).
 Until it has a first one it publishes nothing, and warns for each trajectory dropped: a
 consumer of ``/joint_trajectory_shaped`` relies on the commands being shaped, and an unshaped
 move published there would ring while claiming not to; the unshaped command stays on
@@ -24,7 +25,8 @@ move published there would ring while claiming not to; the unshaped command stay
 unshaped instead (a first move that rings to be identified); with ``source: model`` it
 forwards every move unshaped until the first identified arm, the file's model shaping none.
 A trajectory that cannot be shaped (fewer than 2 points, times that do not increase,
-positions missing or not finite) is dropped with a throttled warning.
+positions missing or not finite, longer than ``max_command_s``) is dropped with a throttled
+warning.
 
 Parameters: :data:`~lumpbeam_ros.nodes.params.shaper_params.SHAPER_SCHEMA`
     (``doc/parameters.md``)::
@@ -55,6 +57,7 @@ from lumpbeam_ros.core.model.arm.config import ArmConfig, load_arm_config
 from lumpbeam_ros.core.shaping.apply import shape_trajectory
 from lumpbeam_ros.core.shaping.estimate import choose_shaper, estimate_from_status
 from lumpbeam_ros.core.shaping.impulses import Impulses, Mode
+from lumpbeam_ros.core.shaping.limits import ShapingLimits
 from lumpbeam_ros.core.shaping.shapers import design_shaper
 from lumpbeam_ros.core.shaping.workspace import WorkspaceShaper
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
@@ -91,6 +94,7 @@ class ShaperNode(SchemaNode):
         self.published = 0
         self.dropped = 0
         self._unshaped_first = bool(values['unshaped_until_estimate'])
+        self.limits = ShapingLimits(float(values['max_added_s']), float(values['max_command_s']))
         self._output = publisher(self, JointTrajectoryMsg, JOINT_TRAJECTORY_SHAPED)
         subscription(self, JointTrajectoryMsg, JOINT_TRAJECTORY, self._on_trajectory)
         self.workspace: WorkspaceShaper | None = None
@@ -138,6 +142,7 @@ class ShaperNode(SchemaNode):
 
     def _adopt(self, kind: str, modes: Sequence[Mode]) -> None:
         impulses = design_shaper(kind, modes)
+        self.limits.check_shaper(modes, impulses)
         description = f'{kind.upper()} for ' + ', '.join(
             f'{m.frequency_hz:.4g} Hz (zeta {m.damping_ratio:.3g})' for m in modes
         )
@@ -178,8 +183,11 @@ class ShaperNode(SchemaNode):
     def _on_trajectory(self, msg: JointTrajectoryMsg) -> None:
         try:
             trajectory = trajectory_from_msg(msg)
+            self.limits.check_command(trajectory)
             if self.workspace is not None:
-                shaped, _ = self.workspace.shape(trajectory)
+                shaped, moves = self.workspace.shape(trajectory)
+                for move in moves:
+                    self.limits.check_shaper(move.modes, move.impulses)
             elif self.impulses is None:
                 if not self._unshaped_first:
                     self._drop('no valid estimate yet: nothing published')

@@ -142,13 +142,16 @@ def test_shaper_callbacks(ros_graph):
         for _ in range(max(1, CASES // 4)):
             status = DiagnosticStatus(level=bytes([int(rng.integers(4))]), name=IDENTIFIER_STATUS)
             keys = ('natural_frequency_hz', 'natural_frequency_hz_std', 'damping_ratio',
-                    'damping_ratio_std', 'modes')  # fmt: skip
+                    'damping_ratio_std', 'mode_count', 'mode_2_natural_frequency_hz',
+                    'mode_2_natural_frequency_hz_std', 'mode_2_damping_ratio',
+                    'mode_2_damping_ratio_std')  # fmt: skip
             status.values = [
                 KeyValue(key=k, value=str(rng.choice(garbage))) for k in keys if rng.random() < 0.9
             ]
             node._on_params(DiagnosticArray(status=[status]))
             if node.impulses is not None:
                 assert np.all(np.isfinite(node.impulses.time_s)), node.description
+                assert node.impulses.duration_s <= node.limits.max_added_s, node.description
             msg = JointTrajectory(joint_names=['joint_1'])
             for _ in range(int(rng.integers(0, 6))):
                 t = float(rng.choice([rng.uniform(-1, 2), math.nan, math.inf]))

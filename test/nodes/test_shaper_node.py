@@ -279,3 +279,41 @@ def test_the_model_shapes_nothing_before_the_first_identified_arm_when_asked(ros
         OK, {kv.key: kv.value for kv in arm_status_msg(TRUTH).status[0].values}, NOMINAL
     )
     _assert_is(got[-1], _model_shaped(command, identified), command)
+
+
+def test_estimates_no_shaper_can_serve_keep_the_last_good_one(ros_graph, capfd):
+    # Each once crashed the node (mode_count inf), made a 1 s move 894 s long (5.6e-4 Hz) or
+    # sent every move out unshaped without a word (1e300 Hz).
+    node = _start(ros_graph)
+    ros_graph.publish(BEAM_PARAMS, _status())
+    assert ros_graph.spin_until(lambda: node.impulses is not None, 10.0)
+    good = node.impulses
+    for bad in (
+        _status(natural_frequency_hz=5.6e-4, natural_frequency_hz_std=1e-6),
+        _status(natural_frequency_hz=1e300, natural_frequency_hz_std=1e297),
+    ):
+        ros_graph.publish(BEAM_PARAMS, bad)
+    ros_graph.publish(BEAM_PARAMS, _status(mode_count=math.inf, natural_frequency_hz=4.0))
+    assert ros_graph.spin_until(lambda: '4 Hz' in node.description, 10.0)  # alive
+    assert node.impulses is not good and node.impulses.time_s.size == 2
+    err = capfd.readouterr().err
+    assert 'would add 893' in err and 'more than max_added_s 10 s' in err
+    assert "mode_count 'inf' is not a count" in err
+
+
+def test_a_command_too_long_is_dropped_with_its_reason(ros_graph, capfd):
+    # A 2-point command of 9000 s once held the node 121 s at 7.2 GB.
+    got = ros_graph.collect(OUT, JointTrajectoryMsg)
+    node = _start(ros_graph, source='parameters', frequency_hz=2.0)
+    _send(ros_graph, IN, _command(times=(0.0, 9000.0), positions=[[0.0, 0.0], [1.0, 1.0]]))
+    assert ros_graph.spin_until(lambda: node.dropped >= 1, 10.0)
+    assert got == [] and 'lasts 9000 s, more than max_command_s 600 s' in capfd.readouterr().err
+
+
+def test_a_fixed_mode_no_shaper_can_serve_stops_the_node_in_one_line(ros_graph):
+    with pytest.raises(LumpbeamError, match='too fast to shape') as caught:
+        ShaperNode(
+            context=ros_graph.context,
+            parameter_overrides={'source': 'parameters', 'frequency_hz': 2000.0},
+        )
+    assert '\n' not in str(caught.value)

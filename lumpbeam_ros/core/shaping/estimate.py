@@ -83,6 +83,17 @@ def _mode(values: Mapping[str, str], k: int) -> ModeEstimate:
     return ModeEstimate(Mode(frequency, damping), frequency_std, damping_std)
 
 
+def _mode_count(text: str) -> int | None:
+    """A status's mode count, or ``None`` when it is not a whole number of at least 1."""
+    try:
+        count = float(text)
+    except ValueError:
+        return None
+    if not (math.isfinite(count) and count >= 1.0 and count.is_integer()):
+        return None
+    return int(count)
+
+
 def estimate_from_status(level: int, values: Mapping[str, str], max_modes: int) -> Estimate:
     """The modes of an identifier status, at most ``max_modes``.
 
@@ -103,9 +114,9 @@ def estimate_from_status(level: int, values: Mapping[str, str], max_modes: int) 
         raise LumpbeamError(f'status {name}, no estimate')
     modes = [_mode(values, 1)]
     left_out = []
-    try:
-        count = int(float(values.get(MODE_COUNT_KEY, '1')))
-    except ValueError:
+    count = _mode_count(values.get(MODE_COUNT_KEY, '1'))
+    if count is None:
+        left_out.append(f'{MODE_COUNT_KEY} {values[MODE_COUNT_KEY]!r} is not a count')
         count = 1
     for k in range(2, min(count, max_modes) + 1):
         try:

@@ -87,6 +87,24 @@ SHAPER_SCHEMA = ParameterSchema(
             Bounds(1, 8),
         ),
         ParameterSpec(
+            'max_added_s',
+            'double',
+            10.0,
+            'refuse a shaper that would make each move longer than this (a mode too slow, '
+            'e.g. a mis-scaled estimate); the last good one is kept',
+            's',
+            Bounds(0.0, 3600.0, low_open=True),
+        ),
+        ParameterSpec(
+            'max_command_s',
+            'double',
+            600.0,
+            'drop a /joint_trajectory lasting longer than this (its shaped copy is sampled at '
+            '1 kHz throughout)',
+            's',
+            Bounds(0.0, 86400.0, low_open=True),
+        ),
+        ParameterSpec(
             'unshaped_until_estimate',
             'bool',
             False,

@@ -79,3 +79,14 @@ def test_robust_shaper_when_a_frequency_is_uncertain(stds, expected):
         ModeEstimate(Mode(20.0, 0.0), stds[1], 0),
     ]
     assert choose_shaper(modes, 'zv', 'ei', robust_above=0.01) == expected
+
+
+@pytest.mark.parametrize('count', ['inf', 'nan', '-1', '0', '2.5', 'two', '1e300'])
+def test_a_mode_count_that_is_no_count_leaves_the_first_mode_with_the_reason(count):
+    # 'inf' once stopped the shaper node (int(inf): OverflowError).
+    estimate = estimate_from_status(OK, _status(mode_count=count), max_modes=3)
+    if count == '1e300':  # a count, if an absurd one: as many modes as the status holds
+        assert len(estimate.modes) == 2
+        return
+    assert [m.mode for m in estimate.modes] == [Mode(3.2, 0.01)]
+    assert estimate.left_out == (f'mode_count {count!r} is not a count',)
