@@ -153,13 +153,15 @@ class IdentifierNode(SchemaNode):
             )
 
     def _on_joint_state(self, msg: JointState) -> None:
-        stamp_ns, _, positions = joint_state_values(msg)
-        if not self.joints.push(stamp_ns * 1e-9, positions):
+        stamp_ns, names, positions = joint_state_values(msg)
+        # A malformed message (names and positions that do not pair up) is nobody's joints:
+        # taken, it would switch the node to an arm for good.
+        if len(names) != positions.size or not self.joints.push(stamp_ns * 1e-9, positions):
             self.bad_joint_states += 1
             self.get_logger().warning(
-                f'/joint_states at {stamp_ns * 1e-9:.3f} s ignored: a position that is not '
-                'finite, a stamp going back or another number of joints '
-                f'({self.bad_joint_states} so far)',
+                f'/joint_states at {stamp_ns * 1e-9:.3f} s ignored: {len(names)} names for '
+                f'{positions.size} positions, a position that is not finite, a stamp going '
+                f'back or another number of joints ({self.bad_joint_states} so far)',
                 throttle_duration_sec=WARN_PERIOD_S,
             )
 

@@ -525,3 +525,15 @@ def test_arm_fits_undetermined_then_determined_are_both_published(ros_graph, tmp
         assert ros_graph.spin_until(lambda n=count: len(arm_params) == n, 10.0)
     assert [m.status[0].level for m in arm_params] == [b'\x01', b'\x00', b'\x01']
     assert node.arm_updates == 3
+
+
+def test_a_malformed_joint_state_never_makes_the_node_an_arm(ros_graph):
+    # 3 names for 1 position once switched it to an arm for good: every drop test after it
+    # was "no ring-down yet".
+    node = _identifier(ros_graph)
+    malformed = _joint_state(1.0, [0.1])
+    malformed.name = ['joint_1', 'joint_2', 'joint_3']
+    node._on_joint_state(malformed)
+    assert node.joints.current is None and node.bad_joint_states == 1
+    node._on_joint_state(_joint_state(1.1, [0.1, 0.2]))  # a well-formed one is taken
+    assert node.joints.current is not None and node.bad_joint_states == 1
