@@ -422,6 +422,12 @@ class BeamSimulation:
             except LumpbeamError as exc:
                 self.node.warn(f'ignoring /beam_params: {exc}')
                 return
+            if not _carries(beam, self._load_kg):
+                self.node.warn(
+                    f'ignoring /beam_params: with k_tE={k_total:.6g} N m/rad the beam cannot '
+                    f'carry its {self._load_kg:g} kg load'
+                )
+                return
             self._adopted, self._adopted_beam = (k_total, zeta), beam
             if self.stream is not None:
                 self.stream.set_beam(beam)

@@ -228,6 +228,11 @@ def test_adopts_identified_parameters_when_asked(ros_graph, adopt):
         _beam_params(DiagnosticStatus.OK, stiffness_total_nm_per_rad='abc', damping_ratio='0.01'),
         _beam_params(DiagnosticStatus.OK, damping_ratio='0.01'),
         _beam_params(DiagnosticStatus.OK, stiffness_total_nm_per_rad='-3.0', damping_ratio='0.01'),
+        # Each of these once stopped an adopting node inside a solver.
+        *(
+            _beam_params(DiagnosticStatus.OK, stiffness_total_nm_per_rad=k, damping_ratio='0.01')
+            for k in ('1.0', '1e-300', '8.6e302')
+        ),
     ]
     for msg in ignored:
         ros_graph.publish('/beam_params', msg)

@@ -22,6 +22,10 @@ from lumpbeam_ros.core.model.parameters import BeamParameters
 
 #: Proportional corrections of c_tE (see the module docstring).
 _DAMPING_ITERATIONS = 3
+#: How far an identified stiffness may lie from the model's own, either way: a factor the
+#: fits never reach on a real structure, and that keeps a mis-scaled or fabricated value
+#: (1, 1e-300 or 8.6e302 N m/rad on a 3899 N m/rad beam) away from the solvers.
+MAX_STIFFNESS_FACTOR = 10.0
 
 
 def first_mode(beam: BeamParameters, load_kg: float = 0.0) -> tuple[float, float, float]:
@@ -59,12 +63,19 @@ def adopt_identified(
         The updated beam; its unloaded first mode has ``damping_ratio``.
 
     Raises:
-        LumpbeamError: A non-positive or non-finite stiffness, a ratio outside [0, 1), or a
-            beam whose ``beta_identified`` is 0 while damping is asked for.
+        LumpbeamError: A non-positive or non-finite stiffness, one more than
+            :data:`MAX_STIFFNESS_FACTOR` times the beam's either way, a ratio outside
+            [0, 1), or a beam whose ``beta_identified`` is 0 while damping is asked for.
     """
     k_total, zeta = float(stiffness_total_nm_per_rad), float(damping_ratio)
     if not math.isfinite(k_total) or k_total <= 0.0:
         raise LumpbeamError(f'identified stiffness must be positive, got {k_total!r} N m/rad')
+    own = beam.segment_stiffness() / beam.n_segments  # the beam's k_tE (B.13)
+    if not own / MAX_STIFFNESS_FACTOR <= k_total <= own * MAX_STIFFNESS_FACTOR:
+        raise LumpbeamError(
+            f'identified stiffness {k_total:.6g} N m/rad is not within a factor of '
+            f"{MAX_STIFFNESS_FACTOR:g} of the beam's {own:.6g} N m/rad"
+        )
     if not math.isfinite(zeta) or not 0.0 <= zeta < 1.0:
         raise LumpbeamError(f'identified damping ratio must be in [0, 1), got {zeta!r}')
     adopted = replace(beam, stiffness_source='identified', k_total_nm_per_rad=k_total)

@@ -40,6 +40,10 @@ def test_zero_damping_ratio_switches_damping_off():
         (3000.0, 1.5, 'damping ratio'),
         (3000.0, math.nan, 'damping ratio'),
         (3000.0, -0.1, 'damping ratio'),
+        # Once fed to an adopting simulator, each of these stopped it.
+        (1.0, 0.01, 'not within a factor of 10 of the beam'),
+        (1e-300, 0.01, 'not within a factor of 10'),
+        (8.6e302, 0.01, 'not within a factor of 10'),
     ],
 )
 def test_rejects_impossible_estimates(k, zeta, message):
@@ -50,3 +54,9 @@ def test_rejects_impossible_estimates(k, zeta, message):
 def test_rejects_damping_without_beta():
     with pytest.raises(LumpbeamError, match='beta'):
         adopt_identified(replace(BEAM, beta_identified=0.0), 3000.0, 0.01)
+
+
+@pytest.mark.parametrize('factor', [0.1, 10.0])
+def test_a_stiffness_up_to_ten_times_the_beams_either_way_is_adopted(factor):
+    own = BEAM.segment_stiffness() / BEAM.n_segments
+    assert adopt_identified(BEAM, factor * own, 0.01).k_total_nm_per_rad == factor * own

@@ -40,13 +40,15 @@ from scipy.optimize import least_squares
 
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.core.ident.identification import IdentifiedMode
+from lumpbeam_ros.core.model.adopt import MAX_STIFFNESS_FACTOR
 from lumpbeam_ros.core.model.arm.config import ArmConfig, LinkConfig
 from lumpbeam_ros.core.model.arm.model import ArmModel
 from lumpbeam_ros.core.model.arm.statics import arm_modes
 from lumpbeam_ros.core.model.modes import Modes
 
-#: How far from nominal a factor may go (the solver's bounds on the log factors).
-MAX_FACTOR = 10.0
+#: How far from nominal a factor may go (the solver's bounds on the log factors): as far as
+#: the simulator lets an identified stiffness go from its model's.
+MAX_FACTOR = MAX_STIFFNESS_FACTOR
 #: Common stiffness factors tried for the first matching of measured to model modes.
 START_FACTORS = np.exp(np.linspace(math.log(1 / 3), math.log(3), 49))
 #: Relative step of the central differences behind the covariance.
