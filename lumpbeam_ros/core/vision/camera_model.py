@@ -30,6 +30,11 @@ DISTORTION_MODELS = {PLUMB_BOB: 5, RATIONAL_POLYNOMIAL: 8, EQUIDISTANT: 4}
 _EYE = np.eye(3)
 
 
+#: The longest focal length taken, in image sizes: ``f = size / (2 tan(fov / 2))`` is 1000
+#: sizes for a field of view of 0.06 degrees, narrower than any lens a rig puts at a tip.
+MAX_FOCAL_IMAGES = 1000.0
+
+
 @dataclass(frozen=True)
 class CameraInfo:
     """The calibration a camera driver publishes, without ROS types.
@@ -58,6 +63,13 @@ class CameraInfo:
             raise LumpbeamError(
                 'camera info: K must be a finite 3x3 matrix with fx, fy > 0 (an uncalibrated '
                 'camera publishes K = 0)'
+            )
+        longest = max(self.width, self.height)
+        if max(k[0, 0], k[1, 1]) > MAX_FOCAL_IMAGES * longest:
+            raise LumpbeamError(
+                f'camera info: fx {k[0, 0]:.6g}, fy {k[1, 1]:.6g} px is no lens for a '
+                f'{self.width} x {self.height} image (at most {MAX_FOCAL_IMAGES:g} times its '
+                'size: a field of view of 0.06 deg; a K scaled by mistake?)'
             )
         size = DISTORTION_MODELS.get(self.distortion_model)
         if size is None:

@@ -86,8 +86,18 @@ def test_image_size_must_match():
             "'fov' is not supported",
         ),
         ({'width': 10, 'height': 10, 'k': np.full((3, 3), np.nan)}, 'K must'),
+        # A K scaled by 1e300 once stopped the camera node (OverflowError in the tracker).
+        (
+            {'width': 640, 'height': 480, 'k': np.diag([800e300, 800e300, 1.0])},
+            r'fx 8e\+302, fy 8e\+302 px is no lens for a 640 x 480 image',
+        ),
+        ({'width': 640, 'height': 480, 'k': np.diag([8e5, 800.0, 1.0])}, 'no lens'),
     ],
 )  # fmt: skip
 def test_bad_camera_info_is_rejected(kwargs, message):
     with pytest.raises(LumpbeamError, match=message):
         CameraInfo(**kwargs)
+
+
+def test_the_longest_lens_taken_is_a_thousand_image_sizes():
+    CameraInfo(640, 480, np.diag([640e3, 640e3, 1.0]))
