@@ -63,6 +63,7 @@ from lumpbeam_ros.core.ident.settings import (
 from lumpbeam_ros.core.ident.window import SlidingWindow
 from lumpbeam_ros.core.model.arm.config import load_arm_config
 from lumpbeam_ros.core.model.parameters import BeamParameters, load_beam_config
+from lumpbeam_ros.core.model.statics import carries
 from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node, spin_live
 from lumpbeam_ros.nodes.params.identifier_params import IDENTIFIER_SCHEMA
@@ -91,6 +92,7 @@ class IdentifierNode(SchemaNode):
         )
         beam_file = str(values['beam_config'])
         self.beam: BeamParameters = load_beam_config(beam_file or None)[0]
+        self._carried_kg = math.nan  # the last load reading found carried (checked once)
         self.hardware_id = str(values['hardware_id'])
         self.window = SlidingWindow.from_config(self.config)
         self.joints = RestTracker(self.config.rest_tolerance_rad)
@@ -144,6 +146,16 @@ class IdentifierNode(SchemaNode):
     def _on_load(self, msg: Float64) -> None:
         # Float64 has no stamp: the reading only hints at a release, timed from the poses.
         now = self.get_clock().now().nanoseconds * 1e-9
+        kg = float(msg.data)
+        if math.isfinite(kg) and kg >= 0.0 and kg != self._carried_kg:
+            if not carries(self.beam, kg):
+                self.get_logger().warning(
+                    f'/tip_load {msg.data!r} kg rejected: the beam cannot carry it (no static '
+                    'equilibrium); a wrong reading would make its stiffness (B.12)',
+                    throttle_duration_sec=WARN_PERIOD_S,
+                )
+                return
+            self._carried_kg = kg
         stored, stamp = self.window.push_load_on_arrival(msg.data, now)
         if not stored:
             self.get_logger().warning(

@@ -84,7 +84,7 @@ from lumpbeam_ros.core.model.arm.model import ArmModel
 from lumpbeam_ros.core.model.arm.simulate import ArmMotion
 from lumpbeam_ros.core.model.arm.stream import ArmStream
 from lumpbeam_ros.core.model.parameters import EFFECT_PARAMETERS, BeamParameters, load_beam_config
-from lumpbeam_ros.core.model.statics import static_tip_deflection
+from lumpbeam_ros.core.model.statics import carries
 from lumpbeam_ros.core.model.stream import PredictionStream
 from lumpbeam_ros.core.model.trajectory import TipTrajectory
 from lumpbeam_ros.core.vision.config import load_camera_config
@@ -384,7 +384,7 @@ class BeamSimulation:
         if not math.isfinite(kg) or kg < 0.0:
             self.node.warn(f'ignoring /tip_load of {kg!r} kg: not a mass')
             return
-        if not _carries(self.beam, kg):
+        if not carries(self.beam, kg):
             self.node.warn(
                 f'ignoring /tip_load of {kg:g} kg: the beam has no static equilibrium under it '
                 f'(cannot carry it); keeping {self._load_kg:g} kg'
@@ -422,7 +422,7 @@ class BeamSimulation:
             except LumpbeamError as exc:
                 self.node.warn(f'ignoring /beam_params: {exc}')
                 return
-            if not _carries(beam, self._load_kg):
+            if not carries(beam, self._load_kg):
                 self.node.warn(
                     f'ignoring /beam_params: with k_tE={k_total:.6g} N m/rad the beam cannot '
                     f'carry its {self._load_kg:g} kg load'
@@ -652,18 +652,6 @@ class ArmSimulation:
             f'following a command of {command.time_s.size} points from {start:.3f} s '
             f'({command.time_s[-1]:.3f} s long)'
         )
-
-
-def _carries(beam: BeamParameters, load_kg: float) -> bool:
-    """Whether the beam has a static equilibrium under ``load_kg`` at its tip."""
-    try:
-        # A load the floats cannot carry either (1e308 kg) overflows in the solver: that is
-        # a "no", not a numpy warning in the node's log.
-        with np.errstate(over='raise', invalid='raise'):
-            static_tip_deflection(beam, load_kg)
-    except (RuntimeError, ValueError, ArithmeticError):
-        return False
-    return True
 
 
 def _level(status: DiagnosticStatus) -> int:

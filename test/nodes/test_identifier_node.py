@@ -537,3 +537,14 @@ def test_a_malformed_joint_state_never_makes_the_node_an_arm(ros_graph):
     assert node.joints.current is None and node.bad_joint_states == 1
     node._on_joint_state(_joint_state(1.1, [0.1, 0.2]))  # a well-formed one is taken
     assert node.joints.current is not None and node.bad_joint_states == 1
+
+
+@pytest.mark.parametrize('kg', [1e6, 1e300])
+def test_a_load_the_beam_cannot_carry_is_no_reading(ros_graph, capfd, kg):
+    # Read before a release, 1e300 kg once made /beam_params OK with k_tE 8.6e302 (1e6 kg:
+    # 8.6e8), which killed an adopting simulator.
+    node = _identifier(ros_graph)
+    node._on_load(Float64(data=4.5))
+    node._on_load(Float64(data=kg))
+    assert node.window.snapshot().loads.kg.tolist() == [4.5]
+    assert f'/tip_load {kg!r} kg rejected: the beam cannot carry it' in capfd.readouterr().err

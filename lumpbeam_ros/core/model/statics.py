@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from lumpbeam_ros.core.model.chain import LumpedChain
@@ -65,3 +67,21 @@ def static_tip_deflection(beam: BeamParameters, load_kg: float = 0.0) -> float:
     """
     chain = LumpedChain.from_beam(beam, load_kg)
     return float(-chain.tip_pose(static_equilibrium(chain))[1])
+
+
+def carries(beam: BeamParameters, load_kg: float) -> bool:
+    """Whether the beam has a static equilibrium with ``load_kg`` hanging at its tip.
+
+    What a load read from a topic must pass before it reaches a model: a mass the beam cannot
+    carry (or the floats cannot: 1e308 kg) is a wrong reading, not a load.
+    """
+    if not (math.isfinite(load_kg) and load_kg >= 0.0):
+        return False
+    try:
+        # A load the floats cannot carry overflows in the solver: a "no", not a numpy
+        # warning in a node's log.
+        with np.errstate(over='raise', invalid='raise'):
+            static_tip_deflection(beam, load_kg)
+    except (RuntimeError, ValueError, ArithmeticError, np.linalg.LinAlgError):
+        return False
+    return True

@@ -1,3 +1,4 @@
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -5,8 +6,8 @@ import pytest
 
 from lumpbeam_ros.core.model import rules
 from lumpbeam_ros.core.model.chain import LumpedChain
-from lumpbeam_ros.core.model.parameters import BeamParameters, Effects
-from lumpbeam_ros.core.model.statics import static_equilibrium, static_tip_deflection
+from lumpbeam_ros.core.model.parameters import BeamParameters, Effects, load_beam_config
+from lumpbeam_ros.core.model.statics import carries, static_equilibrium, static_tip_deflection
 
 # A stiff beam keeps rotations tiny, so the comparison is with linear Euler-Bernoulli theory.
 STIFF = BeamParameters(stiffness_source='analytic', bending_stiffness_nm2=5e6, tip_mass_kg=0.0)
@@ -65,3 +66,12 @@ def test_a_tilted_clamp_deflects_as_a_cantilever_under_g_cos_tilt(tilt):
         STIFF.mass_kg * g / STIFF.length_m, STIFF.length_m, 5e6
     ) + rules.end_load_deflection(4.5 * g, STIFF.length_m, 5e6)
     assert static_tip_deflection(beam, 4.5) == pytest.approx(expected, rel=0.01)
+
+
+@pytest.mark.parametrize(
+    ('kg', 'carried'),
+    [(0.0, True), (4.5, True), (1000.0, True), (1e4, False), (1e300, False), (-1.0, False),
+     (math.nan, False), (math.inf, False)],
+)  # fmt: skip
+def test_a_load_is_carried_when_the_beam_has_a_static_equilibrium_under_it(kg, carried):
+    assert carries(load_beam_config()[0], kg) is carried
