@@ -30,6 +30,23 @@ DISTORTION_MODELS = {PLUMB_BOB: 5, RATIONAL_POLYNOMIAL: 8, EQUIDISTANT: 4}
 _EYE = np.eye(3)
 
 
+#: The widest or tallest image taken, px: past the largest machine-vision sensors (151 MP,
+#: 14204 x 10652); a 20000 x 20000 frame is 400 MB a copy, and a mistake.
+MAX_IMAGE_SIDE_PX = 16384
+
+
+def check_image_side(width: int, height: int, what: str) -> None:
+    """Refuses an image size past :data:`MAX_IMAGE_SIDE_PX` (or not positive).
+
+    Raises:
+        LumpbeamError: The size, in one line.
+    """
+    if not (0 < width <= MAX_IMAGE_SIDE_PX and 0 < height <= MAX_IMAGE_SIDE_PX):
+        raise LumpbeamError(
+            f'{what}: bad image size {width} x {height} (each side 1 to {MAX_IMAGE_SIDE_PX} px)'
+        )
+
+
 #: The longest focal length taken, in image sizes: ``f = size / (2 tan(fov / 2))`` is 1000
 #: sizes for a field of view of 0.06 degrees, narrower than any lens a rig puts at a tip.
 MAX_FOCAL_IMAGES = 1000.0
@@ -57,8 +74,7 @@ class CameraInfo:
     def __post_init__(self) -> None:
         k = np.asarray(self.k, dtype=float)
         d = np.asarray(self.d, dtype=float).ravel()
-        if self.width <= 0 or self.height <= 0:
-            raise LumpbeamError(f'camera info: bad image size {self.width} x {self.height}')
+        check_image_side(self.width, self.height, 'camera info')
         if k.shape != (3, 3) or not np.all(np.isfinite(k)) or k[0, 0] <= 0 or k[1, 1] <= 0:
             raise LumpbeamError(
                 'camera info: K must be a finite 3x3 matrix with fx, fy > 0 (an uncalibrated '

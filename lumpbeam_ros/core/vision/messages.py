@@ -13,7 +13,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from lumpbeam_ros.base.errors import BagError
+from lumpbeam_ros.base.errors import BagError, LumpbeamError
 from lumpbeam_ros.base.interface import (
     CAMERA_FRAME,
     CAMERA_INFO_TYPE,
@@ -22,7 +22,7 @@ from lumpbeam_ros.base.interface import (
 )
 from lumpbeam_ros.core.bagio import CameraInfoData, convert
 from lumpbeam_ros.core.bagio.typestore import deserialize, prepare
-from lumpbeam_ros.core.vision.camera_model import CameraInfo
+from lumpbeam_ros.core.vision.camera_model import CameraInfo, check_image_side
 from lumpbeam_ros.core.vision.sources.pixels import decode_compressed, tracker_pixels
 
 #: The image message types the tracker reads.
@@ -107,10 +107,15 @@ def decode_image(data: bytes | memoryview) -> CameraFrame:
         The frame; mono16 and Bayer images come out as mono8.
 
     Raises:
-        BagError: Corrupt bytes, an unsupported encoding, or a data size that does not
-            match ``step * height``.
+        BagError: Corrupt bytes, an unsupported encoding, a data size that does not
+            match ``step * height``, or a side past
+            :data:`~lumpbeam_ros.core.vision.camera_model.MAX_IMAGE_SIDE_PX`.
     """
     msg = deserialize(data, IMAGE_TYPE)
+    try:
+        check_image_side(int(msg.width), int(msg.height), 'image')
+    except LumpbeamError as exc:
+        raise BagError(str(exc)) from None
     pixels, encoding = tracker_pixels(convert.image_array(msg), msg.encoding)
     return CameraFrame(convert.time_ns(msg.header.stamp), pixels, encoding, msg.header.frame_id)
 

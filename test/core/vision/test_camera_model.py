@@ -72,6 +72,7 @@ def test_image_size_must_match():
     ('kwargs', 'message'),
     [
         ({'width': 0, 'height': 10, 'k': np.eye(3)}, 'size'),
+        ({'width': 20000, 'height': 20000, 'k': np.eye(3)}, r'each side 1 to 16384 px'),
         ({'width': 10, 'height': 10, 'k': np.eye(2)}, 'K must'),
         ({'width': 10, 'height': 10, 'k': -np.eye(3)}, 'K must'),
         ({'width': 10, 'height': 10, 'k': np.zeros((3, 3))}, 'K = 0'),

@@ -78,8 +78,10 @@ def test_a_bayer_mosaic_of_a_grey_scene_is_that_grey(pattern):
         (image_cdr(GREY[:, :9], 'bgr8'), 'data has|shorter than'),
         (b'\x00\x01\x00\x00\xff', r'corrupt sensor_msgs/msg/Image message \(5 bytes\)'),
         (b'', r'corrupt sensor_msgs/msg/Image message \(0 bytes\)'),
+        # Refused before any copy of its pixels: a 20000 x 20000 frame is 400 MB a copy.
+        (image_cdr(np.zeros((1, 20000), np.uint8), 'mono8'), r'bad image size 20000 x 1'),
     ],
-    ids=['float', 'yuv', 'size-mismatch', 'corrupt', 'empty'],
+    ids=['float', 'yuv', 'size-mismatch', 'corrupt', 'empty', 'too wide'],
 )
 def test_a_bad_image_is_a_bag_error(data, match):
     with pytest.raises(BagError, match=match) as info:
