@@ -6,6 +6,7 @@ __all__ = [
     'estimate',
     'extra_insensitive',
     'impulses',
+    'limits',
     'loop',
     'modes_file',
     'shapers',
