@@ -1,6 +1,7 @@
 """Identification of stiffness, frequency and damping from tip oscillations."""
 
 __all__ = [
+    'arm',
     'assembly',
     'backbone',
     'bag_analysis',
@@ -21,6 +22,6 @@ __all__ = [
     'settings',
     'sinusoid',
     'stiffness',
+    'vetting',
     'window',
-    'arm',
 ]

@@ -53,6 +53,7 @@ from lumpbeam_ros.core.ident.sinusoid import (
     ModeGuess,
     ShiftPrior,
 )
+from lumpbeam_ros.core.ident.vetting import vetted
 from lumpbeam_ros.core.model.parameters import BeamParameters
 
 #: Grid points (after block averaging) the matrix pencil sees at most: 45 s at 90 Hz.
@@ -118,13 +119,19 @@ def identify_from(
             ``None``: the load release found in the window.
 
     Returns:
-        The identification and the state for the next call (``None`` after an ERROR).
+        The identification, vetted (:func:`~lumpbeam_ros.core.ident.vetting.vetted`), and
+        the state for the next call (``None`` after an ERROR).
 
     Raises:
         LumpbeamError: As for :func:`identify`.
     """
     with single_threaded_blas():
-        return _identify(window, beam, config or IdentifierConfig(), strict, previous, release)
+        result, state = _identify(
+            window, beam, config or IdentifierConfig(), strict, previous, release
+        )
+    published = vetted(result)
+    # A warm start that went wrong is not built on: the next window starts afresh.
+    return published, state if published.status == result.status else None
 
 
 def identify_live(
