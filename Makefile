@@ -64,11 +64,12 @@ test-slow: dev
 # The fuzz campaign at length: random damage to product-written bags through the readers,
 # doctor, repair, analyze, diagnose and track, spoiled /tip_pose and /tip_load streams through
 # analyze and diagnose (test/core/bagio/test_fuzz.py), and random messages into the nodes'
-# callbacks (test/nodes/test_fuzz_callbacks.py). make test runs them at 200 cases.
+# callbacks (test/nodes/test_fuzz_callbacks.py) and property-based ones on their topics
+# (test/nodes/test_fuzz_topics.py, hypothesis). make test runs them at 200 cases.
 FUZZ_CASES ?= 5000
 fuzz: dev
 	LUMPBEAM_FUZZ_CASES=$(FUZZ_CASES) $(BIN)/python -m pytest test/core/bagio/test_fuzz.py \
-		test/nodes/test_fuzz_callbacks.py -n0 -q -p no:logging -s
+		test/nodes/test_fuzz_callbacks.py test/nodes/test_fuzz_topics.py -n0 -q -p no:logging -s
 
 lint: dev
 	$(BIN)/ruff check .
