@@ -182,6 +182,8 @@ def test_bad_trajectories_are_dropped(ros_graph, command):
         ({'damping_ratio': 1.0}, ConfigError, 'damping_ratio: must be in [0, 1)'),
         ({'shaper': 'zvdd'}, ConfigError, 'shaper: must be one of'),
         ({'source': 'model'}, ConfigError, 'arm_config: needed with source model'),
+        ({'max_added_s': 0.0}, ConfigError, 'max_added_s: must be'),
+        ({'max_command_s': -1.0}, ConfigError, 'max_command_s: must be'),
         ({'source': 'model', 'arm_config': 'missing.yaml'}, ConfigError, 'missing.yaml'),
         (
             {'source': 'parameters', 'shaper': 'ei', 'damping_ratio': 0.7},

@@ -22,7 +22,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import TracebackType
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -148,29 +148,43 @@ class ArmGraph:
         return readers
 
 
-def run_arm_graph(
-    spec: ArmGraph,
-    log_dir: Path,
-    bag: Path,
-    domain_id: int | None,
-    ready_timeout_s: float,
-    drive: Callable[[ArmDriver], None],
-    echo: Callable[[str], None],
-) -> None:
+class ArmRunOptions(Protocol):
+    """What an arm demo's options say about its graph."""
+
+    @property
+    def domain_id(self) -> int | None:
+        """ROS domain; when ``None``, a free one."""
+
+    @property
+    def ready_timeout_s(self) -> float:
+        """Longest wait for the nodes to join the graph, s."""
+
+
+class ArmRun(Protocol):
+    """What an arm demo's run gives its graph (``ArmDemoRun``, ``WorkspaceDemoRun``)."""
+
+    options: ArmRunOptions
+    recorded_bag: Path
+    echo: Callable[[str], None]
+
+    @property
+    def log_dir(self) -> Path:
+        """The children's logs."""
+
+
+def run_arm_graph(spec: ArmGraph, run: ArmRun, drive: Callable[[ArmDriver], None]) -> None:
     """Starts the graph, lets ``drive`` command it, stops it and closes the recording.
 
     Args:
         spec: The nodes' parameters.
-        log_dir: The children's logs.
-        bag: The recording to write.
-        domain_id: ROS domain; when ``None``, a free one.
-        ready_timeout_s: Longest wait for the nodes to join the graph, s.
+        run: The demo's run: its domain, logs, recording (``recorded_bag``) and echo.
         drive: What the demo commands, with a ready driver.
-        echo: Where progress lines go.
 
     Raises:
         LumpbeamError: The graph did not start, ``drive`` failed, or a child exited.
     """
+    log_dir, bag, echo = run.log_dir, run.recorded_bag, run.echo
+    domain_id, ready_timeout_s = run.options.domain_id, run.options.ready_timeout_s
     follow = ('-p', f'arm_commands:={JOINT_TRAJECTORY_SHAPED}')
     real_arm = (
         *follow,

@@ -137,15 +137,7 @@ def loop(run: ArmDemoRun) -> None:
         recorded={BEAM_PARAMS: DIAGNOSTIC_ARRAY},
         readers={BEAM_PARAMS: 1},  # the shaper
     )
-    run_arm_graph(
-        spec,
-        run.log_dir,
-        run.recorded_bag,
-        run.options.domain_id,
-        run.options.ready_timeout_s,
-        lambda driver: _drive(driver, run),
-        run.echo,
-    )
+    run_arm_graph(spec, run, lambda driver: _drive(driver, run))
 
 
 def _drive(driver: ArmDriver, run: ArmDemoRun) -> None:

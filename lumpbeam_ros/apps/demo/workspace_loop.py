@@ -282,15 +282,7 @@ def loop(run: WorkspaceDemoRun) -> None:
         recorded={ARM_PARAMS: DIAGNOSTIC_ARRAY, BEAM_PARAMS: DIAGNOSTIC_ARRAY},
         readers={ARM_PARAMS: 2},  # the shaper, the model
     )
-    run_arm_graph(
-        spec,
-        run.log_dir,
-        run.recorded_bag,
-        run.options.domain_id,
-        run.options.ready_timeout_s,
-        lambda driver: _drive(driver, run),
-        run.echo,
-    )
+    run_arm_graph(spec, run, lambda driver: _drive(driver, run))
 
 
 def _drive(driver: ArmDriver, run: WorkspaceDemoRun) -> None:
