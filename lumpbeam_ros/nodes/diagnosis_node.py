@@ -121,14 +121,17 @@ class DiagnosisNode(SchemaNode):
         self.adoption = 'not asked'  # what became of the last adoption, for the status
         self._problem: str | None = None  # why the last stretch was not diagnosed
         self._running: tuple[Stretch, float, AsyncResult[LiveDiagnosis]] | None = None
+        # The time line (count of clock resets) self.last was first published on.
+        self._verdict_line = 0
         self._pool = self._make_pool(values['worker'])
         # Not `_parameters`: that is rclpy's own table of this node's parameters.
         self._simulator_parameters = AsyncParameterClient(self, values[SIMULATOR_NODE])
 
         self._output = publisher(self, DiagnosticArray, MODEL_DISCREPANCY)
-        subscription(self, PoseStamped, TIP_POSE, self._on_pose)
+        # Two-argument callbacks: rclpy passes each message's info (its source timestamp).
+        subscription(self, PoseStamped, TIP_POSE, lambda msg, info: self._on_pose(msg, info))
         subscription(self, PoseStamped, TIP_POSE_PREDICTED, self._on_predicted)
-        subscription(self, Float64, TIP_LOAD, self._on_load)
+        subscription(self, Float64, TIP_LOAD, lambda msg, info: self._on_load(msg, info))
         #: Statuses published on ``/model_discrepancy``.
         self.published = 0
         self._heard = False  # any input yet
@@ -170,10 +173,13 @@ class DiagnosisNode(SchemaNode):
             return None
         return stamp_ns * 1e-9, z, pitch
 
-    def _on_pose(self, msg: PoseStamped) -> None:
+    def _on_pose(self, msg: PoseStamped, info: Mapping[str, int] | None = None) -> None:
         self._heard = True
         pose = self._pose(msg, TIP_POSE)
-        if pose is not None and not self.buffer.push_measured(*pose):
+        if pose is None:
+            return
+        stored = self.buffer.push_measured(*pose, sent_s=self._sent_s(info))
+        if not stored and not self.buffer.measured.holding:
             late = self.buffer.measured.counts
             self.get_logger().warning(
                 f'/tip_pose with a repeated or out-of-order stamp: dropped '
@@ -187,7 +193,7 @@ class DiagnosisNode(SchemaNode):
         if pose is not None:
             self.buffer.push_predicted(*pose)
 
-    def _on_load(self, msg: Float64) -> None:
+    def _on_load(self, msg: Float64, info: Mapping[str, int] | None = None) -> None:
         self._heard = True
         kg = float(msg.data)
         if not math.isfinite(kg) or kg < 0.0:
@@ -195,8 +201,21 @@ class DiagnosisNode(SchemaNode):
                 f'/tip_load {kg!r} rejected: not a mass', throttle_duration_sec=WARN_PERIOD_S
             )
             return
-        # Float64 has no stamp: the change is dated by the node's clock (sim time on a bag).
-        self.buffer.push_load(self.get_clock().now().nanoseconds * 1e-9, kg)
+        # Float64 has no stamp: the buffer dates the change by when it was sent.
+        self.buffer.push_load(self._sent_s(info), kg)
+
+    def _sent_s(self, info: Mapping[str, int] | None) -> float:
+        """When a message was sent, on the clock that dates the load changes.
+
+        On ``/clock`` (a bag played at any rate), the node's clock at its arrival. On wall
+        time, its DDS source timestamp (the sender's wall clock, free of the executor's
+        delays), else the node's clock.
+        """
+        clock = self.get_clock()
+        sent_ns = (info or {}).get('source_timestamp', 0)
+        if sent_ns > 0 and not clock.ros_time_is_active:
+            return sent_ns * 1e-9
+        return float(clock.now().nanoseconds) * 1e-9
 
     def _on_change(self, changes: Mapping[str, Any]) -> str | None:
         if 'adopt' in changes:
@@ -241,7 +260,7 @@ class DiagnosisNode(SchemaNode):
             self._publish_status()
             return
         self.diagnoses += 1
-        self.last, self._problem = result, None
+        self.last, self._problem, self._verdict_line = result, None, self._time_line()
         names = ','.join(name for name, _ in result.missing_effects) or result.missing_effect
         self.get_logger().info(
             f'diagnosis: {names} {result.effect_parameters}; gap rms '
@@ -311,6 +330,10 @@ class DiagnosisNode(SchemaNode):
 
     # -- output -------------------------------------------------------------------------------
 
+    def _time_line(self) -> int:
+        """Which time line the stream is on: the times its clock went back."""
+        return self.buffer.measured.counts.resets
+
     def _late(self) -> int:
         """Measured poses dropped for a repeated stamp or one before the newest."""
         counts = self.buffer.measured.counts
@@ -339,6 +362,13 @@ class DiagnosisNode(SchemaNode):
         elif self.last is not None:
             level, message, pairs = status_values(self.last)
             pairs = [*pairs, ('adoption', self.adoption)]
+            if self._verdict_line != self._time_line():
+                # Repeated as new it would vouch for data the node no longer has.
+                level = STALE
+                message = (
+                    'the clock went back since the last diagnosis, waiting for the next '
+                    f'ring-down (last: {message})'
+                )
         else:
             waiting = 'a load change' if not self.buffer.loads[1:] else 'the ring-down to end'
             if self._running is not None:

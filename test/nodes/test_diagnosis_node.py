@@ -225,6 +225,21 @@ def test_repeated_and_late_poses_are_counted_not_dropped_silently(ros_graph):
         node._on_pose(_pose(t, -0.07, 0.04))
     assert node.buffer.measured_count == 3
     assert _values(node.status())['samples_out_of_order'] == '2'
-    node._on_pose(_pose(1.2 - 1000.0, -0.07, 0.04))  # a loop back beyond keep_s: starts over
-    assert node.buffer.measured.counts.resets == 1 and len(node.buffer.measured) == 1
+    node._on_pose(_pose(1.2 - 1000.0, -0.07, 0.04))  # a loop back, once the next pose agrees
+    node._on_pose(_pose(1.21 - 1000.0, -0.07, 0.04))
+    assert node.buffer.measured.counts.resets == 1 and len(node.buffer.measured) == 2
     assert _values(node.status())['samples_out_of_order'] == '2'
+
+
+def test_a_verdict_from_before_the_clock_went_back_is_repeated_as_stale_not_as_new(ros_graph):
+    node = _start(ros_graph)
+    node._on_load(Float64(data=4.5))
+    for t in (10.0, 10.01, 10.02):
+        node._on_pose(_pose(t, -0.07, 0.04))
+    node.last = _found(2e-5)
+    assert node.status().level == bytes([1])  # WARN: the latency found
+    for t in (0.0, 0.01):  # the bag looped
+        node._on_pose(_pose(t, -0.07, 0.04))
+    status = node.status()
+    assert status.level == bytes([3]) and status.message.startswith('the clock went back')
+    assert _values(status)['missing_effect'] == 'sensor_latency'  # what it was, still said

@@ -7,9 +7,15 @@ every pose pushed:
 
 - a NaN or inf stamp, z or pitch is dropped and counted ``non_finite``;
 - a stamp equal to the newest one is dropped and counted ``duplicates``;
-- a stamp before the newest one is dropped and counted ``out_of_order``, unless it is more
-  than ``reset_jump_back_s`` before it: then the clock jumped back (a bag looping), the
-  buffer is emptied, counted in ``resets``, and the pose starts it again.
+- a stamp before the newest one is dropped and counted ``out_of_order``;
+- a stamp more than ``reset_jump_back_s`` before the newest one, or as far after it, is a
+  *jump*, and one pose cannot tell a jump of the clock from a corrupt stamp: it is held
+  until the next pose says which. A next pose nearer the held one than the newest stored
+  confirms the jump (back: a bag looping; the buffer is emptied, counted in ``resets``, and
+  the held pose starts it again; ahead: a pause in the stream); one nearer the newest stored
+  says the held stamp was an outlier, dropped and counted ``out_of_order``. So a single
+  stamp from the far future or past neither empties the buffer nor blinds it to the poses
+  after it.
 
 Nothing is dropped without a count, and the counts can be had for any stretch of the
 buffer (:meth:`TipBuffer.between`): each stored pose remembers how many had been dropped
@@ -65,6 +71,8 @@ class TipBuffer:
         self._totals = {'non_finite': 0, 'duplicates': 0, 'out_of_order': 0, 'resets': 0}
         self._received = 0
         self._cleared_at = (0, 0)  # the drop totals when the buffer was last emptied
+        # A pose whose stamp jumped, until the next pose says whether the clock did.
+        self._held: tuple[float, float, float, float] | None = None
 
     def __len__(self) -> int:
         return self._size
@@ -107,7 +115,13 @@ class TipBuffer:
         self._head = 0
         self._size = 0
         self._last = -math.inf
+        self._held = None
         self._cleared_at = self._drops()
+
+    @property
+    def holding(self) -> bool:
+        """Whether a pose whose stamp jumped waits for the next one to confirm it."""
+        return self._held is not None
 
     def push(self, stamp: float, z: float, pitch: float = 0.0, x: float = math.nan) -> bool:
         """Adds one tip pose, or counts why not (the module's rule).
@@ -120,22 +134,34 @@ class TipBuffer:
                 it, so a non-finite x does not drop the pose.
 
         Returns:
-            Whether the pose was stored.
+            Whether the pose was stored (``False`` for one held until the next pose).
         """
         self._received += 1
         if not (math.isfinite(stamp) and math.isfinite(z) and math.isfinite(pitch)):
             self._totals['non_finite'] += 1
             return False
-        if stamp <= self._last:
-            if stamp < self._last - self.reset_jump_back_s:
-                self._totals['resets'] += 1
-                self.clear()
-            elif stamp == self._last:
-                self._totals['duplicates'] += 1
-                return False
+        held, self._held = self._held, None
+        if held is not None:
+            if abs(stamp - held[0]) < abs(stamp - self._last):
+                if held[0] < self._last:
+                    self._totals['resets'] += 1
+                    self.clear()
+                self._store(*held)
             else:
                 self._totals['out_of_order'] += 1
-                return False
+        if abs(stamp - self._last) > self.reset_jump_back_s and self._size:
+            self._held = (stamp, x, z, pitch)
+            return False
+        if stamp == self._last:
+            self._totals['duplicates'] += 1
+            return False
+        if stamp < self._last:
+            self._totals['out_of_order'] += 1
+            return False
+        self._store(stamp, x, z, pitch)
+        return True
+
+    def _store(self, stamp: float, x: float, z: float, pitch: float) -> None:
         i = self._head
         for name, value in zip(_FLOATS, (stamp, x, z, pitch), strict=True):
             self._columns[name][i] = value
@@ -143,7 +169,6 @@ class TipBuffer:
         self._head = (i + 1) % self._capacity
         self._size = min(self._size + 1, self._capacity)
         self._last = stamp
-        return True
 
     def latest(self) -> tuple[TipSeries, SampleCounts]:
         """The poses of the newest ``keep_s`` seconds, oldest first, and their counts."""

@@ -16,6 +16,7 @@ turns that into the status level, message and key-value pairs of ``doc/interface
 from __future__ import annotations
 
 import math
+from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -44,6 +45,10 @@ OK, WARN, ERROR, STALE = 0, 1, 2, 3
 
 #: The amplitude of a ring-down is measured over this last stretch of it, s.
 AMPLITUDE_SPAN_S = 0.5
+#: A load reading is dated through the poses of this last stretch, s ...
+DATING_SPAN_S = 1.0
+#: ... at most this many of them.
+DATING_POSES = 400
 
 
 @dataclass(frozen=True)
@@ -57,8 +62,10 @@ class LiveDiagnosisConfig:
         min_amplitude_m: ... or earlier, once the peak-to-peak tip z over the last
             ``AMPLITUDE_SPAN_S`` falls below twice this (0: never).
         window_s: Length of a fixed window, s.
-        keep_s: The buffers hold this much of the latest data, s; a stamp this far before
-            the newest one is the clock going back (a looping bag): everything starts over.
+        keep_s: The buffers hold this much of the latest data, s.
+        reset_jump_back_s: A pose stamped this far before the newest one, and confirmed by
+            the pose after it, is the clock going back (a looping bag): the stream starts
+            over (:class:`~lumpbeam_ros.core.bagio.tipbuffer.TipBuffer`).
         max_rate_hz: Highest pose rate the buffers are sized for; faster input shortens
             what they hold.
     """
@@ -103,6 +110,14 @@ class LiveDiagnosisConfig:
         's',
         Bounds(5.0, 3600.0),
     )
+    reset_jump_back_s: float = setting(
+        'reset_jump_back_s',
+        1.0,
+        'a pose stamped this far before the newest one (and the pose after it) is the clock '
+        'going back, a looping bag: the node starts over on the new time line',
+        's',
+        Bounds(0.0, 3600.0, low_open=True),
+    )
     # Not a parameter: the buffers are sized as the identifier's window is.
     max_rate_hz: float = IdentifierConfig.max_rate_hz
 
@@ -115,11 +130,14 @@ class Stretch:
         start_s: First stamp, s.
         end_s: Last stamp, s.
         release_s: The load change it follows (NaN for a window without one).
+        release_uncertainty_s: How early the load change may be dated, s: the spread of the
+            poses' sending against their stamps, when the change was dated through them.
     """
 
     start_s: float
     end_s: float
     release_s: float
+    release_uncertainty_s: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -194,6 +212,9 @@ def named_effects(result: Any) -> tuple[tuple[str, dict[str, float]], ...]:
 def diagnose_live(record: Record, beam: BeamParameters, stretch: Stretch) -> LiveDiagnosis:
     """Runs the offline workflow on one stretch (in a worker: it takes seconds).
 
+    A sensor latency no longer than the release's dating uncertainty is not named: the
+    verdict is ``none``, saying why (the gaps are the workflow's).
+
     Args:
         record: The stretch as a record.
         beam: The nominal beam.
@@ -209,12 +230,22 @@ def diagnose_live(record: Record, beam: BeamParameters, stretch: Stretch) -> Liv
 
     start = time.perf_counter()
     result = diagnose(record, beam)
+    named, reason = named_effects(result), result.decision.reason
+    missing = result.missing_effect
+    latency = dict(named).get('sensor_latency', {}).get('latency_s', math.nan)
+    if len(named) == 1 and 0.0 <= latency <= stretch.release_uncertainty_s:
+        # Dated up to that much late, the release alone can show such a delay.
+        missing, named = 'none', ()
+        reason = (
+            f'the delay found, {latency * 1e3:.2f} ms, is within how late the release may be '
+            f'dated ({stretch.release_uncertainty_s * 1e3:.2f} ms: /tip_load has no stamp)'
+        )
     return LiveDiagnosis(
-        missing_effect=result.missing_effect,
-        missing_effects=named_effects(result),
+        missing_effect=missing,
+        missing_effects=named,
         gap_before_rms_m=float(result.gap_before.rms_m),
         gap_after_rms_m=float(result.gap_after.rms_m),
-        reason=result.decision.reason,
+        reason=reason,
         stretch=stretch,
         seconds=time.perf_counter() - start,
         samples=record.counts,
@@ -275,22 +306,35 @@ class LiveBuffer:
         self.predicted_count = 0
         self.measured_count = 0
         self._done_until = -math.inf  # stretches ending here or before were handed out
+        # The recent measured poses' stamps, and when they were sent minus their stamps, s.
+        self._sent_after_stamp: deque[tuple[float, float]] = deque(maxlen=DATING_POSES)
+        self._dating_s: dict[float, float] = {}  # a load change's time: its uncertainty
 
     def _buffer(self) -> TipBuffer:
         """A buffer of ``keep_s``; a stamp that far back is the clock going back."""
         s = self.settings
-        return TipBuffer(s.keep_s, s.max_rate_hz, s.keep_s)
+        return TipBuffer(s.keep_s, s.max_rate_hz, s.reset_jump_back_s)
 
     @property
     def latest_s(self) -> float:
         """The newest measured stamp (NaN before the first)."""
         return self.measured.newest_s if len(self.measured) else math.nan
 
-    def push_measured(self, t: float, z: float, pitch: float) -> bool:
+    def push_measured(self, t: float, z: float, pitch: float, sent_s: float = math.nan) -> bool:
         """Adds a measured pose, or counts why not (:class:`~.tipbuffer.TipBuffer`).
 
-        A clock that jumped back by ``keep_s`` or more (a looping bag) starts everything
-        over: the prediction and the loads belong to the old time line.
+        A clock that jumped back (a looping bag) starts the stream over: the prediction and
+        the stretches belong to the old time line, and so do the load readings dated after
+        the new line's first pose; the mass hanging then is kept (the last reading of the
+        old line when the new one has none, as the identifier keeps it).
+
+        Args:
+            t: Header stamp, s.
+            z: Tip z, m.
+            pitch: Tip pitch, rad.
+            sent_s: When the pose was sent (its DDS source timestamp, or the node's clock at
+                its arrival), s; NaN: unknown. It dates the load readings on the poses' time
+                line (:meth:`push_load`).
 
         Returns:
             Whether the pose was stored.
@@ -298,9 +342,15 @@ class LiveBuffer:
         resets = self.measured.counts.resets
         stored = self.measured.push(t, z, pitch)
         if self.measured.counts.resets != resets:
+            first = self.measured.oldest_s
+            kept = [(when, kg) for when, kg in self.loads if when <= first]
+            if not kept and self.loads:
+                kept = [(first, self.loads[-1][1])]
+            self.loads[:] = kept
             self.predicted = self._buffer()
-            self.loads.clear()
             self._done_until = -math.inf
+        if stored and math.isfinite(sent_s):
+            self._sent_after_stamp.append((t, sent_s - t))
         self.measured_count += stored
         return stored
 
@@ -310,12 +360,42 @@ class LiveBuffer:
         self.predicted_count += stored
         return stored
 
-    def push_load(self, t: float, kg: float) -> None:
-        """Adds a ``/tip_load`` reading at its arrival time (Float64 has no stamp)."""
-        if self.loads and t < self.loads[-1][0]:
+    def push_load(self, sent_s: float, kg: float) -> None:
+        """Adds a ``/tip_load`` reading (``Float64`` has no stamp), dated by when it was sent.
+
+        It is dated on the poses' time line: by ``sent_s`` itself when the poses' stamps are
+        on the same clock (a live camera, or a bag played with ``/clock`` and dated by it);
+        else (a bag played on wall time, or poses and load both sent by a player) by the
+        newest pose's stamp plus the time between the two were sent. Dated by their DDS
+        source timestamps, a player's load and poses keep the spacing of the bag, whatever
+        the executor's order; a release dated a millisecond off is a latency to a diagnosis.
+        A reading before any pose is the load hanging from the start.
+
+        Args:
+            sent_s: When the reading was sent (as ``sent_s`` of :meth:`push_measured`), s.
+            kg: Mass at the tip, kg.
+        """
+        recent = self.latest_s - DATING_SPAN_S
+        offsets = [ahead for t, ahead in self._sent_after_stamp if t >= recent]
+        # Through the pose sent latest for its stamp, a load is dated no later than it was
+        # due: a release dated late would show as a negative delay, which no sensor has.
+        ahead = max(offsets) if offsets else math.nan
+        uncertainty = 0.0
+        if not self.measured_count:
+            t = -math.inf
+        elif math.isfinite(ahead) and abs(ahead) > self.settings.reset_jump_back_s:
+            t, uncertainty = sent_s - ahead, ahead - min(offsets)
+        else:
+            t = sent_s
+        if self.loads and (t < self.loads[-1][0] or t == -math.inf):
             self.loads.clear()
         if not self.loads or kg != self.loads[-1][1]:
             self.loads.append((t, kg))
+            self._dating_s[t] = uncertainty
+        # The reading in force keep_s before the newest pose is the oldest one needed.
+        while len(self.loads) > 1 and self.loads[1][0] <= self.latest_s - self.settings.keep_s:
+            del self.loads[0]
+        self._dating_s = {when: self._dating_s.get(when, 0.0) for when, _ in self.loads}
 
     def clear(self) -> None:
         """Forgets everything (the clock went back); the counts are kept."""
@@ -323,6 +403,7 @@ class LiveBuffer:
         self.predicted = self._buffer()
         self.loads.clear()
         self._done_until = -math.inf
+        self._sent_after_stamp.clear()
 
     def missing_input(self) -> str | None:
         """What the diagnosis lacks to start, in words (``None``: nothing)."""
@@ -363,7 +444,8 @@ class LiveBuffer:
             if ring_down_end is None:
                 return None
             self._done_until = ring_down_end
-            return Stretch(release - s.pre_release_s, ring_down_end, release)
+            uncertainty = self._dating_s.get(release, 0.0)
+            return Stretch(release - s.pre_release_s, ring_down_end, release, uncertainty)
         return None
 
     def _ring_down_end(self, release: float, latest: float) -> float | None:

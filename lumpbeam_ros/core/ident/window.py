@@ -99,7 +99,7 @@ class SlidingWindow:
         stored = self.poses.push(stamp, z, pitch, x)
         if self.poses.counts.resets != resets:
             kept = self._load_kg[-1:]
-            self._load_t[:] = [stamp for _ in kept]
+            self._load_t[:] = [self.poses.oldest_s for _ in kept]
             self._load_kg[:] = kept
         return stored
 

@@ -26,14 +26,37 @@ def test_every_dropped_pose_is_counted_by_its_kind(stamp, z, pitch, kind):
     assert len(buffer) == 1
 
 
-def test_a_jump_back_empties_the_buffer_and_is_counted():
+def test_a_jump_back_the_next_pose_confirms_empties_the_buffer_and_is_counted():
     buffer = TipBuffer(keep_s=10.0, max_rate_hz=10.0, reset_jump_back_s=1.0)
     for stamp in (5.0, 6.0, 7.0):
         buffer.push(stamp, 1.0)
-    assert buffer.push(5.5, 2.0)  # 1.5 s back: a loop, not a late pose
-    assert buffer.counts.resets == 1 and len(buffer) == 1 and buffer.newest_s == 5.5
+    assert not buffer.push(5.5, 2.0)  # 1.5 s back: a loop or a corrupt stamp, held
+    assert buffer.holding and len(buffer) == 3 and buffer.counts.resets == 0
+    assert buffer.push(5.6, 3.0)  # nearer the held pose: the clock went back
+    assert buffer.counts.resets == 1 and len(buffer) == 2 and buffer.newest_s == 5.6
     poses, counts = buffer.latest()
-    assert poses.z.tolist() == [2.0] and counts == SampleCounts(received=1)
+    assert poses.z.tolist() == [2.0, 3.0] and counts == SampleCounts(received=2)
+
+
+@pytest.mark.parametrize('outlier', [7.0 + 163.0, 7.0 - 1000.0, 1e18])
+def test_one_stamp_far_off_the_time_line_is_dropped_and_blinds_nothing(outlier):
+    buffer = TipBuffer(keep_s=10.0, max_rate_hz=10.0, reset_jump_back_s=1.0)
+    for stamp in (5.0, 6.0, 7.0):
+        buffer.push(stamp, 1.0)
+    assert not buffer.push(outlier, 9.0)
+    assert buffer.push(7.1, 1.0)  # nearer the time line: the held stamp was an outlier
+    assert buffer.push(7.2, 1.0)
+    assert not buffer.holding and buffer.counts.resets == 0
+    assert buffer.t.tolist() == [5.0, 6.0, 7.0, 7.1, 7.2] and 9.0 not in buffer.z
+    assert buffer.counts.out_of_order == 1
+
+
+def test_a_stream_that_pauses_resumes_after_its_first_pose():
+    buffer = TipBuffer(keep_s=100.0, max_rate_hz=10.0, reset_jump_back_s=1.0)
+    for stamp in (0.0, 0.1, 5.0, 5.1, 10.0, 15.0):  # a pause, then two slow poses
+        buffer.push(stamp, 1.0)
+    assert buffer.t.tolist() == [0.0, 0.1, 5.0, 5.1, 10.0] and buffer.holding
+    assert buffer.counts.dropped == 0
 
 
 def test_a_stretch_counts_what_was_dropped_while_its_poses_arrived():

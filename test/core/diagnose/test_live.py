@@ -10,6 +10,7 @@ import pytest
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.core.bagio.tipseries import SampleCounts
 from lumpbeam_ros.core.diagnose.live import (
+    DATING_SPAN_S,
     ERROR,
     OK,
     WARN,
@@ -200,3 +201,91 @@ def test_late_and_repeated_poses_are_counted_in_the_stretch_record():
     record = buffer.record(buffer.next_stretch())
     assert record.counts.duplicates == len(record) and record.counts.untrusted
     assert buffer.measured.counts.out_of_order == t.size
+
+
+def _played(settings, t, z, pitch, *, passes=1, clock_ahead_s=0.0, odd=None, late_s=None):
+    """Plays the stream as a player does, ``passes`` times (a looping bag), polled per pose.
+
+    The loads are sent at their stamps on the node's clock, ``clock_ahead_s`` after the
+    poses' time line (0: /clock; a bag played on wall time: its age); ``odd`` is one
+    ``(index, stamp)`` pose of a corrupt stamp sent in each pass; ``late_s(i)`` how late the
+    player sends message ``i`` (the load: ``-1``).
+    """
+    buffer, found = LiveBuffer(settings), []
+    for _ in range(passes):
+        pending = [(0.0, 4.5), (RELEASE_S, 0.0)]
+        for i, (ti, zi, pi) in enumerate(zip(t, z, pitch, strict=True)):
+            clock_s = float(ti) + clock_ahead_s + (late_s(i) if late_s else 0.0)
+            while pending and pending[0][0] <= ti:
+                when, kg = pending.pop(0)
+                buffer.push_load(when + clock_ahead_s + (late_s(-1) if late_s else 0.0), kg)
+            if odd is not None and i == odd[0]:
+                buffer.push_measured(odd[1], 1.0, 0.0, sent_s=clock_s)
+            buffer.push_measured(float(ti), float(zi), float(pi), sent_s=clock_s)
+            stretch = buffer.next_stretch()
+            if stretch is not None:
+                found.append((stretch, buffer.record(stretch)))
+    return buffer, found
+
+
+SETTINGS = LiveDiagnosisConfig(pre_release_s=1.0, decay_s=2.3)
+EXPECTED = Stretch(RELEASE_S - 1.0, RELEASE_S + 2.3, RELEASE_S)
+
+
+def test_a_looping_bag_gives_every_pass_its_ring_down():
+    _, _, t, z, pitch = _stream()
+    buffer, found = _played(SETTINGS, t, z, pitch, passes=5)
+    assert [stretch for stretch, _ in found] == [EXPECTED] * 5
+    assert buffer.measured.counts.resets == 4
+    assert all(r.initial_load_kg == 4.5 and r.load_events == ((2.0, 0.0),) for _, r in found)
+    assert all(np.array_equal(r.z, found[0][1].z) for _, r in found)
+
+
+@pytest.mark.parametrize('stamp', [RELEASE_S + 1.0 + 163.0, -1e6, 1e12])
+def test_one_stamp_far_off_during_a_ring_down_loses_nothing(stamp):
+    _, _, t, z, pitch = _stream()
+    index = int(np.searchsorted(t, RELEASE_S + 1.0))
+    buffer, found = _played(SETTINGS, t, z, pitch, odd=(index, stamp))
+    _, clean = _played(SETTINGS, t, z, pitch)
+    assert [stretch for stretch, _ in found] == [EXPECTED]
+    assert np.array_equal(found[0][1].z, clean[0][1].z)
+    assert buffer.measured.counts.out_of_order == 1 and buffer.measured.counts.resets == 0
+
+
+@pytest.mark.parametrize('ahead_s', [0.004, 86400.0 * 365, -3600.0])
+def test_loads_are_dated_on_the_poses_time_line_whatever_the_clock(ahead_s):
+    # A bag played on wall time: the node's clock is the bag's age ahead of the stamps.
+    _, _, t, z, pitch = _stream()
+    _, found = _played(SETTINGS, t, z, pitch, clock_ahead_s=ahead_s, passes=2)
+    assert len(found) == 2
+    for stretch, record in found:
+        ((release, kg),) = record.load_events
+        # By the clock when it agrees with the stamps, else on the stamps' own time line.
+        dated = RELEASE_S + (ahead_s if abs(ahead_s) < SETTINGS.reset_jump_back_s else 0.0)
+        assert kg == 0.0 and release == pytest.approx(dated, abs=1e-6)
+        assert stretch.release_s == release
+
+
+def test_a_release_dated_through_a_jittery_player_says_how_late_it_may_be():
+    _, _, t, z, pitch = _stream()
+    rng = np.random.default_rng(1)
+    lateness = rng.uniform(0.0, 3e-3, t.size)
+    _, found = _played(SETTINGS, t, z, pitch, clock_ahead_s=3600.0, late_s=lambda i: lateness[i])
+    ((stretch, _),) = found
+    window = lateness[(t >= t[t < RELEASE_S][-1] - DATING_SPAN_S) & (t < RELEASE_S)]
+    assert stretch.release_uncertainty_s == pytest.approx(np.ptp(window), abs=1e-6)
+    early = RELEASE_S - stretch.release_s  # never late: that would be a negative delay
+    assert -1e-9 <= early <= stretch.release_uncertainty_s
+
+
+@pytest.mark.parametrize(('uncertainty_s', 'verdict'), [(0.0, 'sensor_latency'), (2e-3, 'none')])
+def test_a_latency_within_the_release_dating_is_not_named(uncertainty_s, verdict):
+    beam, _, t, z, pitch = _stream()
+    early = 1e-3  # the release dated a millisecond early: the tip seems to follow late
+    loads = ((0.0, 4.5), (RELEASE_S - early, 0.0))
+    buffer = _filled(LiveDiagnosisConfig(decay_s=2.3), t, z, pitch, loads=loads)
+    stretch = dataclasses.replace(buffer.next_stretch(), release_uncertainty_s=uncertainty_s)
+    result = diagnose_live(buffer.record(stretch), beam, stretch)
+    assert result.missing_effect == verdict
+    if verdict == 'none':
+        assert result.reason.startswith('the delay found, 1.0') and 'no stamp' in result.reason

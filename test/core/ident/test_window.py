@@ -50,11 +50,12 @@ def test_clock_jumping_back_resets():
     for stamp in range(5, 10):
         w.push(float(stamp), 1.0)
     w.push_load(9.0, 4.5)
-    assert w.push(0.0, 2.0)  # a bag loop
-    assert w.counts.resets == 1 and len(w) == 1
+    assert not w.push(0.0, 2.0)  # a bag loop, once the next pose agrees
+    assert w.push(0.1, 3.0)
+    assert w.counts.resets == 1 and len(w) == 2
     snap = w.snapshot()
     # The load still hangs after the jump: its last reading holds from the new stamp on.
-    assert snap.z.tolist() == [2.0]
+    assert snap.z.tolist() == [2.0, 3.0]
     assert snap.loads.t.tolist() == [0.0] and snap.loads.kg.tolist() == [4.5]
 
 
