@@ -64,7 +64,11 @@ from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
 from lumpbeam_ros.nodes.params.shaper_params import SHAPER_SCHEMA
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
-from lumpbeam_ros.nodes.trajectory_messages import trajectory_from_msg, trajectory_msg
+from lumpbeam_ros.nodes.trajectory_messages import (
+    command_subscription,
+    trajectory_from_msg,
+    trajectory_msg,
+)
 
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0
@@ -96,7 +100,7 @@ class ShaperNode(SchemaNode):
         self._unshaped_first = bool(values['unshaped_until_estimate'])
         self.limits = ShapingLimits(float(values['max_added_s']), float(values['max_command_s']))
         self._output = publisher(self, JointTrajectoryMsg, JOINT_TRAJECTORY_SHAPED)
-        subscription(self, JointTrajectoryMsg, JOINT_TRAJECTORY, self._on_trajectory)
+        command_subscription(self, JOINT_TRAJECTORY, self._on_trajectory, self._drop)
         self.workspace: WorkspaceShaper | None = None
         if values['source'] == 'parameters':
             mode = Mode(float(values['frequency_hz']), float(values['damping_ratio']))

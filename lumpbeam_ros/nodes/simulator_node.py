@@ -101,7 +101,7 @@ from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
 from lumpbeam_ros.nodes.params.simulator_params import SIMULATOR_SCHEMA, effect_parameter_name
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
-from lumpbeam_ros.nodes.trajectory_messages import command_from_msg
+from lumpbeam_ros.nodes.trajectory_messages import command_from_msg, command_subscription
 
 #: DiagnosticStatus.OK as a number (rclpy gives levels as one byte).
 OK_LEVEL = 0
@@ -559,7 +559,7 @@ class ArmSimulation:
         self._latest: ArmMotion | None = None
         self._samples: ArmMotion | None = None  # the samples being published
         self._joints_out = publisher(node, JointState, JOINT_STATES)
-        subscription(node, JointTrajectoryMsg, values['arm_commands'], self._on_command)
+        command_subscription(node, values['arm_commands'], self._on_command, self._refuse)
         self.config = config
         self.adopted = 0
         if values['adopt_identified']:
@@ -640,17 +640,20 @@ class ArmSimulation:
             start = max(command.stamp_s, now) if command.stamp_s > 0.0 else now
             self.stream.command(command.joint_names, command.time_s, command.positions_rad, start)
         except LumpbeamError as exc:
-            self.refused += 1
-            self.last_refusal = str(exc)
-            self.node.warn(
-                f'{self.values["arm_commands"]}: command refused ({exc}); '
-                f'{self.refused} refused so far'
-            )
+            self._refuse(str(exc))
             return
         self.accepted += 1
         self.node.get_logger().info(
             f'following a command of {command.time_s.size} points from {start:.3f} s '
             f'({command.time_s[-1]:.3f} s long)'
+        )
+
+    def _refuse(self, reason: str) -> None:
+        self.refused += 1
+        self.last_refusal = reason
+        self.node.warn(
+            f'{self.values["arm_commands"]}: command refused ({reason}); '
+            f'{self.refused} refused so far'
         )
 
 

@@ -151,6 +151,8 @@ class SampleCounts:
         out_of_order: Samples dropped for a stamp before the newest one (a live buffer).
         resets: Times a live buffer was emptied because the clock jumped back.
         loads_rejected: ``/tip_load`` readings rejected (non-finite, negative or stale).
+        outliers: Samples dropped as isolated outliers of the motion
+            (:mod:`~lumpbeam_ros.core.ident.outliers`).
     """
 
     received: int = 0
@@ -160,11 +162,12 @@ class SampleCounts:
     out_of_order: int = 0
     resets: int = 0
     loads_rejected: int = 0
+    outliers: int = 0
 
     @property
     def dropped(self) -> int:
         """Samples dropped, whatever the reason."""
-        return self.non_finite + self.duplicates + self.out_of_order
+        return self.non_finite + self.duplicates + self.out_of_order + self.outliers
 
     @property
     def kept(self) -> int:
@@ -208,6 +211,7 @@ class SampleCounts:
             out_of_order=self.out_of_order + later.out_of_order,
             resets=self.resets + later.resets,
             loads_rejected=self.loads_rejected + later.loads_rejected,
+            outliers=self.outliers + later.outliers,
         )
 
     def note(self) -> str:
@@ -218,6 +222,8 @@ class SampleCounts:
         repeated = self.duplicates + self.out_of_order
         if repeated:
             parts.append(f'{repeated} with a repeated or out-of-order stamp')
+        if self.outliers:
+            parts.append(f'{self.outliers} isolated outliers')
         notes = []
         if parts:
             notes.append(f'dropped {self.dropped} of {self.received} poses ({"; ".join(parts)})')

@@ -37,6 +37,7 @@ from lumpbeam_ros.core.ident.identification import (
 from lumpbeam_ros.core.ident.logdec import LogDecrement, LogDecrementResult
 from lumpbeam_ros.core.ident.mode_estimate import TWO_PI, ModeEstimate
 from lumpbeam_ros.core.ident.modes import choose_modes
+from lumpbeam_ros.core.ident.outliers import without_spikes
 from lumpbeam_ros.core.ident.pencil import MatrixPencil
 from lumpbeam_ros.core.ident.release import Release, detect_release
 from lumpbeam_ros.core.ident.ring_down import (
@@ -181,6 +182,7 @@ def _identify(
     given: Release | None = None,
 ) -> tuple[Identification, FitState | None]:
     span = AnalysedWindow(window.start_s, window.end_s)
+    window = without_spikes(window)
     dropped = window.counts.dropped
     tally = replace(window.counts, received=len(window) + dropped)
 
