@@ -149,11 +149,10 @@ def simulator(ros_graph):
     node.destroy_node()
 
 
-#: Loads: what a rig hangs, and what no beam carries. A carried but heavy change (0 to 50 kg
-#: on the paper's beam) still costs the next ticks seconds of the reference integrator: the
-#: work per message is not bounded yet, so the property leaves those out.
+#: Loads: what a rig hangs, what sags the beam past the model's regime (refused: 30 kg and up
+#: on the paper's beam), and what no beam carries.
 loads = st.one_of(
-    st.floats(0.0, 10.0),
+    st.floats(0.0, 100.0),
     st.sampled_from([math.nan, math.inf, -math.inf, -1.0, -0.0, 1e4, 1e6, 1e300, 1e308]),
 ).map(lambda kg: Float64(data=kg))
 
