@@ -103,10 +103,10 @@ def quaternions_to_pitch(xyzw: np.ndarray) -> np.ndarray:
     like one with a NaN position (:func:`~lumpbeam_ros.core.ident.samples.clean_window`).
     """
     x, y, z, w = xyzw.T
-    norm2 = x * x + y * y + z * z + w * w
-    bad = ~np.isfinite(norm2) | (norm2 == 0.0)
-    s = 2.0 / np.where(bad, 1.0, norm2)
     with np.errstate(invalid='ignore', over='ignore'):
+        norm2 = x * x + y * y + z * z + w * w
+        bad = ~np.isfinite(norm2) | (norm2 == 0.0)
+        s = 2.0 / np.where(bad, 1.0, norm2)
         d_x = 1.0 - s * (y * y + z * z)
         d_z = s * (x * z - w * y)
         return np.where(bad, np.nan, np.arctan2(-d_z, d_x))

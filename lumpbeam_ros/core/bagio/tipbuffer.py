@@ -101,9 +101,11 @@ class TipBuffer:
 
     @property
     def counts(self) -> SampleCounts:
-        """Every pose pushed since the buffer was made, and what became of it."""
+        """Every pose pushed since the buffer was made, and what became of it (a held pose
+        once it is decided)."""
         return SampleCounts(
-            received=self._received,
+            # A held pose is counted once the next pose decides it.
+            received=self._received - self.holding,
             non_finite=self._totals['non_finite'],
             duplicates=self._totals['duplicates'],
             out_of_order=self._totals['out_of_order'],

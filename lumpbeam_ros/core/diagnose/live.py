@@ -130,8 +130,8 @@ class Stretch:
         start_s: First stamp, s.
         end_s: Last stamp, s.
         release_s: The load change it follows (NaN for a window without one).
-        release_uncertainty_s: How early the load change may be dated, s: the spread of the
-            poses' sending against their stamps, when the change was dated through them.
+        release_uncertainty_s: How early the load change may be dated, s (two pose periods
+            when it was dated through the poses, else 0).
     """
 
     start_s: float
@@ -365,26 +365,33 @@ class LiveBuffer:
 
         It is dated on the poses' time line: by ``sent_s`` itself when the poses' stamps are
         on the same clock (a live camera, or a bag played with ``/clock`` and dated by it);
-        else (a bag played on wall time, or poses and load both sent by a player) by the
-        newest pose's stamp plus the time between the two were sent. Dated by their DDS
-        source timestamps, a player's load and poses keep the spacing of the bag, whatever
-        the executor's order; a release dated a millisecond off is a latency to a diagnosis.
-        A reading before any pose is the load hanging from the start.
+        else (a bag played on wall time) at the stamp of the last pose sent before it, with
+        an uncertainty of two pose periods (:attr:`Stretch.release_uncertainty_s`). A reading
+        before any pose is the load hanging from the start.
 
         Args:
             sent_s: When the reading was sent (as ``sent_s`` of :meth:`push_measured`), s.
             kg: Mass at the tip, kg.
         """
-        recent = self.latest_s - DATING_SPAN_S
-        offsets = [ahead for t, ahead in self._sent_after_stamp if t >= recent]
-        # Through the pose sent latest for its stamp, a load is dated no later than it was
-        # due: a release dated late would show as a negative delay, which no sensor has.
-        ahead = max(offsets) if offsets else math.nan
+        recent = [
+            (t, ahead)
+            for t, ahead in self._sent_after_stamp
+            if t >= self.latest_s - DATING_SPAN_S
+        ]
         uncertainty = 0.0
         if not self.measured_count:
             t = -math.inf
-        elif math.isfinite(ahead) and abs(ahead) > self.settings.reset_jump_back_s:
-            t, uncertainty = sent_s - ahead, ahead - min(offsets)
+        elif recent and abs(recent[-1][1]) > self.settings.reset_jump_back_s:
+            # Sent in the bag's order, the load falls between the stamps of the poses sent
+            # just before and after it, however late the player was: dated at the first (a
+            # release dated late would show as a negative delay, which no sensor has).
+            stamps = np.array([t for t, _ in recent])
+            sent = stamps + np.array([ahead for _, ahead in recent])
+            before = stamps[sent <= sent_s]
+            t = float(before[-1]) if before.size else float(stamps[0])
+            spacing = float(np.median(np.diff(stamps))) if stamps.size > 1 else 0.0
+            # One pose period, and one more for a load that arrived before that pose did.
+            uncertainty = 2.0 * spacing
         else:
             t = sent_s
         if self.loads and (t < self.loads[-1][0] or t == -math.inf):
