@@ -101,8 +101,7 @@ class TipBuffer:
 
     @property
     def counts(self) -> SampleCounts:
-        """Every pose pushed since the buffer was made, and what became of it (a held pose
-        once it is decided)."""
+        """Every pose pushed since the buffer was made, and what became of it (once decided)."""
         return SampleCounts(
             # A held pose is counted once the next pose decides it.
             received=self._received - self.holding,

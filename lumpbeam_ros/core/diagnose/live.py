@@ -374,9 +374,7 @@ class LiveBuffer:
             kg: Mass at the tip, kg.
         """
         recent = [
-            (t, ahead)
-            for t, ahead in self._sent_after_stamp
-            if t >= self.latest_s - DATING_SPAN_S
+            (t, ahead) for t, ahead in self._sent_after_stamp if t >= self.latest_s - DATING_SPAN_S
         ]
         uncertainty = 0.0
         if not self.measured_count:
