@@ -175,9 +175,8 @@ class CameraNode(SchemaNode):
 
     def _took_camera_info(self, changed: bool, problem: str = '') -> None:
         if problem:
-            self.get_logger().warning(
-                f'camera_info ignored: {problem}', throttle_duration_sec=self._warning_period
-            )
+            kept = 'keeping the last one' if self.session.camera_info else 'no intrinsics yet'
+            self.refuse(CAMERA_INFO, f'camera info refused ({problem})', kept)
         elif changed:
             info = self.session.camera_info
             assert info is not None  # a change sets it

@@ -202,7 +202,8 @@ class DiagnosisNode(SchemaNode):
             )
             return
         # Float64 has no stamp: the buffer dates the change by when it was sent.
-        self.buffer.push_load(self._sent_s(info), kg)
+        on_clock = self.get_clock().ros_time_is_active
+        self.buffer.push_load(self._sent_s(info), kg, on_stamps_clock=on_clock)
 
     def _sent_s(self, info: Mapping[str, int] | None) -> float:
         """When a message was sent, on the clock that dates the load changes.

@@ -149,19 +149,22 @@ class IdentifierNode(SchemaNode):
         kg = float(msg.data)
         if math.isfinite(kg) and kg >= 0.0 and kg != self._carried_kg:
             if not carries(self.beam, kg):
-                self.get_logger().warning(
-                    f'/tip_load {msg.data!r} kg rejected: the beam cannot carry it (no static '
-                    'equilibrium); a wrong reading would make its stiffness (B.12)',
-                    throttle_duration_sec=WARN_PERIOD_S,
+                self.refuse(
+                    TIP_LOAD,
+                    f'{msg.data!r} kg refused: the beam cannot carry it (no static equilibrium, '
+                    'or a sag past a tenth of its length); a wrong reading would make its '
+                    'stiffness (B.12)',
+                    f'keeping {self._carried_kg:g} kg',
                 )
                 return
             self._carried_kg = kg
         stored, stamp = self.window.push_load_on_arrival(msg.data, now)
         if not stored:
-            self.get_logger().warning(
-                f'/tip_load {msg.data!r} at {stamp:.3f} s rejected (not a finite mass >= 0, '
-                'or older than the last reading)',
-                throttle_duration_sec=WARN_PERIOD_S,
+            self.refuse(
+                TIP_LOAD,
+                f'{msg.data!r} kg at {stamp:.3f} s refused (not a finite mass >= 0, or older '
+                'than the last reading)',
+                'keeping the last reading',
             )
 
     def _on_joint_state(self, msg: JointState) -> None:
@@ -170,11 +173,12 @@ class IdentifierNode(SchemaNode):
         # taken, it would switch the node to an arm for good.
         if len(names) != positions.size or not self.joints.push(stamp_ns * 1e-9, positions):
             self.bad_joint_states += 1
-            self.get_logger().warning(
-                f'/joint_states at {stamp_ns * 1e-9:.3f} s ignored: {len(names)} names for '
+            self.refuse(
+                JOINT_STATES,
+                f'joint state at {stamp_ns * 1e-9:.3f} s refused: {len(names)} names for '
                 f'{positions.size} positions, a position that is not finite, a stamp going '
-                f'back or another number of joints ({self.bad_joint_states} so far)',
-                throttle_duration_sec=WARN_PERIOD_S,
+                'back or another number of joints',
+                'keeping the joints as they were',
             )
 
     def _on_timer(self) -> None:

@@ -14,6 +14,8 @@ A node calls it once, in ``__init__``::
 from __future__ import annotations
 
 import math
+import time
+from collections import Counter
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, TypedDict, Unpack
 
@@ -197,10 +199,14 @@ class SchemaNode(Node):
 
     Attributes:
         parameter_values: The declared values, by name.
+        refusals: Values refused per topic (:meth:`refuse`).
 
     Raises:
         ConfigError: A value is of the wrong type or out of range, naming the parameter.
     """
+
+    #: Seconds between two warnings about values refused on one topic.
+    REFUSAL_WARN_PERIOD_S = 5.0
 
     def __init__(
         self,
@@ -222,6 +228,8 @@ class SchemaNode(Node):
             parameter_overrides=overrides,
         )
         self.parameter_values = declare_parameters(self, schema, on_change)
+        self.refusals: Counter[str] = Counter()
+        self._refused_at: dict[str, float] = {}
         for name in sorted(self._parameter_overrides):
             if not self.has_parameter(name) and not name.startswith('qos_overrides.'):
                 self.get_logger().warning(
@@ -233,3 +241,26 @@ class SchemaNode(Node):
             problem = set_realtime_priority(int(self.parameter_values[REALTIME_PRIORITY.name]))
             if problem:
                 self.get_logger().warning(problem)
+
+    def refuse(self, topic: str, refused: str, kept: str) -> None:
+        """Refuses what a message brought: the one rule of every node for a bad value.
+
+        A value the physics or the declared parameters do not allow (a load the beam cannot
+        carry, a stiffness or a mode no model or shaper can take, a malformed message) never
+        reaches a solver and never changes the node's state: the last good state is kept,
+        the refusal is counted per topic, and a warning naming the topic, the value and what
+        was kept is logged at most every :attr:`REFUSAL_WARN_PERIOD_S` per topic.
+
+        Args:
+            topic: Where the value came from.
+            refused: The value and why it is refused, e.g. ``'1e+06 kg: not carried'``.
+            kept: What the node keeps instead, e.g. ``'keeping 4.5 kg'``.
+        """
+        self.refusals[topic] += 1
+        now = time.monotonic()
+        if now - self._refused_at.get(topic, -math.inf) < self.REFUSAL_WARN_PERIOD_S:
+            return
+        self._refused_at[topic] = now
+        self.get_logger().warning(
+            f'{topic}: {refused}; {kept} ({self.refusals[topic]} refused so far)'
+        )

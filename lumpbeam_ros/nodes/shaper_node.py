@@ -137,10 +137,7 @@ class ShaperNode(SchemaNode):
             try:
                 arm = arm_from_status(status.level[0], pairs, self.nominal)
             except LumpbeamError as exc:
-                self.get_logger().warning(
-                    f'{ARM_PARAMS}: arm not taken ({exc}): keeping {self.description}',
-                    throttle_duration_sec=WARN_PERIOD_S,
-                )
+                self.refuse(ARM_PARAMS, f'arm refused ({exc})', f'keeping {self.description}')
                 continue
             self._adopt_arm(arm, f'{ARM_PARAMS} ({status.message})')
 
@@ -174,10 +171,7 @@ class ShaperNode(SchemaNode):
                 self._adopt(kind, [m.mode for m in estimate.modes])
             except LumpbeamError as exc:
                 kept = f'keeping {self.description}' if self.impulses else 'no shaper yet'
-                self.get_logger().warning(
-                    f'{BEAM_PARAMS}: invalid estimate ({exc}): {kept}',
-                    throttle_duration_sec=WARN_PERIOD_S,
-                )
+                self.refuse(BEAM_PARAMS, f'estimate refused ({exc})', kept)
                 continue
             for note in estimate.left_out:
                 self.get_logger().warning(

@@ -286,10 +286,6 @@ class SimulatorNode(SchemaNode):
         """The node's clock, s (wall time, or ``/clock`` under ``use_sim_time``)."""
         return float(self.get_clock().now().nanoseconds / NS_PER_S)
 
-    def warn(self, text: str) -> None:
-        """A warning, throttled."""
-        self.get_logger().warning(text, throttle_duration_sec=WARN_PERIOD_S)
-
 
 _NOTHING = TipSeries(*(np.empty(0),) * 4)
 
@@ -381,13 +377,12 @@ class BeamSimulation:
 
     def _on_load(self, msg: Float64) -> None:
         kg = float(msg.data)
-        if not math.isfinite(kg) or kg < 0.0:
-            self.node.warn(f'ignoring /tip_load of {kg!r} kg: not a mass')
-            return
         if not carries(self.beam, kg):
-            self.node.warn(
-                f'ignoring /tip_load of {kg:g} kg: the beam has no static equilibrium under it '
-                f'(cannot carry it); keeping {self._load_kg:g} kg'
+            self.node.refuse(
+                TIP_LOAD,
+                f'{kg!r} kg refused: not a mass, or one the beam cannot carry (no static '
+                'equilibrium, or a sag past a tenth of its length)',
+                f'keeping {self._load_kg:g} kg',
             )
             return
         first = not self._load_seen
@@ -402,6 +397,12 @@ class BeamSimulation:
         elif changed:
             self.stream.set_load(self.node.now(), kg)
 
+    def _keeping(self) -> str:
+        """What the simulator keeps when it refuses an estimate."""
+        if self._adopted is None:
+            return "keeping the beam file's stiffness"
+        return f'keeping k_tE={self._adopted[0]:.6g} N m/rad'
+
     def _on_beam_params(self, msg: DiagnosticArray) -> None:
         if not self.values['adopt_identified']:
             return
@@ -413,19 +414,23 @@ class BeamSimulation:
                 k_total = float(values['stiffness_total_nm_per_rad'])
                 zeta = float(values['damping_ratio'])
             except (KeyError, ValueError) as exc:
-                self.node.warn(f'ignoring /beam_params: bad or missing {exc}')
+                self.node.refuse(
+                    BEAM_PARAMS, f'estimate refused (bad or missing {exc})', self._keeping()
+                )
                 return
             if (k_total, zeta) == self._adopted:
                 return
             try:
                 beam = adopt_identified(self._base_beam, k_total, zeta)
             except LumpbeamError as exc:
-                self.node.warn(f'ignoring /beam_params: {exc}')
+                self.node.refuse(BEAM_PARAMS, f'estimate refused ({exc})', self._keeping())
                 return
             if not carries(beam, self._load_kg):
-                self.node.warn(
-                    f'ignoring /beam_params: with k_tE={k_total:.6g} N m/rad the beam cannot '
-                    f'carry its {self._load_kg:g} kg load'
+                self.node.refuse(
+                    BEAM_PARAMS,
+                    f'k_tE={k_total:.6g} N m/rad refused: the beam would not carry its '
+                    f'{self._load_kg:g} kg load',
+                    self._keeping(),
                 )
                 return
             self._adopted, self._adopted_beam = (k_total, zeta), beam
@@ -627,7 +632,7 @@ class ArmSimulation:
                 arm = arm_from_status(_level(status), pairs, self.config)
                 model = ArmModel.from_config(arm)
             except LumpbeamError as exc:
-                self.node.warn(f'{ARM_PARAMS}: arm not adopted ({exc}): keeping the last one')
+                self.node.refuse(ARM_PARAMS, f'arm refused ({exc})', 'keeping the last one')
                 continue
             self.model = self.stream.model = model
             self.adopted += 1
@@ -651,9 +656,8 @@ class ArmSimulation:
     def _refuse(self, reason: str) -> None:
         self.refused += 1
         self.last_refusal = reason
-        self.node.warn(
-            f'{self.values["arm_commands"]}: command refused ({reason}); '
-            f'{self.refused} refused so far'
+        self.node.refuse(
+            self.values['arm_commands'], f'command refused ({reason})', 'keeping the motion'
         )
 
 

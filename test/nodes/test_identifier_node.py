@@ -547,4 +547,8 @@ def test_a_load_the_beam_cannot_carry_is_no_reading(ros_graph, capfd, kg):
     node._on_load(Float64(data=4.5))
     node._on_load(Float64(data=kg))
     assert node.window.snapshot().loads.kg.tolist() == [4.5]
-    assert f'/tip_load {kg!r} kg rejected: the beam cannot carry it' in capfd.readouterr().err
+    err = capfd.readouterr().err
+    assert f'/tip_load: {kg!r} kg refused: the beam cannot carry it' in err
+    assert 'keeping 4.5 kg (1 refused so far)' in err and node.refusals['/tip_load'] == 1
+    node._on_load(Float64(data=kg))  # counted, said again only after the warning period
+    assert node.refusals['/tip_load'] == 2 and 'refused' not in capfd.readouterr().err

@@ -162,7 +162,8 @@ def test_a_load_the_beam_cannot_carry_is_refused_and_the_node_runs_on(
     ros_graph.publish('/tip_load', Float64(data=2.0), LATCHED)
     assert ros_graph.spin_until(lambda: node.stream.load_kg == 2.0)
     err = capfd.readouterr().err
-    assert f'ignoring /tip_load of {kg:g} kg' in err
+    assert f'/tip_load: {kg!r} kg refused' in err and 'keeping 4.5 kg' in err
+    assert node.refusals['/tip_load'] == 1
     assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
 
 

@@ -45,9 +45,7 @@ OK, WARN, ERROR, STALE = 0, 1, 2, 3
 
 #: The amplitude of a ring-down is measured over this last stretch of it, s.
 AMPLITUDE_SPAN_S = 0.5
-#: A load reading is dated through the poses of this last stretch, s ...
-DATING_SPAN_S = 1.0
-#: ... at most this many of them.
+#: A load reading is dated through the latest this many poses (a backlog of them).
 DATING_POSES = 400
 
 
@@ -130,8 +128,8 @@ class Stretch:
         start_s: First stamp, s.
         end_s: Last stamp, s.
         release_s: The load change it follows (NaN for a window without one).
-        release_uncertainty_s: How early the load change may be dated, s (two pose periods
-            when it was dated through the poses, else 0).
+        release_uncertainty_s: How early the load change may be dated, s (the poses'
+            spacing around it when it was dated through them, else 0).
     """
 
     start_s: float
@@ -233,7 +231,8 @@ def diagnose_live(record: Record, beam: BeamParameters, stretch: Stretch) -> Liv
     named, reason = named_effects(result), result.decision.reason
     missing = result.missing_effect
     latency = dict(named).get('sensor_latency', {}).get('latency_s', math.nan)
-    if len(named) == 1 and 0.0 <= latency <= stretch.release_uncertainty_s:
+    # The margin: the delay is fitted to a few microseconds, the dating's bound is exact.
+    if len(named) == 1 and 0.0 <= latency <= 1.1 * stretch.release_uncertainty_s:
         # Dated up to that much late, the release alone can show such a delay.
         missing, named = 'none', ()
         reason = (
@@ -309,6 +308,7 @@ class LiveBuffer:
         # The recent measured poses' stamps, and when they were sent minus their stamps, s.
         self._sent_after_stamp: deque[tuple[float, float]] = deque(maxlen=DATING_POSES)
         self._dating_s: dict[float, float] = {}  # a load change's time: its uncertainty
+        self._undated: deque[tuple[float, float]] = deque()  # (sent, kg) of loads to date
 
     def _buffer(self) -> TipBuffer:
         """A buffer of ``keep_s``; a stamp that far back is the clock going back."""
@@ -347,10 +347,16 @@ class LiveBuffer:
             if not kept and self.loads:
                 kept = [(first, self.loads[-1][1])]
             self.loads[:] = kept
+            self._sent_after_stamp.clear()
+            # Sent before the new line's first pose: what hangs as it starts.
+            for _, kg in self._undated:
+                self._add_load(first, kg, 0.0)
+            self._undated.clear()
             self.predicted = self._buffer()
             self._done_until = -math.inf
         if stored and math.isfinite(sent_s):
             self._sent_after_stamp.append((t, sent_s - t))
+            self._date_loads_sent_before(sent_s)
         self.measured_count += stored
         return stored
 
@@ -360,38 +366,52 @@ class LiveBuffer:
         self.predicted_count += stored
         return stored
 
-    def push_load(self, sent_s: float, kg: float) -> None:
+    def push_load(self, sent_s: float, kg: float, on_stamps_clock: bool = False) -> None:
         """Adds a ``/tip_load`` reading (``Float64`` has no stamp), dated by when it was sent.
 
         It is dated on the poses' time line: by ``sent_s`` itself when the poses' stamps are
         on the same clock (a live camera, or a bag played with ``/clock`` and dated by it);
-        else (a bag played on wall time) at the stamp of the last pose sent before it, with
-        an uncertainty of two pose periods (:attr:`Stretch.release_uncertainty_s`). A reading
-        before any pose is the load hanging from the start.
+        else (a bag played on wall time) at the stamp of the last pose sent before it, once
+        the first pose sent after it has arrived, the spacing of the two its uncertainty
+        (:attr:`Stretch.release_uncertainty_s`). A reading before any pose is the load
+        hanging from the start.
 
         Args:
             sent_s: When the reading was sent (as ``sent_s`` of :meth:`push_measured`), s.
             kg: Mass at the tip, kg.
+            on_stamps_clock: ``sent_s`` is on the poses' clock whatever they say (a node on
+                ``/clock``).
         """
-        recent = [
-            (t, ahead) for t, ahead in self._sent_after_stamp if t >= self.latest_s - DATING_SPAN_S
-        ]
-        uncertainty = 0.0
         if not self.measured_count:
-            t = -math.inf
-        elif recent and abs(recent[-1][1]) > self.settings.reset_jump_back_s:
-            # Sent in the bag's order, the load falls between the stamps of the poses sent
-            # just before and after it, however late the player was: dated at the first (a
-            # release dated late would show as a negative delay, which no sensor has).
-            stamps = np.array([t for t, _ in recent])
-            sent = stamps + np.array([ahead for _, ahead in recent])
-            before = stamps[sent <= sent_s]
-            t = float(before[-1]) if before.size else float(stamps[0])
-            spacing = float(np.median(np.diff(stamps))) if stamps.size > 1 else 0.0
-            # One pose period, and one more for a load that arrived before that pose did.
-            uncertainty = 2.0 * spacing
+            self._add_load(-math.inf, kg, 0.0)
+        elif (
+            not on_stamps_clock
+            and self._sent_after_stamp
+            and abs(self._sent_after_stamp[-1][1]) > self.settings.reset_jump_back_s
+        ):
+            # Dated once the first pose sent after it has arrived (the two topics may be
+            # delivered out of step, a backlog of poses behind the load).
+            self._undated.append((sent_s, kg))
         else:
-            t = sent_s
+            self._add_load(sent_s, kg, 0.0)
+
+    def _date_loads_sent_before(self, sent_s: float) -> None:
+        """Dates the load readings sent before the pose sent at ``sent_s``.
+
+        A player sends in the bag's order however late it runs: a reading falls between the
+        stamps of the poses sent just before and just after it. It is dated at the first (a
+        release dated late would show as a negative delay, which no sensor has), the gap to
+        the second its uncertainty.
+        """
+        while self._undated and self._undated[0][0] < sent_s:
+            sent_load, kg = self._undated.popleft()
+            stamps = [t for t, _ in self._sent_after_stamp]
+            before = [t for t, ahead in self._sent_after_stamp if t + ahead <= sent_load]
+            after = next(t for t, ahead in self._sent_after_stamp if t + ahead > sent_load)
+            dated = before[-1] if before else stamps[0]
+            self._add_load(dated, kg, after - dated)
+
+    def _add_load(self, t: float, kg: float, uncertainty: float) -> None:
         if self.loads and (t < self.loads[-1][0] or t == -math.inf):
             self.loads.clear()
         if not self.loads or kg != self.loads[-1][1]:
@@ -409,6 +429,7 @@ class LiveBuffer:
         self.loads.clear()
         self._done_until = -math.inf
         self._sent_after_stamp.clear()
+        self._undated.clear()
 
     def missing_input(self) -> str | None:
         """What the diagnosis lacks to start, in words (``None``: nothing)."""

@@ -264,7 +264,7 @@ def test_loads_are_dated_on_the_poses_time_line_whatever_the_clock(ahead_s):
             assert release == pytest.approx(RELEASE_S + ahead_s, abs=1e-9)
         else:  # at the stamp of the pose sent before it, never later than it was due
             assert RELEASE_S - stretch.release_uncertainty_s <= release <= RELEASE_S
-            assert stretch.release_uncertainty_s == pytest.approx(2 / 180, rel=1e-6)
+            assert stretch.release_uncertainty_s == pytest.approx(1 / 180, rel=1e-6)
         assert stretch.release_s == release
 
 
@@ -281,7 +281,7 @@ def test_a_release_played_by_a_late_player_is_dated_by_the_poses_sent_around_it(
     _, found = _played(SETTINGS, t, z, pitch, clock_ahead_s=3600.0, late_s=late_s)
     ((stretch, _),) = found
     early = RELEASE_S - stretch.release_s  # never late: that would be a negative delay
-    assert 0.0 <= early <= stretch.release_uncertainty_s == pytest.approx(2 / 180)
+    assert 0.0 <= early <= stretch.release_uncertainty_s == pytest.approx(1 / 180)
 
 
 @pytest.mark.parametrize(('uncertainty_s', 'verdict'), [(0.0, 'sensor_latency'), (2e-3, 'none')])
@@ -295,3 +295,18 @@ def test_a_latency_within_the_release_dating_is_not_named(uncertainty_s, verdict
     assert result.missing_effect == verdict
     if verdict == 'none':
         assert result.reason.startswith('the delay found, 1.0') and 'no stamp' in result.reason
+
+
+def test_a_load_delivered_ahead_of_a_backlog_of_poses_is_dated_when_they_arrive():
+    _, _, t, z, pitch = _stream()
+    buffer = LiveBuffer(SETTINGS)
+    buffer.push_load(-1.0, 4.5)  # before any pose: what hangs from the start
+    backlog = t >= RELEASE_S - 0.05  # these poses are still on their way
+    for ti, zi, pi in zip(t[~backlog], z[~backlog], pitch[~backlog], strict=True):
+        buffer.push_measured(float(ti), float(zi), float(pi), sent_s=3600.0 + ti)
+    buffer.push_load(3600.0 + RELEASE_S - 1e-4, 0.0)  # sent just before the pose at 2.0 s
+    assert buffer.loads == [(-math.inf, 4.5)]  # not dated yet
+    for ti, zi, pi in zip(t[backlog], z[backlog], pitch[backlog], strict=True):
+        buffer.push_measured(float(ti), float(zi), float(pi), sent_s=3600.0 + ti)
+    release = buffer.loads[-1][0]
+    assert release == pytest.approx(RELEASE_S - 1 / 180) and buffer.next_stretch() is not None
