@@ -43,6 +43,7 @@ TRIGGERS: tuple[Trigger, ...] = ('ring_down', 'window')
 #: DiagnosticStatus levels (as numbers: the core does not import ROS messages).
 OK, WARN, ERROR, STALE = 0, 1, 2, 3
 
+_POSITIVE = Bounds(0.0, low_open=True)
 #: The amplitude of a ring-down is measured over this last stretch of it, s.
 AMPLITUDE_SPAN_S = 0.5
 #: A load reading is dated through the latest this many poses (a backlog of them).
@@ -109,12 +110,12 @@ class LiveDiagnosisConfig:
         Bounds(5.0, 3600.0),
     )
     reset_jump_back_s: float = setting(
-        'reset_jump_back_s',
+        'stream.reset_jump_back_s',
         1.0,
         'a pose stamped this far before the newest one (and the pose after it) is the clock '
         'going back, a looping bag: the node starts over on the new time line',
         's',
-        Bounds(0.0, 3600.0, low_open=True),
+        _POSITIVE,
     )
     # Not a parameter: the buffers are sized as the identifier's window is.
     max_rate_hz: float = IdentifierConfig.max_rate_hz
@@ -323,10 +324,9 @@ class LiveBuffer:
     def push_measured(self, t: float, z: float, pitch: float, sent_s: float = math.nan) -> bool:
         """Adds a measured pose, or counts why not (:class:`~.tipbuffer.TipBuffer`).
 
-        A clock that jumped back (a looping bag) starts the stream over: the prediction and
-        the stretches belong to the old time line, and so do the load readings dated after
-        the new line's first pose; the mass hanging then is kept (the last reading of the
-        old line when the new one has none, as the identifier keeps it).
+        A clock that jumped back (a looping bag) starts the stream over: the prediction, the
+        stretches and the load changes belong to the old time line; the mass hanging (the
+        last reading received) is kept as the load from the new line's start.
 
         Args:
             t: Header stamp, s.
@@ -342,16 +342,12 @@ class LiveBuffer:
         resets = self.measured.counts.resets
         stored = self.measured.push(t, z, pitch)
         if self.measured.counts.resets != resets:
-            first = self.measured.oldest_s
-            kept = [(when, kg) for when, kg in self.loads if when <= first]
-            if not kept and self.loads:
-                kept = [(first, self.loads[-1][1])]
-            self.loads[:] = kept
-            self._sent_after_stamp.clear()
-            # Sent before the new line's first pose: what hangs as it starts.
-            for _, kg in self._undated:
-                self._add_load(first, kg, 0.0)
+            # The new time line starts with the mass in force: the last reading received
+            # (one sent before its first pose is still undated), as the identifier keeps it.
+            latest = [kg for _, kg in (*self.loads, *self._undated)][-1:]
+            self.loads[:] = [(-math.inf, kg) for kg in latest]
             self._undated.clear()
+            self._sent_after_stamp.clear()
             self.predicted = self._buffer()
             self._done_until = -math.inf
         if stored and math.isfinite(sent_s):

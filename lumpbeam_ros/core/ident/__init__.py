@@ -13,6 +13,7 @@ __all__ = [
     'modes',
     'onset',
     'optimize',
+    'outliers',
     'peaks',
     'pencil',
     'release',

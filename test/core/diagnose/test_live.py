@@ -202,17 +202,22 @@ def test_late_and_repeated_poses_are_counted_in_the_stretch_record():
     assert buffer.measured.counts.out_of_order == t.size
 
 
-def _played(settings, t, z, pitch, *, passes=1, clock_ahead_s=0.0, odd=None, late_s=None):
+def _played(
+    settings, t, z, pitch, *, passes=1, clock_ahead_s=0.0, odd=None, late_s=None, readings=False
+):
     """Plays the stream as a player does, ``passes`` times (a looping bag), polled per pose.
 
     The loads are sent at their stamps on the node's clock, ``clock_ahead_s`` after the
     poses' time line (0: /clock; a bag played on wall time: its age); ``odd`` is one
     ``(index, stamp)`` pose of a corrupt stamp sent in each pass; ``late_s(i)`` how late the
-    player sends message ``i`` (the load: ``-1``).
+    player sends message ``i`` (the load: ``-1``). With ``readings``, the load is read every
+    second, as a synthetic bag holds it, and once more after the last pose.
     """
     buffer, found = LiveBuffer(settings), []
     for _ in range(passes):
         pending = [(0.0, 4.5), (RELEASE_S, 0.0)]
+        if readings:
+            pending = [(float(s), 4.5 if s < RELEASE_S else 0.0) for s in range(int(t[-1]) + 1)]
         for i, (ti, zi, pi) in enumerate(zip(t, z, pitch, strict=True)):
             clock_s = float(ti) + clock_ahead_s + (late_s(i) if late_s else 0.0)
             while pending and pending[0][0] <= ti:
@@ -224,6 +229,8 @@ def _played(settings, t, z, pitch, *, passes=1, clock_ahead_s=0.0, odd=None, lat
             stretch = buffer.next_stretch()
             if stretch is not None:
                 found.append((stretch, buffer.record(stretch)))
+        if readings:  # sent after the pass's last pose: dated by the next pass's poses
+            buffer.push_load(float(t[-1]) + clock_ahead_s + 1e-4, 0.0)
     return buffer, found
 
 
@@ -231,10 +238,16 @@ SETTINGS = LiveDiagnosisConfig(pre_release_s=1.0, decay_s=2.3)
 EXPECTED = Stretch(RELEASE_S - 1.0, RELEASE_S + 2.3, RELEASE_S)
 
 
-def test_a_looping_bag_gives_every_pass_its_ring_down():
+@pytest.mark.parametrize('clock_ahead_s', [0.0, 3600.0])
+def test_a_looping_bag_gives_every_pass_its_ring_down(clock_ahead_s):
     _, _, t, z, pitch = _stream()
-    buffer, found = _played(SETTINGS, t, z, pitch, passes=5)
-    assert [stretch for stretch, _ in found] == [EXPECTED] * 5
+    buffer, found = _played(
+        SETTINGS, t, z, pitch, passes=5, clock_ahead_s=clock_ahead_s, readings=True
+    )
+    # Dated through the poses (a bag on wall time): exact here, one pose's spacing uncertain.
+    uncertainty = 0.0 if clock_ahead_s == 0.0 else pytest.approx(1 / 180)
+    expected = dataclasses.replace(EXPECTED, release_uncertainty_s=uncertainty)
+    assert [stretch for stretch, _ in found] == [expected] * 5
     assert buffer.measured.counts.resets == 4
     assert all(r.initial_load_kg == 4.5 and r.load_events == ((2.0, 0.0),) for _, r in found)
     assert all(np.array_equal(r.z, found[0][1].z) for _, r in found)

@@ -15,7 +15,7 @@ LIVE_PARAMETERS = {
     'min_amplitude_m': 'ring_down.min_amplitude_m',
     'window_s': 'window_s',
     'keep_s': 'keep_s',
-    'reset_jump_back_s': 'reset_jump_back_s',
+    'reset_jump_back_s': 'stream.reset_jump_back_s',
 }
 
 
