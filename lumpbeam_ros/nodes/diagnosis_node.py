@@ -202,21 +202,15 @@ class DiagnosisNode(SchemaNode):
             )
             return
         # Float64 has no stamp: the buffer dates the change by when it was sent.
-        on_clock = self.get_clock().ros_time_is_active
-        self.buffer.push_load(self._sent_s(info), kg, on_stamps_clock=on_clock)
+        self.buffer.push_load(self._sent_s(info), kg)
 
     def _sent_s(self, info: Mapping[str, int] | None) -> float:
-        """When a message was sent, on the clock that dates the load changes.
-
-        On ``/clock`` (a bag played at any rate), the node's clock at its arrival. On wall
-        time, its DDS source timestamp (the sender's wall clock, free of the executor's
-        delays), else the node's clock.
-        """
-        clock = self.get_clock()
+        """When a message was sent: its DDS source timestamp (the sender's wall clock, free of
+        the executor's delays and of a /clock that moved on), else the node's clock now."""
         sent_ns = (info or {}).get('source_timestamp', 0)
-        if sent_ns > 0 and not clock.ros_time_is_active:
+        if sent_ns > 0:
             return sent_ns * 1e-9
-        return float(clock.now().nanoseconds) * 1e-9
+        return float(self.get_clock().now().nanoseconds) * 1e-9
 
     def _on_change(self, changes: Mapping[str, Any]) -> str | None:
         if 'adopt' in changes:

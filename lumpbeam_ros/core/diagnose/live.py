@@ -309,7 +309,8 @@ class LiveBuffer:
         # The recent measured poses' stamps, and when they were sent minus their stamps, s.
         self._sent_after_stamp: deque[tuple[float, float]] = deque(maxlen=DATING_POSES)
         self._dating_s: dict[float, float] = {}  # a load change's time: its uncertainty
-        self._undated: deque[tuple[float, float]] = deque()  # (sent, kg) of loads to date
+        # (sent, kg) of the loads to date; bounded for a stream of loads without poses.
+        self._undated: deque[tuple[float, float]] = deque(maxlen=DATING_POSES)
 
     def _buffer(self) -> TipBuffer:
         """A buffer of ``keep_s``; a stamp that far back is the clock going back."""
@@ -362,12 +363,12 @@ class LiveBuffer:
         self.predicted_count += stored
         return stored
 
-    def push_load(self, sent_s: float, kg: float, on_stamps_clock: bool = False) -> None:
+    def push_load(self, sent_s: float, kg: float) -> None:
         """Adds a ``/tip_load`` reading (``Float64`` has no stamp), dated by when it was sent.
 
         It is dated on the poses' time line: by ``sent_s`` itself when the poses' stamps are
-        on the same clock (a live camera, or a bag played with ``/clock`` and dated by it);
-        else (a bag played on wall time) at the stamp of the last pose sent before it, once
+        on the same clock (a live camera); else (a bag played, on ``/clock`` or wall time, at
+        any rate) at the stamp of the last pose sent before it, once
         the first pose sent after it has arrived, the spacing of the two its uncertainty
         (:attr:`Stretch.release_uncertainty_s`). A reading before any pose is the load
         hanging from the start.
@@ -375,14 +376,11 @@ class LiveBuffer:
         Args:
             sent_s: When the reading was sent (as ``sent_s`` of :meth:`push_measured`), s.
             kg: Mass at the tip, kg.
-            on_stamps_clock: ``sent_s`` is on the poses' clock whatever they say (a node on
-                ``/clock``).
         """
         if not self.measured_count:
             self._add_load(-math.inf, kg, 0.0)
         elif (
-            not on_stamps_clock
-            and self._sent_after_stamp
+            self._sent_after_stamp
             and abs(self._sent_after_stamp[-1][1]) > self.settings.reset_jump_back_s
         ):
             # Dated once the first pose sent after it has arrived (the two topics may be
