@@ -205,8 +205,11 @@ class DiagnosisNode(SchemaNode):
         self.buffer.push_load(self._sent_s(info), kg)
 
     def _sent_s(self, info: Mapping[str, int] | None) -> float:
-        """When a message was sent: its DDS source timestamp (the sender's wall clock, free of
-        the executor's delays and of a /clock that moved on), else the node's clock now."""
+        """When a message was sent: its DDS source timestamp, else the node's clock now.
+
+        The sender's wall clock is free of the executor's delays and of a /clock that moved
+        on while the message waited.
+        """
         sent_ns = (info or {}).get('source_timestamp', 0)
         if sent_ns > 0:
             return sent_ns * 1e-9
