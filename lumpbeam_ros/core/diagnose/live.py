@@ -368,8 +368,8 @@ class LiveBuffer:
 
         It is dated on the poses' time line: by ``sent_s`` itself when the poses' stamps are
         on the same clock (a live camera); else (a bag played, on ``/clock`` or wall time, at
-        any rate) at the stamp of the last pose sent before it, once
-        the first pose sent after it has arrived, the spacing of the two its uncertainty
+        any rate) at the stamp of the last pose sent before it, once the first pose sent
+        after it has arrived, the spacing of the two its uncertainty
         (:attr:`Stretch.release_uncertainty_s`). A reading before any pose is the load
         hanging from the start.
 
