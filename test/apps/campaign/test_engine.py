@@ -115,13 +115,23 @@ def test_cli_campaign_writes_table_and_report(campaign_bags, tmp_path):
     assert code == 0 and '3 already done' in out and 'nan' not in out
 
 
-#: A process that starts a local cluster once it has said so (its imports done), and exits
-#: 130 when interrupted, as the lumpbeam command does.
+#: A process that starts a local cluster and is interrupted (a Ctrl-C to itself) as soon as
+#: the cluster's first worker process has started, and exits 130 when interrupted, as the
+#: lumpbeam command does.
 _INTERRUPTED_START = """
-import contextlib, sys
+import contextlib, os, signal, sys
+import multiprocessing.process
 from lumpbeam_ros.apps.campaign.engine import start_client
-import distributed
-print('starting', flush=True)
+
+start = multiprocessing.process.BaseProcess.start
+
+
+def start_then_interrupt(process):
+    start(process)
+    os.kill(os.getpid(), signal.SIGINT)
+
+
+multiprocessing.process.BaseProcess.start = start_then_interrupt
 try:
     with contextlib.ExitStack() as stack:
         start_client(None, 2, stack)
@@ -131,31 +141,12 @@ except KeyboardInterrupt:
 """
 
 
-def _interrupted_start(delay_s):
-    import signal
+def test_a_signal_while_the_cluster_starts_leaves_no_traceback():
     import subprocess
     import sys
-    import time
 
-    child = subprocess.Popen(
-        [sys.executable, '-c', _INTERRUPTED_START],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
+    child = subprocess.run(
+        [sys.executable, '-c', _INTERRUPTED_START], capture_output=True, text=True, timeout=120
     )
-    assert child.stdout.readline().strip() == 'starting'
-    time.sleep(delay_s)
-    child.send_signal(signal.SIGINT)
-    out, err = child.communicate(timeout=60)
-    return child.returncode, out, err
-
-
-def test_a_signal_while_the_cluster_starts_leaves_no_traceback():
-    # Inside the cluster's start: spawning two workers takes longer than these delays,
-    # unless the machine was quick; then a shorter delay is tried.
-    for delay_s in (0.2, 0.1, 0.05, 0.02):
-        code, out, err = _interrupted_start(delay_s)
-        if 'started' not in out:
-            break
-    assert 'started' not in out, 'the signal came after the start every time: no test'
-    assert code == 130 and 'Traceback' not in err, err
+    assert 'started' not in child.stdout, 'the signal came after the start: no test'
+    assert child.returncode == 130 and 'Traceback' not in child.stderr, child.stderr
