@@ -115,9 +115,9 @@ def test_cli_campaign_writes_table_and_report(campaign_bags, tmp_path):
     assert code == 0 and '3 already done' in out and 'nan' not in out
 
 
-#: A process that starts a local cluster and is interrupted (a Ctrl-C to itself) as soon as
-#: the cluster's first worker process has started, and exits 130 when interrupted, as the
-#: lumpbeam command does.
+#: A process that starts a local cluster of one worker and is interrupted (one Ctrl-C to
+#: itself) as soon as the worker's process has started, while the cluster waits for it; it
+#: exits 130 when interrupted, as the lumpbeam command does.
 _INTERRUPTED_START = """
 import contextlib, os, signal, sys
 import multiprocessing.process
@@ -128,13 +128,14 @@ start = multiprocessing.process.BaseProcess.start
 
 def start_then_interrupt(process):
     start(process)
+    multiprocessing.process.BaseProcess.start = start  # one Ctrl-C
     os.kill(os.getpid(), signal.SIGINT)
 
 
 multiprocessing.process.BaseProcess.start = start_then_interrupt
 try:
     with contextlib.ExitStack() as stack:
-        start_client(None, 2, stack)
+        start_client(None, 1, stack)
         print('started', flush=True)
 except KeyboardInterrupt:
     sys.exit(130)
