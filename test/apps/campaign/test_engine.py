@@ -146,8 +146,12 @@ def test_a_signal_while_the_cluster_starts_leaves_no_traceback():
     import subprocess
     import sys
 
-    child = subprocess.run(
-        [sys.executable, '-c', _INTERRUPTED_START], capture_output=True, text=True, timeout=120
-    )
-    assert 'started' not in child.stdout, 'the signal came after the start: no test'
+    # Rarely (a loaded machine) the start still ends before the interrupt is taken: again.
+    for _ in range(3):
+        child = subprocess.run(
+            [sys.executable, '-c', _INTERRUPTED_START], capture_output=True, text=True, timeout=120
+        )
+        if 'started' not in child.stdout:
+            break
+    assert 'started' not in child.stdout, 'the signal came after the start every time: no test'
     assert child.returncode == 130 and 'Traceback' not in child.stderr, child.stderr

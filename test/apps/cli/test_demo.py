@@ -26,8 +26,11 @@ def test_demo_runs_the_graph_end_to_end(demo_results, mcap_doctor):
     # machine), the prediction before it is shifted by the one lag that aligns it best (the
     # latency plus the /tip_load delivery delay: a Float64 has no stamp) and leaves a few
     # times the noise.
-    assert abs(summary['prediction_lag_s']) < 0.1 and summary['prediction_rms_m'] > 1e-3
     live = summary['live_diagnosis']
+    # Before the adoption (the whole record when none came), the hidden latency shows: over a
+    # millimetre. Adopted early in the ring-down, the whole record's gap can fall below it.
+    unadopted = live.get('prediction_before_rms_m') or summary['prediction_rms_m']
+    assert abs(summary['prediction_lag_s']) < 0.1 and unadopted > 1e-3
     after = live.get('prediction_after_rms_m')
     # The node dates the release by the poses sent around /tip_load (up to one pose early):
     # the rest of the timing stays in the gap.
