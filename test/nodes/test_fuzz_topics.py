@@ -133,12 +133,17 @@ def commands(draw: st.DrawFn) -> JointTrajectory:
     return msg
 
 
+def _capturing(node, publisher):
+    """The node, with what ``publisher`` would send kept in ``node.sent`` instead."""
+    node.sent = []
+    publisher.publish = node.sent.append
+    return node
+
+
 @pytest.fixture
 def shaper(ros_graph):
     node = ShaperNode(context=ros_graph.context)
-    node.sent = []
-    node._output.publish = node.sent.append
-    yield node
+    yield _capturing(node, node._output)
     node.destroy_node()
 
 
@@ -251,9 +256,7 @@ def _finite_when_ok(msg: DiagnosticArray) -> None:
 @pytest.fixture
 def identifier(ros_graph):
     node = IdentifierNode(context=ros_graph.context)
-    node.sent = []
-    node._output.publish = node.sent.append
-    yield node
+    yield _capturing(node, node._output)
     node.destroy_node()
 
 
@@ -336,9 +339,7 @@ def camera_messages(draw: st.DrawFn) -> tuple[str, bytes]:
 @pytest.fixture
 def camera(ros_graph):
     node = CameraNode(context=ros_graph.context)
-    node.sent = []
-    node.pose_publisher.publish = node.sent.append
-    yield node
+    yield _capturing(node, node.pose_publisher)
     node.destroy_node()
 
 
