@@ -137,7 +137,8 @@ class ShaperNode(SchemaNode):
             try:
                 arm = arm_from_status(status.level[0], pairs, self.nominal)
             except LumpbeamError as exc:
-                self.refuse(ARM_PARAMS, f'arm refused ({exc})', f'keeping {self.description}')
+                kept = f'keeping {self.description}' if self.workspace else 'moves go unshaped'
+                self.refuse(ARM_PARAMS, f'arm refused ({exc})', kept)
                 continue
             self._adopt_arm(arm, f'{ARM_PARAMS} ({status.message})')
 

@@ -131,8 +131,8 @@ def test_bad_options_stop_before_any_node_starts(tmp_path, capsys, argv, problem
 def test_the_workspace_demo_learns_the_arm_and_shapes_the_later_moves(tmp_path, capsys):
     out = tmp_path / 'results'
     code = main(['demo', '--workspace', '--out', str(out)])
-    printed = capsys.readouterr().out
-    assert code == 0, printed
+    printed, err = capsys.readouterr()
+    assert code == 0, f'{printed}\n{err}'
     summary = json.loads((out / 'summary.json').read_text())
     moves = summary['moves']
     assert len(moves) == 5 and moves[0]['shaped_by'] == 'unshaped'

@@ -119,11 +119,13 @@ class ArmLearner:
         self.ring_down_s = ring_down_s
         self.observations: list[ModeObservation] = []
         self._taken: float | None = None
+        self._determined = False  # a fit of the ring-downs kept was OK
 
     def clear(self) -> None:
         """Forgets the ring-downs (a clock jumping back)."""
         self.observations.clear()
         self._taken = None
+        self._determined = False
 
     def offer(self, rest: JointRest | None, result: Identification) -> ArmEstimate | None:
         """Takes the current ring-down's identification; fits when a ring-down is complete.
@@ -133,8 +135,9 @@ class ArmLearner:
             result: The identification of the window, from the rest's start.
 
         Returns:
-            A new estimate when this call took a ring-down (a WARN one, the ring-down left
-            out, when it has another number of joints than the arm), else ``None``.
+            A new estimate when this call took a ring-down, else ``None``. It is a WARN one,
+            the ring-down left out, when it has another number of joints than the arm or when
+            the arm was determined without it and is not with it (a mode read from noise).
         """
         if (
             rest is None
@@ -158,11 +161,39 @@ class ArmLearner:
             return None
         self._taken = rest.start_s
         self.observations.append(observation)
+        estimate = self.fit()
+        if self._determined and estimate.status != Status.OK:
+            # A mode read from the noise of a well shaped move must not undo what the
+            # ring-downs before it determined: that ring-down goes, the arm stays.
+            self.observations.pop()
+            estimate = ArmEstimate(
+                Status.WARN,
+                f'{observation.label} left out: with it, {estimate.message}',
+                len(self.observations),
+            )
+        self._determined = self._determined or estimate.status == Status.OK
         del self.observations[:-MAX_RING_DOWNS]
-        return self.fit()
+        return estimate
 
     def fit(self) -> ArmEstimate:
-        """The fit of every ring-down taken so far (WARN, with the reason, when it fails)."""
+        """The fit of every ring-down taken so far (WARN, with the reason, when it fails).
+
+        A fit whose values :func:`arm_from_status` would refuse (a std larger than its value,
+        say) is a WARN too: the shaper and the simulator refuse it, so it is never OK.
+        """
+        estimate = self._fit()
+        if estimate.status == Status.OK:
+            try:
+                arm_from_status(int(Status.OK), dict(estimate.key_values()), self.arm)
+            except LumpbeamError as exc:
+                return ArmEstimate(
+                    Status.WARN,
+                    f'not determined: {estimate.message}, but {exc}',
+                    estimate.ring_downs,
+                )
+        return estimate
+
+    def _fit(self) -> ArmEstimate:
         count = len(self.observations)
         try:
             if self.fit_payload:
