@@ -93,7 +93,8 @@ SRC is one of:
                        on --image-topic (default /camera/image_raw, else
                        /camera/image_raw/compressed); stamps from the messages, intrinsics
                        from --camera-info-topic. OUT is a copy of it plus /tip_pose (a
-                       /tip_pose already there is replaced).
+                       /tip_pose already there is replaced), without its images unless
+                       --keep-images.
   a video file         anything OpenCV reads (avi, mkv, mp4, ...); needs --fps or --timestamps.
   a folder of images   png, jpg, tif, bmp, pgm, ppm, read in file-name order (zero-pad the
                        numbers); needs --fps or --timestamps.
@@ -273,6 +274,11 @@ def add_track(parser: argparse.ArgumentParser) -> None:
         "board's frame)",
     )
     parser.add_argument('--json', metavar='FILE', help='also write the summary as JSON')
+    parser.add_argument(
+        '--keep-images',
+        action='store_true',
+        help="a bag's image topics are copied into OUT too (by default they are left out)",
+    )
 
 
 @_subcommand('analyze', help='identify frequency, damping and stiffness')

@@ -27,6 +27,9 @@ def summary_lines(summary: Any, src: str, out: str) -> list[str]:
         lines.append(f'  /tip_pose of {src} ({summary.replaced_poses} poses) replaced')
     if summary.skipped_topics:
         lines.append(f'  not copied (no type definition): {", ".join(summary.skipped_topics)}')
+    if summary.images_left_out:
+        images = ', '.join(summary.images_left_out)
+        lines.append(f'  not copied (images; --keep-images keeps them): {images}')
     if not math.isnan(summary.z_rms_um):
         lines.append(
             f'  vs /tip_pose_truth ({summary.compared} poses): z rms {summary.z_rms_um:.2f} um '
@@ -79,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
             summary = track_bag(
                 args.src, args.out, config, args.image_topic, args.camera_info_topic,
                 camera_info=info, camera_info_source=args.camera_info or '', progress=progress,
-                pose_model=args.pose_model,
+                pose_model=args.pose_model, keep_images=args.keep_images,
             )  # fmt: skip
         else:
             stamps = None
@@ -113,6 +116,7 @@ def run(args: argparse.Namespace) -> int:
                 'fps': summary.fps,
                 'replaced_poses': summary.replaced_poses,
                 'skipped_topics': summary.skipped_topics,
+                'images_left_out': summary.images_left_out,
                 'z_rms_um': summary.z_rms_um,
                 'z_bias_um': summary.z_bias_um,
                 'pitch_rms_mrad': summary.pitch_rms_mrad,

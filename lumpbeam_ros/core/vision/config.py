@@ -254,6 +254,13 @@ class TrackerSettings:
         'squares',
         _POSITIVE,
     )
+    max_depth_correction: float = setting(
+        'tracker.max_depth_correction',
+        0.03,
+        'the rig calibration may put the board at most this fraction off its configured '
+        'distance; farther, the board is not the one configured and every frame is refused',
+        bounds=_POSITIVE,
+    )
     tilt_prior_std_rad: float = setting(
         'tracker.tilt_prior_std_rad',
         5.0e-6,

@@ -1,20 +1,21 @@
 """The camera pipeline over recorded footage, offline: ``lumpbeam track SRC OUT``.
 
 From a bag (:func:`track_bag`), OUT is a copy of it plus ``/tip_pose``: every other topic is
-copied as its stored CDR bytes (never decoded), with its type, definition and offered QoS;
-the images (``sensor_msgs/Image`` or ``sensor_msgs/CompressedImage``) are tracked on the way
-and each pose is written right after its image, stamped with the image's stamp and logged at
-the image's log time. A ``/tip_pose`` already in the bag is replaced by the tracked one (the
-summary says so). ``/beam_markers`` (at most 30 Hz: the tracked tip and the checkerboard, for
-a viewer; :mod:`lumpbeam_ros.core.viz.markers`) is written beside the poses, replacing any the
-bag had. From a video or an image folder (:func:`track_footage`), OUT holds
-``/tip_pose`` and the ``/camera/camera_info`` used, stamped as the footage's stamps say.
-The frames go through the same :class:`~lumpbeam_ros.core.vision.session.TrackingSession` as the
-camera node's.
+copied as its stored CDR bytes (never decoded), with its type, definition and offered QoS,
+but the images (``sensor_msgs/Image`` or ``sensor_msgs/CompressedImage``, nearly all of a
+camera bag's bytes) only when asked. The images are tracked on the way and each pose is
+written at its image's log time (right after it, when kept), stamped with the image's stamp.
+A ``/tip_pose`` already in the bag is replaced by the tracked one (the summary says so).
+``/beam_markers`` (at most 30 Hz: the tracked tip and the checkerboard, for a viewer;
+:mod:`lumpbeam_ros.core.viz.markers`) is written beside the poses, replacing any the bag had.
+From a video or an image folder (:func:`track_footage`), OUT holds ``/tip_pose`` and the
+``/camera/camera_info`` used, stamped as the footage's stamps say. The frames go through the
+same :class:`~lumpbeam_ros.core.vision.session.TrackingSession` as the camera node's.
 
 A frame that does not decode is a lost frame (counted, and the first of each kind named in
 the summary); an image whose size is not the camera's stops the run with an error, and OUT,
-incomplete, is removed; so is OUT when no frame gave a pose, or when the run is interrupted.
+incomplete, is removed; so is OUT when no frame gave a pose, when the run is interrupted, or
+when the poses are more than :data:`MAX_TRUTH_GAP_M` from the bag's ``/tip_pose_truth``.
 """
 
 from __future__ import annotations
@@ -72,6 +73,11 @@ CAMERA_INFO_TOPIC = CAMERA_INFO
 #: Rate of ``/beam_markers`` in OUT, Hz: at most one array per period of it.
 MARKERS_RATE_HZ = 30.0
 
+#: The largest z RMS against ``/tip_pose_truth`` a run may end with, m. The tracker is good
+#: to microns; a centimetre means a rig other than the one filmed (an arm's board, placed
+#: where that arm rests, tracked with the beam's camera file was 641 mm off).
+MAX_TRUTH_GAP_M = 0.01
+
 #: Called after each frame with the frames done and the frames expected (``None``: unknown).
 ProgressCallback = Callable[[int, 'int | None'], None]
 
@@ -87,6 +93,7 @@ class TrackSummary:
         fps: Frames tracked per second of tracking (decoding included, copying not).
         replaced_poses: Messages of BAG's own ``/tip_pose`` that were dropped (0: none).
         skipped_topics: Topics not copied (a type without a definition in BAG).
+        images_left_out: Image topics not copied (``keep_images`` not set).
         z_rms_um: RMS error of z against ``/tip_pose_truth``, um (NaN without truth).
         pitch_rms_mrad: RMS error of the pitch against the truth, mrad (NaN without).
         z_bias_um: Mean z error against the truth, um (NaN without).
@@ -101,6 +108,7 @@ class TrackSummary:
     fps: float = float('nan')
     replaced_poses: int = 0
     skipped_topics: list[str] = field(default_factory=list)
+    images_left_out: list[str] = field(default_factory=list)
     z_rms_um: float = float('nan')
     pitch_rms_mrad: float = float('nan')
     z_bias_um: float = float('nan')
@@ -122,13 +130,18 @@ def _definitions(reader: BagReader) -> dict[str, tuple[str, str]]:
     }
 
 
-def _declare_copies(reader: BagReader, out: BagWriter, summary: TrackSummary) -> set[str]:
+def _declare_copies(
+    reader: BagReader, out: BagWriter, summary: TrackSummary, keep_images: bool
+) -> set[str]:
     """Declares BAG's topics (but ``/tip_pose``, ``/beam_markers``) in OUT; returns the copied."""
     definitions: dict[str, tuple[str, str]] | None = None
     copied = set()
     for name, entry in reader.topics.items():
         if name in (POSE_TOPIC, MARKERS_TOPIC):
             continue  # written anew from the tracked poses
+        if entry.msgtype in IMAGE_TYPES and not keep_images:
+            summary.images_left_out.append(name)
+            continue
         msgdef = None
         if not is_known(entry.msgtype):
             definitions = _definitions(reader) if definitions is None else definitions
@@ -331,8 +344,9 @@ def track_bag(
     camera_info_source: str = '',
     progress: ProgressCallback | None = None,
     pose_model: str = 'plane',
+    keep_images: bool = False,
 ) -> TrackSummary:
-    """Tracks a bag's images and writes OUT = BAG + ``/tip_pose``.
+    """Tracks a bag's images and writes OUT = BAG + ``/tip_pose`` (the images only if asked).
 
     Args:
         bag: The input bag folder.
@@ -347,13 +361,15 @@ def track_bag(
         camera_info_source: Where ``camera_info`` came from, for messages.
         progress: Called after each image.
         pose_model: ``'plane'`` or ``'free'`` (the full 6-DoF pose is written).
+        keep_images: Also copy BAG's image topics.
 
     Returns:
         The summary.
 
     Raises:
         BagError: OUT exists; BAG is not a bag, has no images or no camera info.
-        FootageError: An image of another size than the camera info says.
+        FootageError: An image of another size than the camera info says, or poses more
+            than :data:`MAX_TRUTH_GAP_M` from the bag's ``/tip_pose_truth``.
         LumpbeamError: The camera info is unusable (e.g. K = 0).
     """
     out = Path(out)
@@ -379,7 +395,7 @@ def track_bag(
         with BagWriter(out) as writer:
             name = str(reader.path)
             run = _Run(session, writer, name, camera_info_source, entry.count, progress)
-            copied = _declare_copies(reader, writer, run.summary)
+            copied = _declare_copies(reader, writer, run.summary, keep_images)
             items = bag_frames(
                 reader, session, image_topic, entry.msgtype, camera_info_topic,
                 follow_info=follow_info,
@@ -406,6 +422,13 @@ def track_bag(
     summary.image_topic = image_topic
     if TRUTH_TOPIC in reader.topics and summary.poses:
         _compare_with_truth(out, summary)
+        if summary.z_rms_um > MAX_TRUTH_GAP_M * 1e6:
+            shutil.rmtree(out, ignore_errors=True)
+            raise FootageError(
+                f'{reader.path}: the tracked tip is {summary.z_rms_um * 1e-3:.1f} mm (z RMS) '
+                f'from {TRUTH_TOPIC}: the board or the rig of the camera file is not the one '
+                f'filmed; {out} removed'
+            )
     return summary
 
 

@@ -73,6 +73,7 @@ class TrackStatus(str, Enum):
     POSE_REJECTED = 'pose_rejected'
     TOO_FEW_CORNERS = 'too_few_corners'
     NO_CAMERA_INFO = 'no_camera_info'
+    RIG_MISMATCH = 'rig_mismatch'
 
 
 @dataclass(frozen=True)
@@ -148,6 +149,10 @@ class TipTracker:
         self._object_xy = self._board.object_points()[:, :2]
         self._calibration: RigCalibration | None = None
         self._set_rig(config.rig)
+        self._configured_distance_m = self._board_distance_m
+        # Why every frame is refused, once the board seen is found not to be the one
+        # configured: its poses would be scaled by the ratio of the squares (a wrong value).
+        self._mismatch = ''
         self._pending: list[tuple[np.ndarray, np.ndarray]] = []
         self._whole_board_coverage: str | None = None
         self.reset()
@@ -158,6 +163,7 @@ class TipTracker:
         centre = rig.base_board.translation
         reference = np.array([centre[0], centre[2], 0.0])
         camera_board = camera_board_transform(rig, reference)
+        self._board_distance_m = float(camera_board.translation[2])
         # The free model needs no reference pose: with identity extrinsics (the camera's
         # pose in the board's frame) the detector's corners set the window instead.
         self._window_from_detection = camera_board.translation[2] <= 0
@@ -218,6 +224,8 @@ class TipTracker:
                 return _failure(stamp, TrackStatus.BAD_IMAGE, problem)
             if not math.isfinite(stamp):
                 return _failure(stamp, TrackStatus.BAD_IMAGE, f'stamp {stamp!r} is not finite')
+            if self._mismatch:
+                return _failure(stamp, TrackStatus.RIG_MISMATCH, self._mismatch)
             exposure = self._check_exposure(gray)
             if exposure is not None:
                 self.reset()
@@ -560,6 +568,11 @@ class TipTracker:
                 self._calibrate()
             elif len(self._pending) == 1 and self.pose_model == 'plane':
                 fit = self._calibrate_depth(ideal, fit)
+            if self._mismatch:
+                return _failure(
+                    stamp, TrackStatus.RIG_MISMATCH, self._mismatch, corners=corners,
+                    detected=detected,
+                )  # fmt: skip
         pose, covariance, pose6, covariance6 = fit.pose, fit.covariance, None, None
         if self.pose_model == 'free':
             pose6, covariance6 = fit.pose, fit.covariance
@@ -613,12 +626,31 @@ class TipTracker:
         except LumpbeamError:
             return fit
         self._set_rig(early.rig)
+        self._check_distance()
         refit = self._model.fit(ideal, fit.pose)
         if not refit.converged:
             return fit
         self._history[-1] = (self._history[-1][0], self._history[-1][1], refit.pose)
         self._pending[-1] = (ideal, refit.pose)
         return refit
+
+    def _check_distance(self) -> None:
+        """Refuses the footage when the board's squares put it far from where it is configured.
+
+        The squares' known size gives the board's distance (the calibration's depth); the
+        tip's in-plane pose scales with it. A board of another square size than the
+        configured one (or a rig measured that far off) would give every pose scaled by
+        the ratio: a 50 mm square taken for 60 mm moved the tip by 7.7 mm.
+        """
+        configured, seen = self._configured_distance_m, self._board_distance_m
+        limit = self.settings.max_depth_correction
+        if abs(seen / configured - 1.0) > limit:
+            self._mismatch = (
+                f"the board's squares put it {seen:.3f} m from the camera, the configuration "
+                f'{configured:.3f} m (more than {100 * limit:g} % apart): a board of another '
+                f'square size than {self._board.square_size_m:g} m, or the rig measured wrong; '
+                'every frame is refused'
+            )
 
     def _calibrate(self) -> None:
         pixels = [p for p, _ in self._pending]
@@ -633,6 +665,7 @@ class TipTracker:
             return  # keep the configured rig and try again with the next frames
         self._calibration = calibration
         self._set_rig(calibration.rig)
+        self._check_distance()
         # The last pose was fitted with the old rig; re-fit it so the velocity is consistent.
         t1, corners1, _ = self._history[-1]
         refit = self._model.fit(pixels[-1], poses[-1])

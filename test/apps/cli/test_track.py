@@ -21,24 +21,28 @@ def bag(tmp_path_factory):
     return path
 
 
-def test_out_is_the_bag_plus_tracked_poses(bag, tmp_path, capsys):
+@pytest.mark.parametrize('keep_images', [False, True], ids=['default', 'keep-images'])
+def test_out_is_the_bag_plus_tracked_poses(bag, tmp_path, capsys, keep_images):
     out = tmp_path / 'out'
-    assert main(['track', str(bag), str(out), '--json', str(tmp_path / 'r.json')]) == 0
+    options = ['--json', str(tmp_path / 'r.json')] + ['--keep-images'] * keep_images
+    assert main(['track', str(bag), str(out), *options]) == 0
     text = capsys.readouterr().out
     assert 'tracked' in text and '415 frames, 415 poses, 0 lost' in text
     assert '/tip_pose of' in text and '(415 poses) replaced' in text
     original, copy = BagReader(bag), BagReader(out)
-    assert set(copy.topics) == set(original.topics)
-    for name, entry in original.topics.items():
-        assert copy.topics[name].count == entry.count
-        assert copy.topics[name].qos == entry.qos
-    for topic in ('/camera/image_raw', '/tip_load'):
+    left_out = set() if keep_images else {'/camera/image_raw'}
+    assert set(copy.topics) == set(original.topics) - left_out
+    assert ('--keep-images keeps them): /camera/image_raw' in text) is not keep_images
+    for name in copy.topics:
+        assert copy.topics[name].count == original.topics[name].count
+        assert copy.topics[name].qos == original.topics[name].qos
+    for topic in {'/camera/image_raw', '/tip_load'} - left_out:
         before = [bytes(m.data) for m in original.iter_raw([topic])]
         after = [bytes(m.data) for m in copy.iter_raw([topic])]
         assert before == after
     tracked, noisy = read_tip_poses(out), read_tip_poses(bag)
     truth = read_tip_poses(out, '/tip_pose_truth')
-    np.testing.assert_array_equal(tracked.t, [f.t for f in iter_images(out)])
+    np.testing.assert_array_equal(tracked.t, [f.t for f in iter_images(bag)])
     assert tracked.frame_id == 'beam_base'
     # The tracked poses replaced the bag's noisy ones: they sit on the truth.
     assert np.max(np.abs(noisy.z - tracked.z)) > 40e-6
@@ -46,6 +50,7 @@ def test_out_is_the_bag_plus_tracked_poses(bag, tmp_path, capsys):
     result = json.loads((tmp_path / 'r.json').read_text())
     assert result['frames'] == result['poses'] == 415 and result['lost'] == 0
     assert result['replaced_poses'] == 415 and result['fps'] > 0
+    assert result['images_left_out'] == sorted(left_out)
     assert 0 < result['z_rms_um'] < 30
     assert f'z rms {result["z_rms_um"]:.2f} um' in text
 

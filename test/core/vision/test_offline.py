@@ -94,8 +94,32 @@ def bag(frames, config, tmp_path_factory):
 def tracked(bag, no_calibration, tmp_path_factory):
     out = tmp_path_factory.mktemp('tracked') / 'out'
     calls = []
-    summary = track_bag(bag, out, no_calibration, progress=lambda *a: calls.append(a))
+    summary = track_bag(
+        bag, out, no_calibration, progress=lambda *a: calls.append(a), keep_images=True
+    )
     return out, summary, calls
+
+
+def test_the_images_are_left_out_unless_kept(bag, no_calibration, tmp_path):
+    summary = track_bag(bag, tmp_path / 'out', no_calibration)
+    assert summary.images_left_out == [IMAGE] and summary.poses == 8
+    copy = BagReader(tmp_path / 'out')
+    assert IMAGE not in copy.topics and {CAMERA_INFO, TIP_LOAD, '/reading'} <= set(copy.topics)
+    images = [r.log_time_ns for r in BagReader(bag).iter_raw([IMAGE])]
+    assert [r.log_time_ns for r in copy.iter_raw([TIP_POSE])] == images
+
+
+def test_poses_far_from_the_truth_are_refused(bag, no_calibration, tmp_path):
+    """The camera file of another rig: the board placed 50 mm higher than filmed."""
+    rig = no_calibration.rig
+    board = dataclasses.replace(
+        rig.base_board, translation=rig.base_board.translation + np.array([0.0, 0.0, 0.05])
+    )
+    other = dataclasses.replace(no_calibration, rig=dataclasses.replace(rig, base_board=board))
+    with pytest.raises(FootageError, match=r'50\.0 mm \(z RMS\) from /tip_pose_truth') as info:
+        track_bag(bag, tmp_path / 'out', other)
+    assert '\n' not in str(info.value)
+    assert not (tmp_path / 'out').exists()
 
 
 def test_every_frame_gives_a_pose_on_the_truth(tracked):

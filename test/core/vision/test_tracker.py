@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from lumpbeam_lab.camera.accuracy import render_frames, tracker_config
+from lumpbeam_ros.core.vision.config import with_board
 from lumpbeam_ros.core.vision.pose import PlaneModel
 from lumpbeam_ros.core.vision.tracker import TipTracker, TrackStatus
 
@@ -139,6 +140,22 @@ def test_a_wrong_board_distance_is_corrected_from_the_first_frame(config, frames
     assert all(r.ok and not r.calibrated for r in results)
     errors = np.array([r.pose - f.truth for r, f in zip(results, frames[:5], strict=True)])
     assert np.max(np.abs(errors[:, :2])) < 20e-6
+
+
+@pytest.mark.parametrize(('square_m', 'seen_m'), [(0.05, 0.792), (0.08, 1.267), (0.0595, None)])
+def test_a_board_of_another_square_size_is_refused_not_scaled(config, frames, square_m, seen_m):
+    """The 60 mm squares taken for another size: every pose would be scaled by the ratio."""
+    believed = with_board(config, square_size_m=square_m)
+    tracker = TipTracker(config.camera_info, believed)
+    results = [tracker.process(f.image, f.stamp) for f in frames[:3]]
+    if seen_m is None:  # 0.8 % off: within the configured distance's tolerance
+        assert all(r.ok for r in results)
+        return
+    assert [r.status for r in results] == [TrackStatus.RIG_MISMATCH] * 3
+    assert all(r.pose is None for r in results)
+    assert f"the board's squares put it {seen_m:.3f} m from the camera, the configuration " \
+        '0.950 m (more than 3 % apart)' in results[0].reason  # fmt: skip
+    assert results[1].reason == results[0].reason
 
 
 @pytest.fixture(scope='module')
