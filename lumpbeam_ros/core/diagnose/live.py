@@ -131,12 +131,16 @@ class Stretch:
         release_s: The load change it follows (NaN for a window without one).
         release_uncertainty_s: How early the load change may be dated, s (the poses'
             spacing around it when it was dated through them, else 0).
+        release_lead_s: How much later than ``release_s`` the send times put it, s: the
+            reading's send time interpolated between those of the poses sent around it
+            (within ``[0, release_uncertainty_s]``; exact for a player on time).
     """
 
     start_s: float
     end_s: float
     release_s: float
     release_uncertainty_s: float = 0.0
+    release_lead_s: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -212,7 +216,9 @@ def diagnose_live(record: Record, beam: BeamParameters, stretch: Stretch) -> Liv
     """Runs the offline workflow on one stretch (in a worker: it takes seconds).
 
     A sensor latency no longer than the release's dating uncertainty is not named: the
-    verdict is ``none``, saying why (the gaps are the workflow's).
+    verdict is ``none``, saying why (the gaps are the workflow's). A longer one is named less
+    the release's lead (:attr:`Stretch.release_lead_s`): the workflow sees the release where
+    it was dated, up to a pose's spacing early, and that much of the delay is the dating's.
 
     Args:
         record: The stretch as a record.
@@ -240,6 +246,9 @@ def diagnose_live(record: Record, beam: BeamParameters, stretch: Stretch) -> Liv
             f'the delay found, {latency * 1e3:.2f} ms, is within how late the release may be '
             f'dated ({stretch.release_uncertainty_s * 1e3:.2f} ms: /tip_load has no stamp)'
         )
+    elif len(named) == 1 and stretch.release_lead_s > 0.0 and math.isfinite(latency):
+        ((name, parameters),) = named
+        named = ((name, {**parameters, 'latency_s': latency - stretch.release_lead_s}),)
     return LiveDiagnosis(
         missing_effect=missing,
         missing_effects=named,
@@ -308,7 +317,8 @@ class LiveBuffer:
         self._done_until = -math.inf  # stretches ending here or before were handed out
         # The recent measured poses' stamps, and when they were sent minus their stamps, s.
         self._sent_after_stamp: deque[tuple[float, float]] = deque(maxlen=DATING_POSES)
-        self._dating_s: dict[float, float] = {}  # a load change's time: its uncertainty
+        # A load change's time: its dating's uncertainty and lead (Stretch), s.
+        self._dating_s: dict[float, tuple[float, float]] = {}
         # (sent, kg) of the loads to date; bounded for a stream of loads without poses.
         self._undated: deque[tuple[float, float]] = deque(maxlen=DATING_POSES)
 
@@ -370,15 +380,16 @@ class LiveBuffer:
         on the same clock (a live camera); else (a bag played, on ``/clock`` or wall time, at
         any rate) at the stamp of the last pose sent before it, once the first pose sent
         after it has arrived, the spacing of the two its uncertainty
-        (:attr:`Stretch.release_uncertainty_s`). A reading before any pose is the load
-        hanging from the start.
+        (:attr:`Stretch.release_uncertainty_s`) and its send time interpolated between
+        theirs its lead (:attr:`Stretch.release_lead_s`). A reading before any pose is the
+        load hanging from the start.
 
         Args:
             sent_s: When the reading was sent (as ``sent_s`` of :meth:`push_measured`), s.
             kg: Mass at the tip, kg.
         """
         if not self.measured_count:
-            self._add_load(-math.inf, kg, 0.0)
+            self._add_load(-math.inf, kg)
         elif (
             self._sent_after_stamp
             and abs(self._sent_after_stamp[-1][1]) > self.settings.reset_jump_back_s
@@ -387,7 +398,7 @@ class LiveBuffer:
             # delivered out of step, a backlog of poses behind the load).
             self._undated.append((sent_s, kg))
         else:
-            self._add_load(sent_s, kg, 0.0)
+            self._add_load(sent_s, kg)
 
     def _date_loads_sent_before(self, sent_s: float) -> None:
         """Dates the load readings sent before the pose sent at ``sent_s``.
@@ -395,26 +406,27 @@ class LiveBuffer:
         A player sends in the bag's order however late it runs: a reading falls between the
         stamps of the poses sent just before and just after it. It is dated at the first (a
         release dated late would show as a negative delay, which no sensor has), the gap to
-        the second its uncertainty.
+        the second its uncertainty, and where its send time falls between theirs its lead.
         """
         while self._undated and self._undated[0][0] < sent_s:
             sent_load, kg = self._undated.popleft()
-            stamps = [t for t, _ in self._sent_after_stamp]
-            before = [t for t, ahead in self._sent_after_stamp if t + ahead <= sent_load]
-            after = next(t for t, ahead in self._sent_after_stamp if t + ahead > sent_load)
-            dated = before[-1] if before else stamps[0]
-            self._add_load(dated, kg, after - dated)
+            sent = [(t, t + ahead) for t, ahead in self._sent_after_stamp]
+            before = [pair for pair in sent if pair[1] <= sent_load]
+            after, sent_after = next(pair for pair in sent if pair[1] > sent_load)
+            dated, sent_before = before[-1] if before else (sent[0][0], sent_load)
+            share = (sent_load - sent_before) / (sent_after - sent_before)
+            self._add_load(dated, kg, after - dated, min(max(share, 0.0), 1.0) * (after - dated))
 
-    def _add_load(self, t: float, kg: float, uncertainty: float) -> None:
+    def _add_load(self, t: float, kg: float, uncertainty: float = 0.0, lead: float = 0.0) -> None:
         if self.loads and (t < self.loads[-1][0] or t == -math.inf):
             self.loads.clear()
         if not self.loads or kg != self.loads[-1][1]:
             self.loads.append((t, kg))
-            self._dating_s[t] = uncertainty
+            self._dating_s[t] = (uncertainty, lead)
         # The reading in force keep_s before the newest pose is the oldest one needed.
         while len(self.loads) > 1 and self.loads[1][0] <= self.latest_s - self.settings.keep_s:
             del self.loads[0]
-        self._dating_s = {when: self._dating_s.get(when, 0.0) for when, _ in self.loads}
+        self._dating_s = {when: self._dating_s.get(when, (0.0, 0.0)) for when, _ in self.loads}
 
     def clear(self) -> None:
         """Forgets everything (the clock went back); the counts are kept."""
@@ -464,8 +476,8 @@ class LiveBuffer:
             if ring_down_end is None:
                 return None
             self._done_until = ring_down_end
-            uncertainty = self._dating_s.get(release, 0.0)
-            return Stretch(release - s.pre_release_s, ring_down_end, release, uncertainty)
+            uncertainty, lead = self._dating_s.get(release, (0.0, 0.0))
+            return Stretch(release - s.pre_release_s, ring_down_end, release, uncertainty, lead)
         return None
 
     def _ring_down_end(self, release: float, latest: float) -> float | None:

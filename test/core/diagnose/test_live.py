@@ -310,6 +310,29 @@ def test_a_latency_within_the_release_dating_is_not_named(uncertainty_s, verdict
         assert result.reason.startswith('the delay found, 1.0') and 'no stamp' in result.reason
 
 
+@pytest.mark.parametrize('load_sent_s', [-1e-4, 1e-4], ids=['before-its-pose', 'after-it'])
+def test_a_latency_past_the_dating_is_named_less_the_releases_lead(load_sent_s):
+    """A player sends the release a hair before or after the pose of the same stamp.
+
+    Sent before, the release is dated a pose's spacing early: the workflow's delay is
+    then the sensor's 15 ms plus 5.6 ms, the lead its send time gives back.
+    """
+    beam, _, t, z, pitch = _stream(effects={'sensor_latency': 0.015})
+
+    def late_s(i):
+        return load_sent_s if i < 0 else 0.0
+
+    _, found = _played(SETTINGS, t, z, pitch, clock_ahead_s=3600.0, late_s=late_s)
+    ((stretch, record),) = found
+    early = RELEASE_S - stretch.release_s
+    assert early == pytest.approx(1 / 180 if load_sent_s < 0 else 0.0, abs=1e-9)
+    assert stretch.release_lead_s == pytest.approx(early, abs=2e-4)
+    result = diagnose_live(record, beam, stretch)
+    assert result.missing_effect == 'sensor_latency'
+    ((name, parameters),) = result.missing_effects
+    assert parameters['latency_s'] == pytest.approx(0.015, abs=2e-4)
+
+
 def test_a_load_delivered_ahead_of_a_backlog_of_poses_is_dated_when_they_arrive():
     _, _, t, z, pitch = _stream()
     buffer = LiveBuffer(SETTINGS)
