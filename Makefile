@@ -17,7 +17,7 @@ export ROS_HOME := $(CURDIR)/.cache/ros
 export ROS_AUTOMATIC_DISCOVERY_RANGE ?= LOCALHOST
 export PYTHONDONTWRITEBYTECODE :=
 
-.PHONY: venv dev demo test test-slow fuzz lint typecheck bench docs clean
+.PHONY: venv dev demo test test-opencv-lowest test-slow fuzz lint typecheck bench docs clean
 
 # One pip run: the venv's own pip installs these wheels as well as a newer one would, so it
 # is not upgraded first (about 5 s). --no-compile: Python compiles a module when it is first
@@ -47,12 +47,30 @@ demo: venv
 PYTEST_WORKERS ?= auto
 PYTEST_PARALLEL := -n $(PYTEST_WORKERS) --maxprocesses=4 --dist loadscope
 
+# The lowest OpenCV setup.py accepts (its [vision] lower bound): the venv holds the newest,
+# and the tests that use OpenCV run again on this one, installed alone into .cache and put
+# first on the path.
+OPENCV_LOWEST := $(shell sed -n "s/.*'opencv-python-headless>=\([0-9.]*\),.*/\1/p" setup.py)
+OPENCV_LOWEST_DIR := .cache/opencv-$(OPENCV_LOWEST)
+OPENCV_TESTS := test/core/vision test/apps/cli/test_track.py test/apps/cli/test_track_sources.py \
+	test/test_calibrate_real_photos.py test/test_setup.py::test_opencv_is_within_the_declared_range
+
+$(OPENCV_LOWEST_DIR)/.stamp: setup.py
+	$(BIN)/python -m pip install -q --disable-pip-version-check --no-compile --no-deps \
+		--target $(OPENCV_LOWEST_DIR) 'opencv-python-headless==$(OPENCV_LOWEST).*'
+	@touch $@
+
+test-opencv-lowest: dev $(OPENCV_LOWEST_DIR)/.stamp
+	PYTHONPATH=$(OPENCV_LOWEST_DIR) $(BIN)/python -m pytest $(PYTEST_PARALLEL) -m 'not slow' \
+		-p no:cacheprovider $(OPENCV_TESTS)
+
 # pytest also builds the documentation site (mkdocs build --strict) and checks its links
 # (test/test_docs.py).
 test: dev
 	$(BIN)/ruff check .
 	$(BIN)/mypy
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL)
+	$(MAKE) --no-print-directory test-opencv-lowest
 
 # The long validation matrices (marked slow): CI runs them after `make test`. The computing
 # ones run in parallel; the live graphs among them (marked ros) then run alone, on a machine

@@ -12,7 +12,9 @@ REQUIRES = ['setuptools', 'numpy', 'scipy', 'pyyaml', 'threadpoolctl', 'rosbags'
 
 #: The rest, by what it serves (lumpbeam_ros/apps/cli/dependencies.py names them when missing).
 EXTRAS = {
-    'vision': ['opencv-python-headless'],
+    # The lowest (make test runs the vision tests on it too: 4.10 is the first built for
+    # NumPy 2) to the newest major the tests run on.
+    'vision': ['opencv-python-headless>=4.10,<6'],
     'ros': ['ros-jazzy-rclpy[fastrtps]', 'ros-jazzy-common-interfaces'],
     'plots': ['matplotlib'],
     # lumpbeam campaign: the Dask cluster and the Parquet/CSV table.

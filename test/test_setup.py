@@ -95,3 +95,14 @@ def test_the_distribution_carries_the_readme():
     assert (ROOT / 'README.md').read_text(encoding='utf-8').splitlines()[0] in (
         metadata.get_payload() or metadata['Description']
     )
+
+
+def test_opencv_is_within_the_declared_range():
+    """Run on the venv's OpenCV (the newest) and on the lowest (``make test-opencv-lowest``)."""
+    import cv2
+    from packaging.requirements import Requirement
+
+    declared = [Requirement(r) for r in importlib.metadata.requires(PACKAGE) or []]
+    ranges = {r.specifier for r in declared if r.name == 'opencv-python-headless'}
+    assert len(ranges) == 1  # [vision] and [all] alike
+    assert cv2.__version__ in ranges.pop(), cv2.__version__

@@ -256,7 +256,9 @@ class CameraInfo:
         pts = np.ascontiguousarray(target).reshape(-1, 1, 2)
         if self.distortion_model == EQUIDISTANT:
             xy = cv2.fisheye.undistortPoints(pts, _EYE, self.d, criteria=criteria)
-        else:
+        elif hasattr(cv2, 'undistortPointsIter'):  # OpenCV 4: the variant with criteria
+            xy = cv2.undistortPointsIter(pts, _EYE, self.d, None, None, criteria)
+        else:  # OpenCV 5 folded it into undistortPoints
             xy = cv2.undistortPoints(pts, _EYE, self.d, None, None, None, criteria)
         xy = xy.reshape(-1, 2)
         if not np.all(np.isfinite(xy)):

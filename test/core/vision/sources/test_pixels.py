@@ -22,7 +22,9 @@ def test_bayer_patterns_follow_the_ros_names(encoding):
     luma = 0.299 * 200 + 0.587 * 100 + 0.114 * 50
     swapped = 0.299 * 50 + 0.587 * 100 + 0.114 * 200
     centre = grey[4:-4, 4:-4].astype(float)
-    assert np.all(np.abs(centre - luma) <= 1.0), (centre.min(), centre.max(), swapped)
+    # OpenCV 4's demosaic rounds 1 DN lower than OpenCV 5's (123 and 124 for 124.2); a
+    # swap is 28 DN off.
+    assert np.all(np.abs(centre - luma) <= 1.5), (centre.min(), centre.max(), swapped)
 
 
 def test_bayer_demosaic_keeps_full_resolution_edges():
