@@ -10,7 +10,7 @@ from lumpbeam_lab.bench.tracker import run
 @pytest.mark.slow
 def test_quick_run_reports_speed_accuracy_and_end_to_end_against_same_run_baselines():
     assert 'tracker' in available_suites()
-    speed, accuracy, shm = run(quick=True)
+    speed, versus, accuracy, shm = run(quick=True)
     assert speed.name == 'tracker_fps_640x480_distorted'
     assert speed.value > 0 and speed.baseline_value > 0
     assert abs(speed.ratio - speed.value / speed.baseline_value) < 1e-9
@@ -25,6 +25,13 @@ def test_quick_run_reports_speed_accuracy_and_end_to_end_against_same_run_baseli
     assert speed.details['target'] == f'{verdict} (>= 180 fps and >= 10x)'
     # Free PnP per frame errs far more than the tracker, on the same distorted frames.
     assert speed.details['baseline_z_rms_um'] > 5 * speed.details['z_rms_um']
+    # OpenCV's best pipeline on the same frames: both axes, side by side.
+    assert versus.name == 'tracker_vs_opencv_plane_640x480'
+    assert abs(versus.ratio - versus.value / versus.baseline_value) < 1e-9
+    assert versus.details['poses'] == versus.details['opencv_poses'] == 45
+    lead = versus.details['opencv_z_rms_um'] / versus.details['z_rms_um']
+    assert versus.details['accuracy_lead'] == pytest.approx(lead)
+    assert 0 < versus.details['z_rms_um'] < 20 and versus.details['opencv'].count('.') == 2
     assert accuracy.name == 'tracker_z_rms_640x480' and accuracy.unit == 'um'
     assert 0 < accuracy.value < 20 and accuracy.details['frames_lost'] == 0
     assert accuracy.details['frames'] == 109
