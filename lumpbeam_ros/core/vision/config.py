@@ -200,6 +200,14 @@ class TrackerSettings:
         # A window reaching the neighbouring corner pulls the estimate toward it.
         bounds=Bounds(0.0, 0.5, low_open=True, high_open=True),
     )
+    max_window_px: int = setting(
+        'tracker.max_window_px',
+        12,
+        "the refinement window's largest half-size: a larger one averages more of the image "
+        'into each corner, at a cost that grows with its area',
+        'px',
+        Bounds(3, 40),
+    )
     max_homography_residual_px: float = setting(
         'tracker.max_homography_residual_px',
         1.0,

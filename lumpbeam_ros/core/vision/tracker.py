@@ -61,14 +61,6 @@ from lumpbeam_ros.core.vision.reprojection import PoseFit, sorted_median
 ENCODINGS = ('mono8', 'bgr8', 'rgb8')
 
 
-#: The refinement window's largest half-size, px. The corners' noise falls with the window:
-#: OpenCV's own pipeline (``cornerSubPix`` at 11 px, then the same plane fit) left 1.74 um of
-#: z RMS at 1024 x 1024 where this tracker had 2.47 um at 5 px; 12 px matches or beats it at
-#: 1024 and 2048 (``lumpbeam bench --only tracker``, rows ``tracker_vs_opencv_plane``),
-#: at about twice the refinement time of 5 px.
-MAX_HALF_WINDOW_PX = 12
-
-
 class TrackStatus(str, Enum):
     """Why a frame did or did not give a pose."""
 
@@ -187,7 +179,8 @@ class TipTracker:
 
     def _window_for(self, corners: np.ndarray) -> int:
         spacing = np.median(np.linalg.norm(np.diff(corners, axis=0), axis=1))
-        return int(np.clip(round(self.settings.window_fraction * spacing), 3, MAX_HALF_WINDOW_PX))
+        largest = self.settings.max_window_px
+        return int(np.clip(round(self.settings.window_fraction * spacing), 3, largest))
 
     @property
     def calibration(self) -> RigCalibration | None:
