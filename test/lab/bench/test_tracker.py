@@ -1,9 +1,11 @@
+import dataclasses
 import math
 
 import pytest
 
 from lumpbeam_lab.bench.runner import available_suites
-from lumpbeam_lab.bench.tracker import run
+from lumpbeam_lab.bench.tracker import run, versus_opencv_raycast
+from lumpbeam_lab.camera.validation import matrix_cases
 
 
 # Three timed tracking runs and a camera node over shared memory: make test-slow runs it.
@@ -44,3 +46,13 @@ def test_quick_run_reports_speed_accuracy_and_end_to_end_against_same_run_baseli
     assert shm.details['poses_received'] > 0
     assert shm.details['latency_p50_ms'] > 0
     assert math.isfinite(shm.ratio)
+
+
+@pytest.mark.slow
+def test_the_independent_renderer_gives_the_same_side_by_side_row():
+    case = dataclasses.replace(matrix_cases()[1], frame_step=6)
+    row = versus_opencv_raycast(case, repeat=1)
+    assert row.name == 'tracker_vs_opencv_plane_raycast_1024x1024_distorted'
+    assert row.details['poses'] == row.details['opencv_poses'] == row.details['frames'] == 25
+    assert 0 < row.details['z_rms_um'] < 20 and 0 < row.details['opencv_z_rms_um'] < 20
+    assert row.ratio == pytest.approx(row.value / row.baseline_value)
