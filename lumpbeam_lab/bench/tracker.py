@@ -12,9 +12,13 @@ and the camera node is run end to end through ROS topics between processes
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
+import tempfile
 import time
 from collections.abc import Sequence
 from dataclasses import replace
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -333,6 +337,68 @@ def _versus(
     )  # fmt: skip
 
 
+#: The end-to-end target of ``lumpbeam track``: times the plain script's frame rate.
+TRACK_TARGET_RATIO = 2.0
+
+
+def _wall_s(command: list[str]) -> float:
+    """Wall time of a command run to its end, s (it must succeed)."""
+    start = time.perf_counter()
+    subprocess.run(command, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return time.perf_counter() - start
+
+
+def track_end_to_end(width: int, height: int, duration_s: float, repeat: int) -> BenchResult:
+    """``lumpbeam track`` as a process against a plain script reading the same bag.
+
+    The bag is a synthetic drop test filmed at ``width`` x ``height`` (release at 2 s). Both
+    run as processes, start-up included, on an otherwise idle machine: ``lumpbeam track``
+    (reading, tracking, the output bag, the truth comparison) and
+    :mod:`lumpbeam_lab.bench.plain_track` (reading and tracking only).
+
+    Args:
+        width: Image width, px.
+        height: Image height, px.
+        duration_s: The drop test's length, s (180 frames a second).
+        repeat: Runs of each, alternated (the fastest counts).
+
+    Returns:
+        Frames per second of wall time of each, and whether the target
+        (:data:`TRACK_TARGET_RATIO` times the plain script) is met.
+    """
+    from lumpbeam_ros.core.model.parameters import load_beam_config
+    from lumpbeam_ros.core.synthetic.drop_test import SynthOptions, write_drop_test_bag
+    from lumpbeam_ros.core.synthetic.images import ImageOptions
+
+    with tempfile.TemporaryDirectory(prefix='lumpbeam-bench-') as folder:
+        bag, out = Path(folder) / 'filmed', Path(folder) / 'tracked'
+        beam, drop = load_beam_config()
+        options, images = SynthOptions(duration_s=duration_s), ImageOptions(width, height)
+        trajectory, _ = write_drop_test_bag(bag, beam, drop, options, images=images)
+        frames = len(trajectory.t)
+        lumpbeam = [sys.executable, '-m', 'lumpbeam_ros.apps.cli.main']
+        track = [*lumpbeam, 'track', str(bag), str(out), '--quiet', '--force']
+        plain = [sys.executable, '-m', 'lumpbeam_lab.bench.plain_track', str(bag)]
+        plain += [str(width), str(height)]
+        ours, theirs = math.inf, math.inf
+        for _ in range(repeat):
+            ours = min(ours, _wall_s(track))
+            theirs = min(theirs, _wall_s(plain))
+    fps, plain_fps = frames / ours, frames / theirs
+    met = fps >= TRACK_TARGET_RATIO * plain_fps
+    details: dict[str, object] = {
+        'frames': frames,
+        'track_wall_s': ours,
+        'plain_wall_s': theirs,
+        'target': f'{"pass" if met else "FAIL"} (>= {TRACK_TARGET_RATIO:g}x)',
+    }
+    baseline = 'a plain script: iter_images + TrackingSession'
+    return BenchResult(
+        f'track_e2e_{width}x{height}', fps, 'frames/s', baseline, plain_fps, fps / plain_fps,
+        details,
+    )  # fmt: skip
+
+
 def accuracy(width: int, height: int, frame_step: int) -> BenchResult:
     """z RMS error (every pose, bias in) on the drop test, against the 10 um target."""
     report = measure_accuracy(width, height, frame_step=frame_step)
@@ -410,12 +476,14 @@ def run(quick: bool) -> list[BenchResult]:
 
     Args:
         quick: A smoke test: 640 x 480, 45 timed frames, every 20th frame scored, 1 s of
-            320 x 240 end to end (shared memory only).
+            320 x 240 end to end (shared memory only), ``lumpbeam track`` of 2.2 s of
+            320 x 240 once.
 
     Returns:
         Speed at 2048 x 2048 with a distorting lens, and without at 2048, 1024 and 640;
         against OpenCV's best pipeline at 1024 and 2048, with and without the lens, on
-        the renderer the tests use and on the independent ray caster;
+        the renderer the tests use and on the independent ray caster; then ``lumpbeam
+        track`` as a process against a plain script (:func:`track_end_to_end`);
         accuracy at the three sizes on the whole
         drop test, then the end-to-end figures at 1024 x 1024 offered at 180 fps.
     """
@@ -425,6 +493,7 @@ def run(quick: bool) -> list[BenchResult]:
             versus_opencv(640, 480, 45, repeat=2),
             accuracy(640, 480, frame_step=20),
             *end_to_end(320, 240, 180.0, 1.0, default_transport=False),
+            track_end_to_end(320, 240, 2.2, repeat=1),
         ]
     results = [speed(2048, 2048, 150, repeat=5, distortion=LENS_DISTORTION)]
     results += [speed(w, h, 150, repeat=3) for w, h in ((2048, 2048), (1024, 1024), (640, 480))]
@@ -438,4 +507,5 @@ def run(quick: bool) -> list[BenchResult]:
     results += [versus_opencv_raycast(cases[i], repeat=3) for i in (0, 1, 6, 7)]
     results += [accuracy(w, h, 1) for w, h in ((2048, 2048), (1024, 1024), (640, 480))]
     results += end_to_end(1024, 1024, 180.0, 4.0)
+    results.append(track_end_to_end(1024, 1024, 3.0, repeat=3))
     return results

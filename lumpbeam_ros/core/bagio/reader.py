@@ -65,6 +65,7 @@ from mcap.writer import MCAP0_MAGIC
 
 from lumpbeam_ros.base.errors import BagError
 from lumpbeam_ros.core.bagio import metadata
+from lumpbeam_ros.core.bagio.fastscan import message_record
 from lumpbeam_ros.core.bagio.typestore import deserialize
 
 _log = logging.getLogger(__name__)
@@ -75,8 +76,6 @@ MAGIC = MCAP0_MAGIC
 MAX_CHUNK_BYTES = 1 << 30
 #: A record's opcode and length, before its content.
 _RECORD_PREFIX = 1 + 8
-#: A Message record's fields before its data: channel id, sequence, log and publish times.
-_MESSAGE_HEADER = struct.Struct('<HIQQ')
 #: A chunk's fields besides its compression's name and its data: start and end times, the
 #: uncompressed size and CRC, the lengths of the name and of the data.
 _CHUNK_FIELDS = 8 + 8 + 8 + 4 + 4 + 8
@@ -475,24 +474,16 @@ def read_record_at(
             cut=True,
         )
     start, stop = at + _RECORD_PREFIX, at + _RECORD_PREFIX + length
-    if opcode == Opcode.MESSAGE and length >= _MESSAGE_HEADER.size:
-        # Nearly every record of a bag, an image's megabyte among them: its fields read in
-        # place and its data copied once (mcap's own reader copies it three times).
-        channel_id, sequence, log_time, publish_time = _MESSAGE_HEADER.unpack_from(data, start)
-        message = bytes(data[start + _MESSAGE_HEADER.size : stop])
-        record: McapRecord | None = Message(
-            channel_id=channel_id,
-            sequence=sequence,
-            log_time=log_time,
-            publish_time=publish_time,
-            data=message,
-        )
-        return opcode, record, stop
+    if opcode == Opcode.MESSAGE:
+        # Nearly every record of a bag, an image's megabyte among them.
+        message = message_record(data, start, stop)
+        if message is not None:
+            return opcode, message, stop
     body = bytes(data[start:stop])
     stream = _ExactStream(io.BytesIO(body))
     try:
         if opcode == Opcode.MESSAGE:
-            record = Message.read(stream, len(body))
+            record: McapRecord | None = Message.read(stream, len(body))
         else:
             reader = _RECORD_READERS.get(opcode)
             record = None if reader is None else reader(stream)

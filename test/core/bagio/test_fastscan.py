@@ -1,9 +1,12 @@
+import io
+import struct
+
 import numpy as np
 import pytest
 
 from lumpbeam_ros.core.bagio import BagReader, BagWriter, read_floats, read_tip_poses
 from lumpbeam_ros.core.bagio.convert import pose_values
-from lumpbeam_ros.core.bagio.fastscan import decode_float64, decode_pose_stamped
+from lumpbeam_ros.core.bagio.fastscan import decode_float64, decode_pose_stamped, message_record
 from lumpbeam_ros.core.bagio.typestore import deserialize
 
 
@@ -78,3 +81,17 @@ def test_float_series_match_the_general_reader(tmp_path):
     general = [deserialize(p, 'std_msgs/msg/Float64').data for p in payloads]
     np.testing.assert_array_equal(decode_float64(payloads), general)
     assert decode_float64([b'\x00\x01\x00\x00' + b'\x00' * 4]) is None
+
+
+@pytest.mark.parametrize('size', [0, 1, 1_000_000])
+def test_a_message_record_reads_as_mcaps_own_reader_reads_it(size):
+    from mcap.data_stream import ReadDataStream
+    from mcap.records import Message
+
+    data = bytes(range(256)) * (size // 256) + bytes(size % 256)
+    content = struct.pack('<HIQQ', 7, 2**31 + 5, 2**62 + 3, 11) + data
+    padded = b'pad' + content + b'tail'
+    ours = message_record(padded, 3, 3 + len(content))
+    theirs = Message.read(ReadDataStream(io.BytesIO(content)), len(content))
+    assert ours == theirs and isinstance(ours.data, bytes)
+    assert message_record(padded, 3, 3 + 21) is None  # no room for the fields: mcap says why

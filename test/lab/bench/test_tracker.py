@@ -12,7 +12,7 @@ from lumpbeam_lab.camera.validation import matrix_cases
 @pytest.mark.slow
 def test_quick_run_reports_speed_accuracy_and_end_to_end_against_same_run_baselines():
     assert 'tracker' in available_suites()
-    speed, versus, accuracy, shm = run(quick=True)
+    speed, versus, accuracy, shm, track = run(quick=True)
     assert speed.name == 'tracker_fps_640x480_distorted'
     assert speed.value > 0 and speed.baseline_value > 0
     assert abs(speed.ratio - speed.value / speed.baseline_value) < 1e-9
@@ -46,6 +46,11 @@ def test_quick_run_reports_speed_accuracy_and_end_to_end_against_same_run_baseli
     assert shm.details['poses_received'] > 0
     assert shm.details['latency_p50_ms'] > 0
     assert math.isfinite(shm.ratio)
+    # lumpbeam track and the plain script, each a process on the same bag.
+    assert track.name == 'track_e2e_320x240' and track.details['frames'] == 397
+    assert track.ratio == pytest.approx(track.value / track.baseline_value)
+    verdict = 'pass' if track.ratio >= 2 else 'FAIL'
+    assert track.details['target'] == f'{verdict} (>= 2x)'
 
 
 @pytest.mark.slow
