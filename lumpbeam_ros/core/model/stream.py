@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.base.interface import POSE_RATE_HZ
 from lumpbeam_ros.core.model.integrate import ChainState
 from lumpbeam_ros.core.model.parameters import BeamParameters
@@ -179,6 +180,12 @@ class PredictionStream:
 
         Returns:
             The due samples (possibly none), each with the load at its instant.
+
+        Raises:
+            LumpbeamError: The simulation failed (diverged, or over its solver's budget). The
+                stream has then restarted at rest at ``now`` under the current load: left
+                behind, every later call would have to simulate from the failure on, longer
+                each time (a simulator node once spent minutes on 447 s of it).
         """
         if now <= self._time:
             return _empty()
@@ -188,6 +195,14 @@ class PredictionStream:
             return _empty()
         stamps = np.arange(self._next_index, last_index + 1) / self._rate_hz
         self._next_index = last_index + 1
+        try:
+            return self._simulate(stamps)
+        except LumpbeamError:
+            self.reset(now)
+            raise
+
+    def _simulate(self, stamps: np.ndarray) -> TipTrajectory:
+        """The samples at ``stamps``, the simulation advanced through them."""
         simulation = self._simulation
         # Not before the simulation's present: a latency made longer holds the pose.
         physical = np.maximum(stamps - self._beam.effects.latency_s, simulation.time)

@@ -5,7 +5,11 @@ import numpy as np
 import pytest
 
 from lumpbeam_ros.core.model.parameters import BeamParameters
-from lumpbeam_ros.core.model.simulate import simulate_loads
+from lumpbeam_ros.core.model.simulate import (
+    BeamSimulation,
+    SimulationDivergedError,
+    simulate_loads,
+)
 from lumpbeam_ros.core.model.stream import PredictionStream
 
 BEAM = BeamParameters()
@@ -91,6 +95,31 @@ def test_reset_restarts_at_rest_without_repeating_stamps():
     stream.reset(0.0, 4.5)  # the clock went back: the grid starts again
     t, z, _ = _run(stream, 0.1)
     assert t[0] == 0.0 and z[0] == pytest.approx(stream.equilibrium_pose()[1])
+
+
+def test_a_failed_simulation_restarts_at_rest_instead_of_falling_behind(monkeypatch):
+    stream = PredictionStream(BEAM, 4.5, 0.0)
+    stream.set_load(0.1, 0.0)
+    _run(stream, 1.0)  # ringing
+    advance = BeamSimulation.advance
+
+    def diverge(simulation, t_out):
+        raise SimulationDivergedError('the modal solver did not converge')
+
+    monkeypatch.setattr(BeamSimulation, 'advance', diverge)
+    with pytest.raises(SimulationDivergedError):
+        stream.advance_to(2.0)
+    spans = []
+
+    def record(simulation, t_out):
+        spans.append((simulation.time, float(t_out[-1])))
+        return advance(simulation, t_out)
+
+    monkeypatch.setattr(BeamSimulation, 'advance', record)
+    t, z, _ = _run(stream, 2.5, start=2.0)
+    # At rest from the failure on under the load of the moment: nothing simulated twice.
+    assert t[0] > 2.0 and min(start for start, _ in spans) >= 2.0 - 1e-9
+    assert np.ptp(z) < 1e-12 and z[0] == pytest.approx(stream.equilibrium_pose()[1])
 
 
 def test_set_beam_keeps_the_motion():
