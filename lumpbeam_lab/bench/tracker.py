@@ -63,6 +63,16 @@ def _track_pass(
     return time.perf_counter() - start, time.process_time() - cpu, results
 
 
+def _opencv_corners(image: np.ndarray, pattern_size: tuple[int, int]) -> np.ndarray | None:
+    """A calibration script's corners: ``findChessboardCorners``, then ``cornerSubPix`` 11 px."""
+    flags = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
+    found, corners = cv2.findChessboardCorners(image, pattern_size, flags=flags)
+    if not found:
+        return None
+    criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_MAX_ITER, 30, 0.001)
+    return np.asarray(cv2.cornerSubPix(image, corners, (11, 11), (-1, -1), criteria))
+
+
 def _baseline_pass(
     frames: Sequence[SyntheticFrame], config: CameraConfig
 ) -> tuple[float, float, list[np.ndarray | None]]:
@@ -71,17 +81,14 @@ def _baseline_pass(
     objects = board.object_points()
     k = config.camera_info.k
     d = config.camera_info.d
-    criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_MAX_ITER, 30, 0.001)
-    flags = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
     poses: list[np.ndarray | None] = []
     cpu = time.process_time()
     start = time.perf_counter()
     for frame in frames:
-        found, corners = cv2.findChessboardCorners(frame.image, board.pattern_size, flags=flags)
-        if not found:
+        corners = _opencv_corners(frame.image, board.pattern_size)
+        if corners is None:
             poses.append(None)
             continue
-        corners = cv2.cornerSubPix(frame.image, corners, (11, 11), (-1, -1), criteria)
         ok, rvec, tvec = cv2.solvePnP(objects, corners, k, d)
         poses.append(np.hstack([rvec.ravel(), tvec.ravel()]) if ok else None)
     return time.perf_counter() - start, time.process_time() - cpu, poses
@@ -195,16 +202,13 @@ def _opencv_plane_pass(
     model = PlaneModel(rig, info)
     objects = board.object_points()
     expected = camera_board_transform(rig, np.array([0.0, 0.0, 0.0])).rotation
-    criteria = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_MAX_ITER, 30, 0.001)
-    flags = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
     poses: list[np.ndarray | None] = []
     start = time.perf_counter()
     for frame in frames:
-        found, corners = cv2.findChessboardCorners(frame.image, board.pattern_size, flags=flags)
-        if not found:
+        corners = _opencv_corners(frame.image, board.pattern_size)
+        if corners is None:
             poses.append(None)
             continue
-        corners = cv2.cornerSubPix(frame.image, corners, (11, 11), (-1, -1), criteria)
         ideal = info.undistort_pixels(corners.reshape(-1, 2).astype(np.float64))
         camera_board = solve_board_pnp(objects, ideal, info, expected)
         if camera_board is None:
