@@ -49,6 +49,10 @@ def _write(tmp_path: Path, change: dict) -> Path:
         ({'synthetic.wall_dn': 300.0}, 'synthetic.wall_dn'),
         ({'tracker.window_fraction': 0.6}, 'tracker.window_fraction'),
         ({'tracker.calibration_frames': 2}, 'tracker.calibration_frames'),
+        ({'tracker.max_window_px': 2}, 'tracker.max_window_px'),
+        ({'tracker.max_window_px': 12.5}, 'tracker.max_window_px'),
+        ({'tracker.max_depth_correction': 0.0}, 'tracker.max_depth_correction'),
+        ({'tracker.max_depth_correction': 'many'}, 'tracker.max_depth_correction'),
         ({'tracker.typo_key': 1}, 'tracker.typo_key'),
     ],
 )
