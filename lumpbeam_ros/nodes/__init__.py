@@ -1,8 +1,9 @@
 """The ROS 2 adapters: nodes that translate messages into core calls, and what they need.
 
 One module per node (``*_node.py``) and for the recorder and player; :mod:`~.params`: each
-node's declared parameters; :mod:`~.realtime`: real-time scheduling; :mod:`~.ros_domain`:
-private domains; :mod:`~.foxglove_server`: the live view over Foxglove's WebSocket.
+node's declared parameters; :mod:`~.realtime`: real-time scheduling; :mod:`~.sent_time`: dating
+messages that carry no stamp; :mod:`~.ros_domain`: private domains; :mod:`~.foxglove_server`:
+the live view over Foxglove's WebSocket.
 """
 
 __all__ = [
@@ -21,6 +22,7 @@ __all__ = [
     'ros_domain',
     'ros_parameters',
     'scripts',
+    'sent_time',
     'shaper_node',
     'simulator_node',
     'trajectory_messages',

@@ -67,6 +67,7 @@ from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
 from lumpbeam_ros.nodes.params.diagnosis_params import DIAGNOSIS_SCHEMA
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
+from lumpbeam_ros.nodes.sent_time import sent_ns
 
 #: Seconds between repeated warnings about the same kind of bad input.
 WARN_PERIOD_S = 5.0
@@ -210,9 +211,9 @@ class DiagnosisNode(SchemaNode):
         The sender's wall clock is free of the executor's delays and of a /clock that moved
         on while the message waited.
         """
-        sent_ns = (info or {}).get('source_timestamp', 0)
-        if sent_ns > 0:
-            return sent_ns * 1e-9
+        sent = sent_ns(info)
+        if sent > 0:
+            return sent * 1e-9
         return float(self.get_clock().now().nanoseconds) * 1e-9
 
     def _on_change(self, changes: Mapping[str, Any]) -> str | None:

@@ -5,7 +5,10 @@ Subscribes ``/tip_load`` (std_msgs/Float64, kg; reliable, transient local, depth
 publishes ``/tip_pose_predicted`` (geometry_msgs/PoseStamped in ``beam_base``). A steady
 timer advances a :class:`~lumpbeam_ros.core.model.stream.PredictionStream` to the node's clock
 (wall time, or ``/clock`` with ``use_sim_time``) and publishes the samples due since the last
-tick, each stamped with its model time. Another, at ``markers_rate_hz``, publishes
+tick, each stamped with its model time. A load change is dated by when it was sent
+(:mod:`~lumpbeam_ros.nodes.sent_time`; under ``use_sim_time`` the node also reads ``/clock``'s
+send times for it), and one taken after the model passed that instant is simulated again
+from it. Another timer, at ``markers_rate_hz``, publishes
 ``/beam_markers`` (visualization_msgs/MarkerArray, :mod:`lumpbeam_ros.core.viz.markers`): the
 model's latest shape, its tip, the last ``/tip_pose`` it received, the load and the board.
 With ``arm_config`` naming an arm file (doc/arm.md) the node simulates the flexible arm
@@ -50,6 +53,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseStamped
 from rclpy.clock import Clock, ClockType
 from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 from trajectory_msgs.msg import JointTrajectory as JointTrajectoryMsg
@@ -62,6 +66,7 @@ from lumpbeam_ros.base.interface import (
     BASE_FRAME,
     BEAM_MARKERS,
     BEAM_PARAMS,
+    CLOCK,
     IDENTIFIER_STATUS,
     JOINT_STATES,
     TIP_LOAD,
@@ -101,6 +106,7 @@ from lumpbeam_ros.nodes.endpoints import publisher, subscription
 from lumpbeam_ros.nodes.lifecycle import run_node
 from lumpbeam_ros.nodes.params.simulator_params import SIMULATOR_SCHEMA, effect_parameter_name
 from lumpbeam_ros.nodes.ros_parameters import NodeOptions, SchemaNode
+from lumpbeam_ros.nodes.sent_time import SentClock, sent_ns
 from lumpbeam_ros.nodes.trajectory_messages import command_from_msg, command_subscription
 
 #: DiagnosticStatus.OK as a number (rclpy gives levels as one byte).
@@ -316,7 +322,10 @@ class BeamSimulation:
         self._board = load_board(values['camera_config'])
         self._latest: TipTrajectory | None = None  # the last samples published
         self._with_effect_parameters(given)
-        subscription(node, Float64, TIP_LOAD, self._on_load)
+        self._sent = SentClock(bool(node.get_parameter('use_sim_time').value))
+        if self._sent.sim_time:
+            subscription(node, ClockMsg, CLOCK, lambda msg, info: self._on_clock(msg, info))
+        subscription(node, Float64, TIP_LOAD, lambda msg, info: self._on_load(msg, info))
         subscription(node, DiagnosticArray, BEAM_PARAMS, self._on_beam_params)
 
     @property
@@ -375,7 +384,10 @@ class BeamSimulation:
 
     # -- its inputs ---------------------------------------------------------------------------
 
-    def _on_load(self, msg: Float64) -> None:
+    def _on_clock(self, msg: ClockMsg, info: Mapping[str, int]) -> None:
+        self._sent.clock_sent(sent_ns(info), time_ns(msg.clock) / NS_PER_S)
+
+    def _on_load(self, msg: Float64, info: Mapping[str, int] | None = None) -> None:
         kg = float(msg.data)
         if not carries(self.beam, kg):
             self.node.refuse(
@@ -395,7 +407,8 @@ class BeamSimulation:
             # The first reading says what has been hanging there all along, not a change.
             self.stream.reset(max(self.node.now(), self.stream.time), kg)
         elif changed:
-            self.stream.set_load(self.node.now(), kg)
+            # Float64 has no stamp: dated by when it was sent, however late it is delivered.
+            self.stream.set_load(self._sent.sent_at(sent_ns(info), self.node.now()), kg)
 
     def _keeping(self) -> str:
         """What the simulator keeps when it refuses an estimate."""

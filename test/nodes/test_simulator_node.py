@@ -7,6 +7,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PoseStamped
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile
+from rosgraph_msgs.msg import Clock
 from scipy.optimize import curve_fit
 from std_msgs.msg import Float64
 
@@ -132,6 +133,37 @@ def test_follows_clock_under_sim_time_and_matches_the_batch_simulation(ros_graph
     t2, z2, _ = _columns(got[91:])
     assert t2[0] == pytest.approx(10.0, abs=1e-9)
     assert z2 == pytest.approx(node.stream.equilibrium_pose(0.0)[1], abs=1e-9)
+
+
+def test_a_load_taken_late_is_dated_when_it_was_sent(ros_graph):
+    got = ros_graph.collect('/tip_pose_predicted', PoseStamped, 1000)
+    node = _start(ros_graph, use_sim_time=True)
+    ros_graph.publish('/tip_load', Float64(data=4.5), LATCHED)  # hanging all along
+    ros_graph.set_clock([node], 100.0)
+    assert ros_graph.spin_until(lambda: node.stream is not None and node.stream.load_kg == 4.5)
+    for step in range(1, 21):
+        ros_graph.set_clock([node], 100.0 + step / 180)
+    # The drop is sent at 100 + 20/180 s, but the node takes it only after the next /clock,
+    # 20 periods on (a loaded machine): rclpy hands it /clock first.
+    ros_graph.executor.remove_node(node)
+    ros_graph.publish('/tip_load', Float64(data=0.0), LATCHED)
+    ros_graph.publish('/clock', _clock(100.0 + 40 / 180))
+    ros_graph.executor.add_node(node)
+    assert ros_graph.spin_until(lambda: node.stream.load_kg == 0.0)
+    assert node.now() == pytest.approx(100.0 + 40 / 180, abs=1e-9)
+    for step in range(41, 91):
+        ros_graph.set_clock([node], 100.0 + step / 180)
+    assert ros_graph.spin_until(lambda: len(got) >= 91, 3.0)
+    t, z, _ = _columns(got)
+    # Simulated from when it was sent: the ring-down is not 20 periods late.
+    ref = simulate_loads(node.beam, t - 100.0, [(20 / 180, 0.0)], 4.5)
+    np.testing.assert_allclose(z, ref.z, atol=1e-6)
+
+
+def _clock(seconds):
+    msg = Clock()
+    msg.clock.sec, msg.clock.nanosec = divmod(round(seconds * 1e9), 1_000_000_000)
+    return msg
 
 
 def test_bad_loads_are_ignored(ros_graph):

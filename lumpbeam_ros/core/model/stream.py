@@ -7,7 +7,11 @@ prediction shares its stamps with a 180 Hz camera that started on a whole second
 sample is computed at its own stamp, however late the call comes.
 
 Load changes are queued with their time and applied when the simulation reaches it, so a
-change that arrives between two ticks still takes effect at its own instant. The sensor
+change that arrives between two ticks still takes effect at its own instant. One that arrives
+after the simulation passed its instant (a message delayed on a loaded machine) is simulated
+again from the last checkpoint before it, up to :data:`REWIND_S` back: the samples already
+returned stay as they were, the later ones follow the load from its own instant rather than
+carry the delay through the whole ring-down. The sensor
 effects are applied as in :func:`~lumpbeam_ros.core.model.simulate.simulate_loads`: the sample
 stamped ``t`` shows the beam at ``t - latency``, which is what a late camera would report, and
 its position's displacement from rest is ``sensor_scale`` times the true one.
@@ -16,6 +20,7 @@ its position's displacement from rest is ``sensor_scale`` times the true one.
 from __future__ import annotations
 
 import bisect
+import copy
 import math
 
 import numpy as np
@@ -31,6 +36,10 @@ from lumpbeam_ros.core.model.trajectory import TipTrajectory
 #: Slack when rounding a time to the stamp grid, in grid periods: a clock that reads 1 ns
 #: short of a stamp because of float rounding still produces that stamp.
 _GRID_SLACK = 1e-6
+
+#: How far back a late load change is simulated again, s: far beyond a message's delivery
+#: delay on a loaded machine, and a bounded memory (one checkpoint per call).
+REWIND_S = 1.0
 
 
 def _check_load(load_kg: float) -> float:
@@ -68,6 +77,9 @@ class PredictionStream:
         self._time: float  # set by reset(), which ends this constructor
         self.rate_hz = rate_hz
         self._events: list[tuple[float, float]] = []
+        # The simulation as each call found it, and every change queued since the oldest.
+        self._checkpoints: list[BeamSimulation] = []
+        self._log: list[tuple[float, float]] = []
         self.reset(t0, load_kg)
 
     @property
@@ -120,6 +132,7 @@ class PredictionStream:
         start = min(t, first_index / self._rate_hz) - self._beam.effects.latency_s
         self._simulation = BeamSimulation(self._beam, load, t0=start, step=self.step)
         self._events.clear()
+        self._forget_past()
         self._time = float(t)
         self._origin = float(t)  # mount_creep counts from here
         self._next_index = first_index
@@ -145,12 +158,18 @@ class PredictionStream:
         simulation = BeamSimulation(beam, old.load_kg, t0=old.time, step=self.step)
         simulation.state = ChainState(old.state.phi.copy(), old.state.phi_dot.copy())
         self._beam, self._simulation = beam, simulation
+        self._forget_past()  # a rewind would simulate the past with the new beam
+
+    def _forget_past(self) -> None:
+        self._checkpoints.clear()
+        self._log.clear()
 
     def set_load(self, t: float, load_kg: float) -> None:
         """Queues a load change at time ``t`` (a drop is a change to a smaller load).
 
-        A change dated before the simulation's present (a late message) takes effect at the
-        present: the past is not simulated again.
+        A change dated before the simulation's present (a late message) is simulated again
+        from the last checkpoint at or before ``t`` (the oldest one when ``t`` is older than
+        them all, or the present when there is none: just after a reset or a new beam).
 
         Args:
             t: When the load changed, s.
@@ -162,7 +181,21 @@ class PredictionStream:
         load = _check_load(load_kg)
         if not math.isfinite(t):
             raise ValueError(f'load change time must be finite, got {t!r}')
-        bisect.insort(self._events, (float(t), load), key=lambda event: event[0])
+        event = (float(t), load)
+        if t < self._simulation.time and self._checkpoints:
+            self._rewind(t)
+        bisect.insort(self._events, event, key=lambda queued: queued[0])
+        bisect.insort(self._log, event, key=lambda queued: queued[0])
+
+    def _rewind(self, t: float) -> None:
+        """Goes back to the last checkpoint at or before ``t``, its later changes queued again."""
+        times = [checkpoint.time for checkpoint in self._checkpoints]
+        index = max(bisect.bisect_right(times, t) - 1, 0)
+        checkpoint = self._checkpoints[index]
+        del self._checkpoints[index + 1 :]
+        # Restored as a copy: the checkpoint may be needed again by a later, later message.
+        self._simulation = copy.copy(checkpoint)
+        self._events = [event for event in self._log if event[0] > checkpoint.time]
 
     def equilibrium_pose(self, load_kg: float | None = None) -> tuple[float, float, float]:
         """The tip pose ``(x, z, pitch)`` at rest under a load (default: the current one)."""
@@ -203,6 +236,7 @@ class PredictionStream:
 
     def _simulate(self, stamps: np.ndarray) -> TipTrajectory:
         """The samples at ``stamps``, the simulation advanced through them."""
+        self._checkpoint()
         simulation = self._simulation
         # Not before the simulation's present: a latency made longer holds the pose.
         physical = np.maximum(stamps - self._beam.effects.latency_s, simulation.time)
@@ -225,6 +259,21 @@ class PredictionStream:
         x, z, pitch = simulation.chain.tip_pose(phi)
         x, z = measured_position(self._beam, stamps - self._origin, x, z)
         return TipTrajectory(t=stamps, x=x, z=z, pitch=pitch, load_kg=loads, q=phi)
+
+    def _checkpoint(self) -> None:
+        """Keeps the simulation as it is now, and forgets what is older than a rewind reaches.
+
+        A shallow copy is enough: advancing replaces the simulation's state and time rather
+        than change them in place, and its solver caches stay valid for every copy.
+        """
+        simulation = self._simulation
+        self._checkpoints.append(copy.copy(simulation))
+        horizon = simulation.time - REWIND_S
+        while len(self._checkpoints) > 1 and self._checkpoints[1].time <= horizon:
+            del self._checkpoints[0]
+        oldest = self._checkpoints[0].time
+        while self._log and self._log[0][0] <= oldest:
+            del self._log[0]
 
 
 def _empty() -> TipTrajectory:

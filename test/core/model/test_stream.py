@@ -10,7 +10,7 @@ from lumpbeam_ros.core.model.simulate import (
     SimulationDivergedError,
     simulate_loads,
 )
-from lumpbeam_ros.core.model.stream import PredictionStream
+from lumpbeam_ros.core.model.stream import REWIND_S, PredictionStream
 
 BEAM = BeamParameters()
 
@@ -74,14 +74,46 @@ def test_starts_at_the_loaded_equilibrium_and_settles_after_the_drop():
     assert 1 / period == pytest.approx(3.06, abs=0.03)
 
 
-def test_a_late_load_change_applies_at_the_present():
+def _ticks(stream, start, until, period=0.01):
+    """Advances at a steady period; the samples' stamps and heights."""
+    parts = [
+        stream.advance_to(k * period)
+        for k in range(round(start / period) + 1, round(until / period) + 1)
+    ]
+    return np.concatenate([p.t for p in parts]), np.concatenate([p.z for p in parts])
+
+
+@pytest.mark.parametrize(
+    ('late_s', 'released_s', 'early_ticks'),
+    [
+        (0.03, 0.97, 0),  # a message a few ticks late: simulated again from its own instant
+        (0.8, 0.2, 0),
+        # Older than the rewind reaches: from its oldest checkpoint, on the stamp grid.
+        (REWIND_S + 0.5, 1.5 - REWIND_S, 2),
+    ],
+)
+def test_a_late_load_change_is_simulated_again_from_its_instant(late_s, released_s, early_ticks):
+    now = round(released_s + late_s, 2) if late_s < REWIND_S else 1.5
     stream = PredictionStream(BEAM, 4.5, 0.0)
-    t1, z1, _ = _run(stream, 1.0)
-    stream.set_load(0.2, 0.0)  # dated in the past
-    t2, z2, _ = _run(stream, 1.5)
+    t1, z1 = _ticks(stream, 0.0, now)
+    stream.set_load(now - late_s, 0.0)
+    t2, z2 = _ticks(stream, now, now + 0.5)
+    assert np.ptp(z1) < 1e-12  # what was returned before the message stays as it was
+    gaps = [
+        np.max(np.abs(z2 - simulate_loads(BEAM, t2, [(released, 0.0)], 4.5).z))
+        for released in released_s - np.arange(early_ticks + 1) / 180
+    ]
+    assert min(gaps) < 1e-6 and np.ptp(z2) > 0.01
+
+
+def test_a_late_load_change_after_a_new_beam_applies_at_the_present():
+    stream = PredictionStream(BEAM, 4.5, 0.0)
+    t1, _ = _ticks(stream, 0.0, 1.0)
+    stream.set_beam(BEAM)  # the past would be simulated with the new beam: not again
+    stream.set_load(0.2, 0.0)
+    t2, z2 = _ticks(stream, 1.0, 1.5)
     ref = simulate_loads(BEAM, np.concatenate([t1, t2]), [(1.0, 0.0)], 4.5)
-    np.testing.assert_allclose(np.concatenate([z1, z2]), ref.z, atol=1e-7)
-    assert np.ptp(z2) > 0.01
+    np.testing.assert_allclose(z2, ref.z[t1.size :], atol=1e-6)
 
 
 def test_reset_restarts_at_rest_without_repeating_stamps():
