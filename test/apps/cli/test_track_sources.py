@@ -62,11 +62,18 @@ def _bag(path, frames, encoding, info, with_info=True):
     return path
 
 
-def _folder(path, frames, ext):
+def _folder(path, frames, kind):
+    """Writes the frames as files; ``kind`` is the extension, then ``16-bit`` or ``colour``."""
+    ext, _, detail = kind.partition(' ')
     path.mkdir()
     for i, frame in enumerate(frames):
         params = [cv2.IMWRITE_JPEG_QUALITY, 90] if ext == '.jpg' else []
-        cv2.imwrite(str(path / f'{i:05d}{ext}'), frame.image, params)
+        image = frame.image
+        if detail == '16-bit':  # the full 16-bit range, as a 16-bit camera's files have it
+            image = image.astype(np.uint16) * 257
+        elif detail == 'colour':
+            image = cv2.cvtColor(image, cv2.COLOR_GRAY2BGR)
+        cv2.imwrite(str(path / f'{i:05d}{ext}'), image, params)
     return path
 
 
@@ -93,8 +100,9 @@ def _source(kind, tmp_path, footage):
 
 
 LOSSLESS = ['bag mono8', 'bag mono16', 'bag bgr8', 'bag rgb8', 'bag png', 'video FFV1',
-            'folder .png']  # fmt: skip
-LOSSY = ['bag jpeg', *(f'bag {p}' for p in sorted(PATTERNS)), 'video MJPG', 'folder .jpg']
+            'folder .png', 'folder .png 16-bit', 'folder .tif']  # fmt: skip
+LOSSY = ['bag jpeg', *(f'bag {p}' for p in sorted(PATTERNS)), 'video MJPG', 'folder .jpg',
+         'folder .jpg colour']  # fmt: skip
 
 
 def _errors(out, frames):
