@@ -1,8 +1,12 @@
-"""``lumpbeam analyze BAG``: identification of a drop test or an arm move (doc/interfaces.md)."""
+"""``lumpbeam analyze BAG``: a drop test, an arm move or any record's free vibrations.
+
+See doc/interfaces.md.
+"""
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -16,6 +20,7 @@ from lumpbeam_ros.core.ident.bag_analysis import (
     BagAnalysis,
     analyze_bag,
     read_window,
+    record_json,
     result_json,
 )
 from lumpbeam_ros.core.ident.settings import load_identifier_config, with_max_modes
@@ -51,17 +56,22 @@ def run(args: argparse.Namespace) -> int:
         from lumpbeam_ros.core.model.arm.config import load_arm_config
 
         arm = load_arm_config(args.arm)
+    band = None if args.band is None else parse_band(args.band)
     analysis = analyze_bag(
-        args.bag, beam, config, arm_joints=None if arm is None else arm.n_joints
+        args.bag, beam, config, arm_joints=None if arm is None else arm.n_joints, band=band
     )
     window, result = analysis.window, analysis.result
     for note in analysis.notes:
         print(f'lumpbeam analyze: warning: {args.bag}: {POSE_TOPIC}: {note}', file=sys.stderr)
-    print(f'{args.bag}: {len(window)} poses over {window.end_s - window.start_s:.2f} s')
+    what = 'poses' if analysis.quantity == 'displacement' else 'accelerations (/tip_imu)'
+    print(f'{args.bag}: {len(window)} {what} over {window.end_s - window.start_s:.2f} s')
     print(result.summary())
     _print_modes(analysis, arm)
+    _print_record(analysis)
     if args.json:
-        write_json(args.json, result_json(result, analysis.rest))
+        write_json(args.json, {**result_json(result, analysis.rest), **record_json(analysis)})
+    if args.plots and analysis.quantity != 'displacement':
+        raise LumpbeamError('--plots draws tip poses: the bag has accelerations (/tip_imu) only')
     if args.plots:
         from lumpbeam_ros.apps.plots.analysis import write_analysis_plots
 
@@ -72,6 +82,38 @@ def run(args: argparse.Namespace) -> int:
 
         print(f'wrote {write_analysis_report(analysis, args.report)}')
     return 0 if result.ok else 1
+
+
+def parse_band(text: str) -> tuple[float, float]:
+    """``--band LOW,HIGH`` as ``(low, high)`` Hz.
+
+    Raises:
+        LumpbeamError: Not two numbers, or not ``0 <= LOW < HIGH``.
+    """
+    parts = text.split(',')
+    try:
+        low, high = (float(part) for part in parts)
+    except ValueError:
+        low = high = math.nan
+    if not (math.isfinite(low) and math.isfinite(high) and 0.0 <= low < high):
+        raise LumpbeamError(f'--band {text!r}: give LOW,HIGH in Hz with 0 <= LOW < HIGH')
+    return low, high
+
+
+def _print_record(analysis: BagAnalysis) -> None:
+    """The free vibrations found and the steady lines, one line each."""
+    unit = 'm' if analysis.quantity == 'displacement' else 'm/s^2'
+    for event in analysis.events:
+        modes = ', '.join(
+            f'{m.natural_frequency_hz.value:.5g} Hz (zeta {m.damping_ratio.value:.3g})'
+            for m in event.identification.modes
+        )
+        print(
+            f'free vibration {event.event.start_s:.3f} to {event.event.end_s:.3f} s '
+            f'({event.event.kind}): {modes or event.identification.message}'
+        )
+    for line in analysis.lines:
+        print(f'steady line {line.frequency_hz:.5g} Hz, amplitude {line.amplitude:.3g} {unit}')
 
 
 def _print_modes(analysis: BagAnalysis, arm: ArmConfig | None) -> None:

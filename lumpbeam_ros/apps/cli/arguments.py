@@ -288,7 +288,7 @@ def add_analyze(parser: argparse.ArgumentParser) -> None:
         'bag',
         nargs='+',
         metavar='BAG',
-        help='rosbag2 folder with /tip_pose (and /tip_load); several with --fit-links',
+        help='rosbag2 folder with /tip_pose (and /tip_load) or /tip_imu; several with --fit-links',
     )
     parser.add_argument('--json', help='write the result as JSON to this file')
     parser.add_argument('--plots', help='write figures (PNG) into this folder')
@@ -301,6 +301,12 @@ def add_analyze(parser: argparse.ArgumentParser) -> None:
         metavar='N',
         help='report at most N modes, each only when it stands out of the noise '
         "(default: the identifier config's fit.max_modes, 3)",
+    )
+    parser.add_argument(
+        '--band',
+        metavar='LOW,HIGH',
+        help='look for modes between LOW and HIGH Hz only (default: up to the Nyquist '
+        "frequency of a record, the identifier config's band for a drop test)",
     )
     add_report(parser)
     arm = parser.add_argument_group("an arm's bags (doc/arm.md)")

@@ -6,6 +6,7 @@ __all__ = [
     'backbone',
     'bag_analysis',
     'covariance',
+    'free_vibration',
     'identification',
     'identify',
     'logdec',

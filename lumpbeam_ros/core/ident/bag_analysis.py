@@ -13,18 +13,27 @@ Its modes, for a script (e.g. fitting an arm's links to the modes of several bag
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from lumpbeam_ros.base.errors import BagError, LumpbeamError
-from lumpbeam_ros.base.interface import BASE_FRAME, JOINT_STATES, TIP_LOAD, TIP_POSE
+from lumpbeam_ros.base.interface import BASE_FRAME, JOINT_STATES, TIP_IMU, TIP_LOAD, TIP_POSE
 from lumpbeam_ros.base.progress import Progress
 from lumpbeam_ros.core.bagio import BagReader, read_load_events, read_tip_poses
-from lumpbeam_ros.core.bagio.series import JointSeries, read_joint_states
+from lumpbeam_ros.core.bagio.series import JointSeries, read_accelerations, read_joint_states
 from lumpbeam_ros.core.bagio.tipseries import LoadSeries
 from lumpbeam_ros.core.ident.assembly import FitState
+from lumpbeam_ros.core.ident.free_vibration import (
+    EventModes,
+    FreeVibration,
+    Line,
+    analyze_record,
+    steady_lines,
+)
 from lumpbeam_ros.core.ident.identification import Identification, IdentifiedMode
 from lumpbeam_ros.core.ident.identify import identify_from
 from lumpbeam_ros.core.ident.ring_down import (
@@ -135,6 +144,11 @@ class BagAnalysis:
         rest: For an arm's bag, the joints at rest after the last move: when they stopped
             (the start of the free vibration) and at which angles (the configuration the
             modes belong to); ``None`` for a drop test.
+        lines: The record's steady lines (``lines`` in JSON).
+        events: Its free vibrations, each identified (``events`` in JSON).
+        quantity: What ``window`` holds as its z: ``displacement`` (m) or ``acceleration``
+            (m/s^2, a ``/tip_imu`` record).
+        imu: The ``/tip_imu`` record's own analysis when the bag also has ``/tip_pose``.
     """
 
     bag: Path
@@ -143,6 +157,10 @@ class BagAnalysis:
     fit: FitState | None
     notes: tuple[str, ...] = ()
     rest: JointRest | None = None
+    lines: tuple[Line, ...] = ()
+    events: tuple[EventModes, ...] = ()
+    quantity: str = 'displacement'
+    imu: BagAnalysis | None = None
 
     @property
     def modes(self) -> tuple[IdentifiedMode, ...]:
@@ -156,40 +174,126 @@ def analyze_bag(
     config: IdentifierConfig,
     show_progress: bool = True,
     arm_joints: int | None = None,
+    band: tuple[float, float] | None = None,
 ) -> BagAnalysis:
     """Identifies the modes, and a drop test's stiffness, from a whole bag (B.12, B.20-B.22).
 
+    A drop test (``/tip_load``, or a release found in the poses) is identified as one; any
+    other record (a tap, a pluck, a shaker switched off, ``/tip_imu`` alone) by its free
+    vibrations (:mod:`~lumpbeam_ros.core.ident.free_vibration`), the headline figures those
+    of the one that rang longest.
+
     Args:
-        bag: The bag folder, with ``/tip_pose`` and (optionally) ``/tip_load``.
+        bag: The bag folder, with ``/tip_pose`` and (optionally) ``/tip_load``, or
+            ``/tip_imu``.
         beam: Supplies L, g and the masses.
         config: Identifier settings; the fit may run to the record's end whatever
             ``max_fit_s`` says, since the whole record is one window.
         show_progress: Draw a progress bar while reading.
         arm_joints: For an arm's bag, its number of joints: the free vibration is the one
             after the last move on ``/joint_states`` (in place of a load release).
+        band: ``(low, high)`` Hz the modes are looked for in (``None``: up to the record's
+            Nyquist frequency, and a drop test's configured band).
 
     Returns:
         The analysis; its :attr:`BagAnalysis.modes` are the modes, its ``rest`` (arm) the
         joint angles they were measured at.
 
     Raises:
-        BagError: Not a bag or no usable ``/tip_pose`` (or, for an arm, ``/joint_states``).
+        BagError: Not a bag or no usable ``/tip_pose`` or ``/tip_imu`` (or, for an arm,
+            ``/joint_states``).
         LumpbeamError: Too few samples, no move or no rest after it, named with the bag.
     """
+    topics = BagReader(bag).topics
+    imu = None
+    if TIP_IMU in topics:
+        imu = _analyze_imu(Path(bag), topics, config, band)
+        if POSE_TOPIC not in topics:
+            return imu
     window = read_window(bag, show_progress)
     config = replace(config, max_fit_s=math.inf)
+    if band is not None:
+        config = replace(config, min_frequency_hz=band[0], max_frequency_hz=band[1])
     if arm_joints is not None:
-        return _analyze_ring_down(Path(bag), window, beam, config, arm_joints)
+        return replace(_analyze_ring_down(Path(bag), window, beam, config, arm_joints), imu=imu)
+    whole = window
     window, split = keep_release_segment(window, config)
     arm_hint = ''
-    if JOINT_STATES in BagReader(bag).topics:
+    if JOINT_STATES in topics:
         arm_hint = f'taken as a drop test, but the bag has {JOINT_STATES}: an arm? (--arm FILE)'
     notes = tuple(note for note in (window.counts.note(), split, arm_hint) if note)
     try:
         result, fit = identify_from(window, beam, config, strict=True)
     except LumpbeamError as exc:
         raise LumpbeamError(f'{bag}: {exc}') from None
-    return BagAnalysis(Path(bag), window, result, fit, notes)
+    lines = steady_lines(whole.t, whole.z)
+    if not result.ok and LOAD_TOPIC not in topics:
+        # No drop test in it: a record of another excitation (a tap, a pluck)?
+        hints = _hints(Path(bag), topics, whole.t)
+        record = analyze_record(whole.t, whole.z, config, band, hints)
+        if record.events:
+            return BagAnalysis(
+                Path(bag), whole, record.identification, None, notes, lines=record.lines,
+                events=record.events, imu=imu,
+            )  # fmt: skip
+        lines = record.lines
+    release = FreeVibration(float(result.release.time_s.value), window.end_s, 'release')
+    events = (EventModes(release, result),) if result.ok else ()
+    return BagAnalysis(Path(bag), window, result, fit, notes, lines=lines, events=events, imu=imu)
+
+
+def _analyze_imu(
+    bag: Path,
+    topics: Mapping[str, Any],
+    config: IdentifierConfig,
+    band: tuple[float, float] | None,
+) -> BagAnalysis:
+    """A ``/tip_imu`` record: the acceleration along its axis of largest motion."""
+    series = read_accelerations(bag)
+    axes = np.vstack([series.x, series.y, series.z])
+    finite = np.all(np.isfinite(axes), axis=0)
+    spread = [float(np.std(a[finite])) if finite.any() else 0.0 for a in axes]
+    window = clean_window(series.t, axes[int(np.argmax(spread))])
+    if len(window) < 16:
+        raise BagError(f'{bag}: {TIP_IMU} holds {len(window)} usable samples')
+    record = analyze_record(window.t, window.z, config, band, _hints(bag, topics, window.t))
+    notes = tuple(note for note in (window.counts.note(),) if note)
+    return BagAnalysis(
+        bag, window, record.identification, None, notes, lines=record.lines,
+        events=record.events, quantity='acceleration',
+    )  # fmt: skip
+
+
+def _hints(bag: Path, topics: Mapping[str, Any], t: np.ndarray) -> list[tuple[float, str]]:
+    """The excitations the bag names: ``/tip_load`` changes and the ends of joint moves."""
+    hints: list[tuple[float, str]] = []
+    if LOAD_TOPIC in topics:
+        loads = read_load_events(bag, LOAD_TOPIC)
+        changed = np.flatnonzero(np.diff(loads.kg) != 0.0) + 1
+        hints += [(float(loads.t[k]), 'release') for k in changed]
+    if JOINT_STATES in topics:
+        joints = read_joint_states(bag)
+        for rest in rest_stretches(joints.t, joints.angles, 1e-3):
+            if rest.after_move:
+                hints.append((rest.start_s, 'move_end'))
+    return [(when, kind) for when, kind in hints if t[0] <= when <= t[-1]]
+
+
+def record_json(analysis: BagAnalysis) -> dict[str, Any]:
+    """``events`` and ``lines`` of ``lumpbeam analyze``'s JSON (and ``tip_imu``'s own)."""
+    out: dict[str, Any] = {
+        'events': [event.as_dict() for event in analysis.events],
+        'lines': [line.as_dict() for line in analysis.lines],
+    }
+    if analysis.imu is not None:
+        imu = analysis.imu
+        out['tip_imu'] = {
+            'status': imu.result.status.name,
+            'message': imu.result.message,
+            'modes': [mode.as_dict() for mode in imu.modes],
+            **record_json(replace(imu, imu=None)),
+        }
+    return out
 
 
 def identify_ring_down(

@@ -5,6 +5,7 @@ from pathlib import Path
 
 import pytest
 from ring_downs import MODES, ring_down, write_bag
+from taps import Tap
 
 from lumpbeam_ros.apps.cli.analyze import CONTRACT_KEYS
 from lumpbeam_ros.apps.cli.main import main
@@ -69,8 +70,9 @@ def test_analyze_json_keeps_the_keys_their_order_and_values(drop_bag, tmp_path):
     assert main(['analyze', str(drop_bag), '--json', str(out)]) == 0
     data = json.loads(out.read_text())
     expected = GOLDEN['analyze_json']
-    # The modes came later, after every golden key; the top-level keys are the first mode's.
-    assert list(data) == [*expected, 'modes']
+    # The modes came later, after every golden key, then the record's free vibrations and
+    # steady lines; the top-level keys are the first mode's.
+    assert list(data) == [*expected, 'modes', 'events', 'lines']
     assert set(CONTRACT_KEYS) | {f'{key}_std' for key in CONTRACT_KEYS} <= set(data)
     assert [key for key in expected if not same_value(data[key], expected[key])] == []
     # The drop's second mode (35 Hz, about 20 um at the start, damped in 0.1 s) is under the
@@ -84,6 +86,10 @@ def test_analyze_json_keeps_the_keys_their_order_and_values(drop_bag, tmp_path):
             'amplitude_m': data['amplitude_m'],
         }
     ]
+    # One free vibration, the release's, with the same modes; no steady line.
+    [event] = data['events']
+    assert event['kind'] == 'release' and event['modes'] == data['modes']
+    assert event['start_s'] == data['release_time_s'] and data['lines'] == []
 
 
 def _bag(path, poses=(), frame='beam_base', loads=()):
@@ -308,3 +314,78 @@ def test_an_arm_bag_without_arm_says_so(arm_bag, capsys):
     assert 'taken as a drop test, but the bag has /joint_states: an arm? (--arm FILE)' in (
         capsys.readouterr().err
     )
+
+
+#: A steel cantilever tapped once, an accelerometer at its tip (m/s^2), 1.65 kHz: its three
+#: modes and 50 Hz mains hum.
+TAPPED = Tap(1650, 12, (1.0,), ((6.62, 0.004, 10.0), (41.4, 0.003, 5.0), (117.5, 0.002, 3.0)),
+             noise=0.05, hum=(50.0, 0.2))  # fmt: skip
+
+
+def _imported(tmp_path, t, y, quantity='acceleration'):
+    """A record as a lab has it (CSV), through ``lumpbeam import``."""
+    csv = tmp_path / 'record.csv'
+    csv.write_text(
+        'time,signal\n'
+        + ''.join(f'{float(a)!r},{float(b)!r}\n' for a, b in zip(t, y, strict=True))
+    )
+    bag = tmp_path / 'bag'
+    args = ['import', str(csv), str(bag), '--quantity', quantity, '--column', 'signal']
+    assert main([*args, '--time-column', 'time']) == 0
+    return bag
+
+
+def test_an_accelerometer_record_of_a_tap_gives_its_modes_events_and_lines(tmp_path, capsys):
+    bag = _imported(tmp_path, *TAPPED.record())
+    out = tmp_path / 'r.json'
+    assert main(['analyze', str(bag), '--json', str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert 'accelerations (/tip_imu)' in printed and 'steady line 49.99' in printed
+    data = json.loads(out.read_text())
+    [event] = data['events']
+    # Stamped from lumpbeam import's default start, 2000-01-01T00:00:00Z.
+    assert event['kind'] == 'impact' and 1.0 <= event['start_s'] - 946684800.0 < 1.2
+    assert data['modes'] == event['modes'] and len(data['modes']) == 3
+    for mode, (f, zeta, _) in zip(data['modes'], TAPPED.modes, strict=True):
+        assert abs(mode['natural_frequency_hz'] - f) <= 3 * mode['natural_frequency_hz_std']
+        assert abs(mode['damping_ratio'] - zeta) <= 3 * mode['damping_ratio_std']
+    [line] = data['lines']
+    assert line['frequency_hz'] == pytest.approx(50.0, abs=1e-3)
+    # No static change of a tip pose: no stiffness.
+    assert data['stiffness_total_nm_per_rad'] is None and data['status'] == 'OK'
+
+
+def test_a_band_restricts_the_modes_looked_for(tmp_path):
+    bag = _imported(tmp_path, *TAPPED.record())
+    out = tmp_path / 'r.json'
+    assert main(['analyze', str(bag), '--json', str(out), '--band', '20,80']) == 0
+    [mode] = json.loads(out.read_text())['modes']
+    assert mode['natural_frequency_hz'] == pytest.approx(41.4, rel=1e-3)
+
+
+def test_a_shaker_still_running_gives_lines_and_no_mode(tmp_path, capsys):
+    """A measured record (test/data/records): a cantilever driven at 100, 120 and 150 Hz."""
+    lvm = Path(__file__).parents[2] / 'data' / 'records' / 'shaker_cantilever_test3_400hz.lvm'
+    bag = tmp_path / 'shaker'
+    args = ['--quantity', 'acceleration', '--column', 'Acceleration', '--unit', 'g']
+    assert main(['import', str(lvm), str(bag), *args]) == 0
+    out = tmp_path / 'r.json'
+    assert main(['analyze', str(bag), '--json', str(out)]) == 1
+    data = json.loads(out.read_text())
+    assert data['status'] == 'ERROR' and 'no free vibration' in data['message']
+    assert data['natural_frequency_hz'] is None and data['modes'] == data['events'] == []
+    lines = sorted(line['frequency_hz'] for line in data['lines'])
+    assert lines == pytest.approx([100.0, 120.0, 150.0], abs=0.05)
+
+
+@pytest.mark.parametrize('band', ['20', '80,20', 'a,b', '-1,5', 'nan,5', '1,2,3'])
+def test_a_bad_band_is_one_line(drop_bag, band, capsys):
+    assert main(['analyze', str(drop_bag), f'--band={band}']) == 2
+    assert f'--band {band!r}: give LOW,HIGH in Hz' in _error_line(capsys)
+
+
+def test_plots_of_an_accelerometer_record_are_refused_in_one_line(tmp_path, capsys):
+    bag = _imported(tmp_path, *TAPPED.record())
+    capsys.readouterr()
+    assert main(['analyze', str(bag), '--plots', str(tmp_path / 'plots')]) == 2
+    assert '--plots draws tip poses' in _error_line(capsys)
