@@ -119,6 +119,7 @@ def _print_record(analysis: BagAnalysis) -> None:
 def _print_modes(analysis: BagAnalysis, arm: ArmConfig | None) -> None:
     """One line per mode; for an arm, the model's nearest mode at the rest angles beside it."""
     model: list[dict[str, float]] = []
+    unit = 'm' if analysis.quantity == 'displacement' else 'm/s^2'
     rest = analysis.rest
     if rest is not None and arm is not None:
         import numpy as np
@@ -133,7 +134,7 @@ def _print_modes(analysis: BagAnalysis, arm: ArmConfig | None) -> None:
         f, zeta = mode.natural_frequency_hz, mode.damping_ratio
         line = (
             f'mode {k}: {f.value:.5g} +- {f.std:.2g} Hz, damping ratio {zeta.value:.4g} +- '
-            f'{zeta.std:.2g}, amplitude {mode.amplitude_m:.3g} m'
+            f'{zeta.std:.2g}, amplitude {mode.amplitude_m:.3g} {unit}'
         )
         if model:
             near = min(model, key=lambda m: abs(m['natural_frequency_hz'] - f.value))

@@ -568,7 +568,8 @@ Writes OUT, a rosbag2 bag (MCAP), from a measured record: a displacement becomes
 
 SRC is one of:
   a CSV file (.csv, .tsv, .txt)  one header row of names; fields separated by , or ; or tab
-                                 (with ; or tab, a decimal comma is read too); --column NAME
+                                 (with ; or tab, a decimal comma is read too), or spaces
+                                 under a '# name name' line (numpy.savetxt); --column NAME
                                  (needed when there are several), --time-column NAME or --rate
   a LabVIEW file (.lvm)          the channel by its name in the last header (--column, needed
                                  when there are several); time from its X_Value column where

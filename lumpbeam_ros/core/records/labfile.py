@@ -1,7 +1,8 @@
 """One channel of a lab's measurement file, with its time.
 
 A lab records with LabVIEW, a data logger or a script, and hands over a LabVIEW measurement
-file (``.lvm``), a CSV file, a NumPy file or a MATLAB file. :func:`read_lab_file` reads one
+file (``.lvm``), a CSV file (or columns apart by spaces under a ``#`` line of names, as
+``numpy.savetxt`` writes them), a NumPy file or a MATLAB file. :func:`read_lab_file` reads one
 channel of any of them as a :class:`LabRecord`: its samples and their times in seconds.
 
 Time comes from the file where it holds one (a time column, LabVIEW's ``X_Value`` column, or
@@ -206,11 +207,19 @@ def _read_csv(source: Path, choice: ChannelChoice) -> tuple[str, np.ndarray, np.
     if first is None:
         raise RecordError(f'{source}: empty file')
     header_line = lines[first]
-    separator = max(CSV_SEPARATORS, key=header_line.count)
-    if header_line.count(separator) == 0:
-        separator = ','
-    rows = list(csv.reader(io.StringIO('\n'.join(lines[first:])), delimiter=separator))
-    names = [n.strip() for n in rows[0]]
+    data_line = next((line for line in lines[first + 1 :] if line.strip()), '')
+    if data_line and not any(sep in data_line for sep in CSV_SEPARATORS):
+        # Columns apart by spaces, the names after a '#' (numpy.savetxt's layout).
+        names_text = header_line.strip().lstrip('#')
+        names = [n.strip() for n in names_text.split(',' if ',' in names_text else None)]
+        rows = [names, *(line.split() for line in lines[first + 1 :])]
+        separator = ' '
+    else:
+        separator = max(CSV_SEPARATORS, key=header_line.count)
+        if header_line.count(separator) == 0:
+            separator = ','
+        rows = list(csv.reader(io.StringIO('\n'.join(lines[first:])), delimiter=separator))
+        names = [n.strip() for n in rows[0]]
     if all(_is_number(n) for n in names if n):
         raise RecordError(
             f'{source}: the first row holds numbers, not column names; add a header row'
@@ -224,7 +233,7 @@ def _read_csv(source: Path, choice: ChannelChoice) -> tuple[str, np.ndarray, np.
         column = others[_pick(source, [names[i] for i in others], None, 'column')]
     else:
         column = _pick(source, names, choice.column, 'column')
-    decimal_comma = separator != ','
+    decimal_comma = separator not in (',', ' ')
     wanted = [column] if time_column is None else [column, time_column]
     numbered = [
         (f'line {number}', row)

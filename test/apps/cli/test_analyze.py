@@ -3,6 +3,7 @@ import math
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 from ring_downs import MODES, ring_down, write_bag
 from taps import Tap
@@ -389,3 +390,36 @@ def test_plots_of_an_accelerometer_record_are_refused_in_one_line(tmp_path, caps
     capsys.readouterr()
     assert main(['analyze', str(bag), '--plots', str(tmp_path / 'plots')]) == 2
     assert '--plots draws tip poses' in _error_line(capsys)
+
+
+RECORDS = Path(__file__).parents[2] / 'data' / 'records'
+
+
+def _shock(trial, tmp_path):
+    """A measured shock of a circuit board (test/data/records), imported and analysed."""
+    source = RECORDS / f'pcb_shock_acc_pcb_a{trial}.txt'
+    bag, out = tmp_path / f'b{trial}', tmp_path / f'r{trial}.json'
+    columns = ['--time-column', 'time(s)', '--column', 'acceleration(g)', '--unit', 'g']
+    assert main(['import', str(source), str(bag), '--quantity', 'acceleration', *columns]) == 0
+    assert main(['analyze', str(bag), '--json', str(out)]) == 0
+    return np.loadtxt(source), json.loads(out.read_text())
+
+
+def test_measured_shocks_of_one_board_agree_within_their_standard_deviations(tmp_path):
+    first = {}
+    for trial in (0, 10, 20):
+        record, data = _shock(trial, tmp_path)
+        [event] = data['events']
+        assert event['kind'] == 'impact' and data['status'] == 'OK'
+        mode = data['modes'][0]
+        # A plain FFT of the whole record puts the board's strongest peak within 0.3 %.
+        t, a = record[:, 0], record[:, 1]
+        spectrum = np.abs(np.fft.rfft((a - a.mean()) * np.hanning(a.size), 16 * a.size))
+        peak = np.fft.rfftfreq(16 * a.size, np.median(np.diff(t)))[np.argmax(spectrum)]
+        assert mode['natural_frequency_hz'] == pytest.approx(peak, rel=3e-3)
+        for key in ('natural_frequency_hz', 'damping_ratio'):
+            if key in first:
+                apart = abs(mode[key] - first[key][0])
+                assert apart <= 3 * math.hypot(mode[f'{key}_std'], first[key][1]), (trial, key)
+            else:
+                first[key] = (mode[key], mode[f'{key}_std'])

@@ -121,6 +121,15 @@ def test_labview_layouts(tmp_path, rows, options, values, t):
             [1, np.nan, 3],
             [0, 1, 2],
         ),
+        # numpy.savetxt's layout: columns apart by spaces, the names after a '#'.
+        (
+            '# time(s), \t acc(g)\n0.0e+00 1.5e+00\n1.0e-01  2.5e+00\n',
+            '.txt',
+            {'time_column': 'time(s)', 'column': 'acc(g)'},
+            [1.5, 2.5],
+            [0, 0.1],
+        ),
+        ('# t acc\n0 1\n0.1 2\n', '.txt', {'time_column': 't'}, [1, 2], [0, 0.1]),
     ],
 )
 def test_csv_files(tmp_path, text, suffix, options, values, t):
