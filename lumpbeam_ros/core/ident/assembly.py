@@ -185,9 +185,11 @@ def _derive(
     level_after, level_after_std = params.offset, params.offset_std
     deflection = level_after - release.level_before_m
     deflection_std = math.hypot(level_after_std, release.level_before_std_m)
+    after = release.load_after_kg if math.isfinite(release.load_after_kg) else 0.0
     static = stiffness.from_static_change(
-        deflection, deflection_std, load, beam.length_m, beam.gravity_mps2
-    )
+        deflection, deflection_std, load, beam.length_m, beam.gravity_mps2,
+        stiffness.formula_share(beam, after, load),
+    )  # fmt: skip
     return Figures(
         cycles=float((t[-1] - t[0]) * mode.damped_frequency_hz),
         damping_total=_damping_total(params, mode),

@@ -47,6 +47,12 @@ def test_analyze_prints_writes_json_and_plots(drop_bag, tmp_path, capsys):
     assert data['release_time_s'] == pytest.approx(2.0, abs=0.2 / 180.0)
     assert data['status'] == 'OK'
     assert data['static_deflection_m'] == pytest.approx(0.04044, rel=1e-3)
+    # The beam's own k_tE within 3 standard deviations: B.12's share of the error in them.
+    truth = BeamParameters().k_total_nm_per_rad
+    assert (
+        abs(data['stiffness_total_nm_per_rad'] - truth)
+        < 3 * data['stiffness_total_nm_per_rad_std']
+    )
     assert sorted(p.name for p in plots.iterdir()) == [
         'estimates.png',
         'spectrum.png',

@@ -6,10 +6,13 @@ import pytest
 
 from lumpbeam_ros.core.ident.stiffness import (
     RAYLEIGH_BEAM_FRACTION,
+    formula_share,
     from_frequency,
     from_pitch_change,
     from_static_change,
 )
+from lumpbeam_ros.core.model.parameters import BeamParameters
+from lumpbeam_ros.core.model.statics import static_tip_deflection
 
 G = 9.81
 CASES = [(5000.6, 2.3107, 4.5), (1200.0, 1.0, 0.5), (20000.0, 3.0, 10.0)]  # EI, L, load
@@ -60,3 +63,20 @@ def test_frequency_gives_the_rayleigh_stiffness(ei, length, tip_kg, beam_kg):
     ) / (2 * h)
     assert std == pytest.approx(slope * 1e-3, rel=1e-6)
     assert all(math.isnan(v) for v in from_frequency(math.inf, 0.0, tip_kg, beam_kg))
+
+
+@pytest.mark.parametrize(('after', 'load'), [(0.0, 4.5), (0.0, 1.0), (2.0, 1.0)])
+def test_b12s_own_error_on_the_lumped_beam_is_its_share(after, load):
+    """B.12 on the chain's own static change errs by the share it reports, a few tenths of %."""
+    beam = BeamParameters()
+    share = formula_share(beam, after, load)
+    deflection = static_tip_deflection(beam, after + load) - static_tip_deflection(beam, after)
+    found = from_static_change(deflection, 0.0, load, beam.length_m, beam.gravity_mps2, share)
+    error = found.total_nm_per_rad - beam.k_total_nm_per_rad
+    assert 1e-3 < share < 1e-2
+    assert abs(error) == pytest.approx(found.total_nm_per_rad_std, rel=0.01)
+
+
+@pytest.mark.parametrize(('after', 'load'), [(0.0, 0.0), (math.nan, 4.5), (-1.0, 4.5)])
+def test_no_share_without_a_release_to_compute_it_on(after, load):
+    assert formula_share(BeamParameters(), after, load) == 0.0
