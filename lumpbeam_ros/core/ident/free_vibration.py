@@ -66,6 +66,10 @@ FLOOR_QUANTILE = 0.05
 TOP_FRACTION = 0.9
 #: Fewest damped periods of the strongest frequency in a free vibration worth fitting.
 MIN_PERIODS = 2.0
+#: Fewest samples a record must have to be looked at.
+MIN_SAMPLES = 16
+#: Samples at the record's extreme that make it a clipped record.
+CLIP_RUN = 3
 #: Kinds of a free vibration's start (doc/interfaces.md).
 KINDS = ('release', 'impact', 'move_end', 'unknown')
 
@@ -257,7 +261,7 @@ def find_free_vibrations(
     Returns:
         The free vibrations (none in a record of noise or of a steady forcing).
     """
-    if t.size < 16:
+    if t.size < MIN_SAMPLES:
         return ()
     f = _strongest_frequency(t, y)
     width = int(np.clip(round(2.0 * sample_rate_hz(t) / f), 4, max(4, t.size // 16)))
@@ -439,6 +443,14 @@ def analyze_record(
     Returns:
         The analysis; its identification is ERROR with the reason when nothing rang.
     """
+    clipped = clipped_samples(y)
+    if np.count_nonzero(~clipped) < MIN_SAMPLES:
+        reason = 'flat' if y.size == 0 or np.ptp(y) == 0.0 else 'clipped almost throughout'
+        return RecordAnalysis((), (), _error(f'no free vibration in the record: it is {reason}'))
+    if clipped.any():
+        # A clipped swing is no damped sinusoid: its samples are left out (the fits take
+        # uneven stamps), and the headline says so.
+        t, y = t[~clipped], y[~clipped]
     lines = steady_lines(t, y)
     rest = without_lines(t, y, lines)
     events = tuple(
@@ -457,4 +469,21 @@ def analyze_record(
             'no free vibration in the record: nothing rises out of the floor and decays'
             + (said if lines else '')
         )
+    if clipped.any():
+        note = f'{int(clipped.sum())} clipped samples left out'
+        headline = replace(headline, message=f'{headline.message}; {note}'.lstrip('; '))
     return RecordAnalysis(lines, events, headline)
+
+
+def clipped_samples(y: np.ndarray) -> np.ndarray:
+    """The samples at a sensor's limit: the record's extreme, reached :data:`CLIP_RUN` times.
+
+    A real swing reaches its largest value once; a clipped one sits on the limit.
+    """
+    clipped = np.zeros(y.size, dtype=bool)
+    if y.size:
+        for extreme in (np.max(y), np.min(y)):
+            at = y == extreme
+            if at.sum() >= CLIP_RUN:
+                clipped |= at
+    return clipped

@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from ring_downs import MODES, ring_down, write_bag
-from taps import Tap
 
+from lumpbeam_lab.ident.taps import Tap
 from lumpbeam_ros.apps.cli.analyze import CONTRACT_KEYS
 from lumpbeam_ros.apps.cli.main import main
 from lumpbeam_ros.base.resources import config_path

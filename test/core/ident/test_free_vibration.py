@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
-from taps import Tap
 
+from lumpbeam_lab.ident.taps import Tap
 from lumpbeam_ros.core.ident.free_vibration import (
     FreeVibration,
     analyze_record,
@@ -111,3 +111,13 @@ def test_a_stretch_too_short_for_the_band_is_an_error_not_a_mode():
     event = FreeVibration(0.03, 0.0302, 'impact')
     result = identify_free_vibration(t, without_lines(t, y, ()), event, CONFIG, band=(1, 10))
     assert result.identification.status == Status.ERROR and result.identification.modes == ()
+
+
+def test_a_clipped_record_leaves_its_clipped_samples_out_and_says_so():
+    tap = Tap(1000, 6, (0.5,), ((12.0, 0.02, 1.0),), noise=0.002, clip=0.6)
+    t, y = tap.record()
+    result = analyze_record(t, y, CONFIG)
+    assert 'clipped samples left out' in result.identification.message
+    [mode] = result.identification.modes
+    assert abs(mode.natural_frequency_hz.value - 12.0) <= 3 * mode.natural_frequency_hz.std
+    assert abs(mode.damping_ratio.value - 0.02) <= 3 * mode.damping_ratio.std

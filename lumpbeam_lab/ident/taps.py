@@ -1,4 +1,4 @@
-"""Synthetic records of struck structures with known modes, for the free-vibration tests.
+"""Synthetic records of struck structures with known modes, for the free-vibration checks.
 
 Each mode rings from the tap on as ``a e^{-sigma tau} sin(omega_d tau + phase)``, switched
 on over a fraction of a millisecond as a hammer's contact would; lines, noise, quantization
@@ -24,6 +24,7 @@ class Tap:
         noise: White noise's standard deviation.
         hum: ``(frequency Hz, amplitude)`` of a steady line, or ``None``.
         step: Quantization step (0: none).
+        clip: The sensor's range: samples beyond it read as its limit (0: none).
     """
 
     rate_hz: float
@@ -33,6 +34,7 @@ class Tap:
     noise: float = 0.0
     hum: tuple[float, float] | None = None
     step: float = 0.0
+    clip: float = 0.0
 
     def record(self, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
         """The stamps and samples."""
@@ -51,4 +53,6 @@ class Tap:
         y += self.noise * rng.standard_normal(t.size)
         if self.step:
             y = self.step * np.round(y / self.step)
+        if self.clip:
+            y = np.clip(y, -self.clip, self.clip)
         return t, y
