@@ -15,6 +15,7 @@ SUITES = (
     'camera-accuracy',
     'ident',
     'crb',
+    'records',
     'bagio',
     'diagnose',
     'diagnose_pairs',

@@ -56,3 +56,18 @@ class Tap:
         if self.clip:
             y = np.clip(y, -self.clip, self.clip)
         return t, y
+
+
+#: A lab's records with their truth: a tapped steel cantilever with an accelerometer and
+#: mains hum, a beam struck and filmed at 15 kHz, a structure at half a hertz, a 1.79 Hz ring
+#: of 9 mm in 1 mm steps, a record clipped by its sensor.
+RECORDS = {
+    'tapped_cantilever': Tap(1650, 20, (1.0,), ((6.62, 0.004, 10.0), (41.4, 0.003, 5.0),
+                             (117.5, 0.002, 3.0)), noise=0.05, hum=(50.0, 0.2)),
+    'struck_beam_15khz': Tap(15000, 0.25, (0.02,), ((695.0, 0.01, 1.0), (1897.5, 0.01, 0.6)),
+                             noise=0.02),
+    'half_a_hertz': Tap(50, 120, (5.0,), ((0.5, 0.01, 1.0),), noise=0.01),
+    'quantized_ring': Tap(1000, 6, (0.5,), ((1.79, 0.01, 9.0),), step=1.0),
+    'clipped': Tap(2000, 4, (0.2,), ((12.0, 0.02, 1.0), (75.0, 0.01, 0.3)), noise=0.003,
+                   clip=0.7),
+}  # fmt: skip

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from lumpbeam_lab.ident.taps import Tap
+from lumpbeam_lab.ident.taps import RECORDS, Tap
 from lumpbeam_ros.core.ident.free_vibration import (
     FreeVibration,
     analyze_record,
@@ -15,19 +15,8 @@ from lumpbeam_ros.core.ident.settings import IdentifierConfig
 
 CONFIG = IdentifierConfig()
 
-#: Records a lab makes: a tapped cantilever with an accelerometer (three modes, mains hum),
-#: a struck beam filmed at 15 kHz, a slow structure, a quantized ring (1 mm steps on 9 mm).
-RECORDS = {
-    'tapped cantilever': Tap(1650, 20, (1.0,), ((6.62, 0.004, 1.0), (41.4, 0.003, 0.5),
-                             (117.5, 0.002, 0.3)), noise=0.01, hum=(50.0, 0.05)),
-    'struck beam at 15 kHz': Tap(15000, 0.25, (0.02,), ((695, 0.01, 1.0), (1897.5, 0.01, 0.6)),
-                                 noise=0.02),
-    'half a hertz': Tap(50, 120, (5.0,), ((0.5, 0.01, 1.0),), noise=0.01),
-    'quantized ring': Tap(1000, 6, (0.5,), ((1.79, 0.01, 9.0),), step=1.0),
-}  # fmt: skip
 
-
-@pytest.mark.parametrize('name', sorted(RECORDS))
+@pytest.mark.parametrize('name', sorted(set(RECORDS) - {'clipped'}))
 @pytest.mark.parametrize('seed', range(3))
 def test_every_mode_of_a_record_is_found_within_three_standard_deviations(name, seed):
     tap = RECORDS[name]
@@ -48,10 +37,10 @@ def test_every_mode_of_a_record_is_found_within_three_standard_deviations(name, 
 
 
 def test_mains_hum_is_a_line_not_a_mode():
-    t, y = RECORDS['tapped cantilever'].record()
+    t, y = RECORDS['tapped_cantilever'].record()
     [line] = steady_lines(t, y)
     assert line.frequency_hz == pytest.approx(50.0, abs=0.01)
-    assert line.amplitude == pytest.approx(0.05, rel=0.05)
+    assert line.amplitude == pytest.approx(0.2, rel=0.05)
     modes = analyze_record(t, y, CONFIG).identification.modes
     assert all(abs(m.natural_frequency_hz.value - 50.0) > 1.0 for m in modes)
 
@@ -100,14 +89,14 @@ def test_nothing_is_identified_from_noise_or_a_steady_forcing(record):
 
 
 def test_a_band_keeps_the_modes_inside_it():
-    t, y = RECORDS['tapped cantilever'].record()
+    t, y = RECORDS['tapped_cantilever'].record()
     result = analyze_record(t, y, CONFIG, band=(20.0, 80.0))
     [mode] = result.identification.modes
     assert mode.natural_frequency_hz.value == pytest.approx(41.4, rel=1e-3)
 
 
 def test_a_stretch_too_short_for_the_band_is_an_error_not_a_mode():
-    t, y = RECORDS['struck beam at 15 kHz'].record()
+    t, y = RECORDS['struck_beam_15khz'].record()
     event = FreeVibration(0.03, 0.0302, 'impact')
     result = identify_free_vibration(t, without_lines(t, y, ()), event, CONFIG, band=(1, 10))
     assert result.identification.status == Status.ERROR and result.identification.modes == ()
