@@ -4,7 +4,8 @@ A lab's record is not always a drop test: a beam is tapped, plucked or struck, a
 switched off, an arm stops. Whatever started it, a free vibration is a sum of damped modes
 from where the excitation ended until it dies in the noise; a steady line (mains hum, a fan,
 a shaker still running) does not decay and is never a mode. The record is analysed in three
-steps, each from the data alone:
+steps, each from the data alone, once a straight line through the record (a sensor's drift)
+is taken out:
 
 1. **Lines** (:func:`steady_lines`): a spectral peak that stands out in every quarter of the
    record with about the same amplitude does not decay. Each is fitted as a sinusoid over the
@@ -25,11 +26,10 @@ steps, each from the data alone:
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from lumpbeam_ros.base.errors import LumpbeamError
 from lumpbeam_ros.core.bagio.tipseries import SampleCounts
@@ -64,6 +64,9 @@ END_FACTOR = 2.0
 FLOOR_QUANTILE = 0.05
 #: A free vibration starts where the envelope falls below this fraction of its top.
 TOP_FRACTION = 0.9
+#: An excitation over within this many envelope widths (two periods each) is an impact; a
+#: longer one (a forcing switched off) is of unknown kind.
+SHARP_WIDTHS = 4
 #: Fewest damped periods of the strongest frequency in a free vibration worth fitting.
 MIN_PERIODS = 2.0
 #: Fewest samples a record must have to be looked at.
@@ -215,15 +218,33 @@ def steady_lines(t: np.ndarray, y: np.ndarray) -> tuple[Line, ...]:
         # A frequency off by a thousandth of a bin over many periods leaves a slow beat
         # that looks like a lightly damped mode: the least-squares frequency.
         bin_hz = rate / n_fft
-        best = minimize_scalar(
-            lambda g: -float(np.sum(_sinusoids(t, y, [g]) ** 2)),
-            bounds=(f - bin_hz, f + bin_hz),
-            method='bounded',
-            options={'xatol': 1e-6 * bin_hz},
+        best = _golden_max(
+            lambda g: float(np.sum(_sinusoids(t, y, [g]) ** 2)), f - bin_hz, f + bin_hz
         )
-        fitted = _sinusoids(t, y, [float(best.x)])
-        lines.append(Line(float(best.x), float(np.sqrt(2.0) * np.std(fitted))))
+        fitted = _sinusoids(t, y, [best])
+        lines.append(Line(best, float(np.sqrt(2.0) * np.std(fitted))))
     return tuple(sorted(lines, key=lambda line: -line.amplitude))
+
+
+def _golden_max(function: Callable[[float], float], low: float, high: float) -> float:
+    """Where ``function`` is largest in ``[low, high]``, by golden-section search (1e-6 of it).
+
+    A hand-made search rather than scipy's: ``lumpbeam analyze`` does not load scipy.
+    """
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    a, b = low, high
+    c, d = b - ratio * (b - a), a + ratio * (b - a)
+    fc, fd = function(c), function(d)
+    while b - a > 1e-6 * (high - low):
+        if fc > fd:
+            b, d, fd = d, c, fc
+            c = b - ratio * (b - a)
+            fc = function(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + ratio * (b - a)
+            fd = function(d)
+    return 0.5 * (a + b)
 
 
 def without_lines(t: np.ndarray, y: np.ndarray, lines: Sequence[Line]) -> np.ndarray:
@@ -292,7 +313,7 @@ def find_free_vibrations(
                 break
         # The centred envelope's window reaches half a width past the excitation's end.
         first = min(start + width // 2, end)
-        sharp = start - onset <= 2 * width
+        sharp = start - onset <= SHARP_WIDTHS * width
         kind = 'impact' if sharp else 'unknown'
         if sharp:
             # Short (a tap, a pluck): free from its largest swing on.
@@ -341,8 +362,8 @@ def identify_free_vibration(
         t: The record's stamps, s.
         y: Its samples without steady lines.
         event: The stretch to fit.
-        config: ``fit.max_modes`` (up to 8 here whatever it says when ``band`` is open),
-            ``fit.mode_false_alarm``, ``fit.drift``, ``quality.*``.
+        config: ``fit.mode_false_alarm``, ``quality.min_cycles`` and
+            ``quality.warn_rel_std_damping`` (up to 8 modes, each with a drift: a sensor's).
         band: ``(low, high)`` Hz to look in (``None``: up to the record's Nyquist frequency).
 
     Returns:
@@ -355,8 +376,9 @@ def identify_free_vibration(
     low, high = _band(ts, band) if ts.size > 2 else (math.nan, math.nan)
     if not low < high:
         return EventModes(event, _error(f'no band left to look in ({low:.3g}..{high:.3g} Hz)'))
-    fit = DampedSinusoidFit(n_modes=1, drift=config.drift, min_frequency_hz=low,
-                            max_frequency_hz=high)  # fmt: skip
+    fit = DampedSinusoidFit(
+        n_modes=1, drift=config.drift, min_frequency_hz=low, max_frequency_hz=high
+    )
     try:
         params = fit.fit(ts, ys)
     except LumpbeamError as exc:
@@ -451,12 +473,12 @@ def analyze_record(
         # A clipped swing is no damped sinusoid: its samples are left out (the fits take
         # uneven stamps), and the headline says so.
         t, y = t[~clipped], y[~clipped]
+    # A sensor's drift is no vibration: a straight line through the record comes out first.
+    y = y - np.polyval(np.polyfit(t - t[0], y, 1), t - t[0])
     lines = steady_lines(t, y)
     rest = without_lines(t, y, lines)
-    events = tuple(
-        identify_free_vibration(t, rest, event, config, band)
-        for event in find_free_vibrations(t, rest, hints)
-    )
+    found = find_free_vibrations(t, rest, hints)
+    events = tuple(identify_free_vibration(t, rest, event, config, band) for event in found)
     rang = [e for e in events if e.identification.ok]
     if rang:
         headline = max(rang, key=lambda e: e.duration_s).identification

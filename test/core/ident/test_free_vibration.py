@@ -18,7 +18,7 @@ CONFIG = IdentifierConfig()
 
 @pytest.mark.parametrize('name', sorted(set(RECORDS) - {'clipped'}))
 @pytest.mark.parametrize('seed', range(3))
-def test_every_mode_of_a_record_is_found_within_three_standard_deviations(name, seed):
+def test_every_mode_of_a_record_is_found_within_its_standard_deviations(name, seed):
     tap = RECORDS[name]
     result = analyze_record(*tap.record(seed), CONFIG)
     assert result.identification.status != Status.ERROR, result.identification.message
@@ -28,9 +28,11 @@ def test_every_mode_of_a_record_is_found_within_three_standard_deviations(name, 
     assert tap.taps_s[0] <= event.event.start_s < tap.taps_s[0] + 1.0 / tap.modes[0][0]
     found = event.identification.modes
     assert len(found) == len(tap.modes)
+    # 4 sd per trial (3 sd misses 0.3 % of honest estimates, one in a few runs of this
+    # test's 50); the coverage within 3 sd over 30 seeds is the bench's records rows.
     for mode, (f, zeta, _) in zip(found, tap.modes, strict=True):
-        assert abs(mode.natural_frequency_hz.value - f) <= 3 * mode.natural_frequency_hz.std
-        assert abs(mode.damping_ratio.value - zeta) <= 3 * mode.damping_ratio.std
+        assert abs(mode.natural_frequency_hz.value - f) <= 4 * mode.natural_frequency_hz.std
+        assert abs(mode.damping_ratio.value - zeta) <= 4 * mode.damping_ratio.std
     # The headline figures are the first mode's.
     assert result.identification.modes == found
     assert result.identification.estimates.natural_frequency_hz == found[0].natural_frequency_hz
@@ -110,3 +112,17 @@ def test_a_clipped_record_leaves_its_clipped_samples_out_and_says_so():
     [mode] = result.identification.modes
     assert abs(mode.natural_frequency_hz.value - 12.0) <= 3 * mode.natural_frequency_hz.std
     assert abs(mode.damping_ratio.value - 0.02) <= 3 * mode.damping_ratio.std
+
+
+@pytest.mark.parametrize('slope', [0.05, 0.5])
+def test_a_drifting_sensor_gives_the_same_modes(slope):
+    tap = Tap(1000, 8, (1.0,), ((12.0, 0.01, 1.0), (47.0, 0.005, 0.3)), noise=0.01)
+    t, y = tap.record()
+    steady = analyze_record(t, y, CONFIG).identification.modes
+    drifting = analyze_record(t, y + slope * t, CONFIG).identification.modes
+    assert len(drifting) == len(steady) == 2
+    for a, b in zip(drifting, steady, strict=True):
+        assert a.natural_frequency_hz.value == pytest.approx(
+            b.natural_frequency_hz.value, rel=1e-6
+        )
+        assert a.damping_ratio.value == pytest.approx(b.damping_ratio.value, rel=1e-3)
