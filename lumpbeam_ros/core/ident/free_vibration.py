@@ -363,7 +363,7 @@ def identify_free_vibration(
         y: Its samples without steady lines.
         event: The stretch to fit.
         config: ``fit.mode_false_alarm``, ``quality.min_cycles`` and
-            ``quality.warn_rel_std_damping`` (up to 8 modes, each with a drift: a sensor's).
+            ``quality.warn_rel_std_damping`` (up to 8 modes and a drift, a sensor's).
         band: ``(low, high)`` Hz to look in (``None``: up to the record's Nyquist frequency).
 
     Returns:
@@ -376,9 +376,7 @@ def identify_free_vibration(
     low, high = _band(ts, band) if ts.size > 2 else (math.nan, math.nan)
     if not low < high:
         return EventModes(event, _error(f'no band left to look in ({low:.3g}..{high:.3g} Hz)'))
-    fit = DampedSinusoidFit(
-        n_modes=1, drift=config.drift, min_frequency_hz=low, max_frequency_hz=high
-    )
+    fit = DampedSinusoidFit(n_modes=1, drift=True, min_frequency_hz=low, max_frequency_hz=high)
     try:
         params = fit.fit(ts, ys)
     except LumpbeamError as exc:
@@ -474,6 +472,8 @@ def analyze_record(
         # uneven stamps), and the headline says so.
         t, y = t[~clipped], y[~clipped]
     # A sensor's drift is no vibration: a straight line through the record comes out first.
+    # Each fit holds a drift of its own, so that this line is no bias where it is not quite
+    # the drift (a slow ring's own lean in a short record).
     y = y - np.polyval(np.polyfit(t - t[0], y, 1), t - t[0])
     lines = steady_lines(t, y)
     rest = without_lines(t, y, lines)
