@@ -149,9 +149,9 @@ def live_diagnosis(
         for name, (start, end) in spans.items():
             found[f'prediction_{name}_rms_m'] = residual.rms(start=start, end=end)
             found[f'prediction_{name}_relative'] = _relative(residual, start, end)
-            # The simulator dates the unstamped /tip_load on arrival (its own clock, which
-            # may be a /clock tick behind): the lag in each span separates that timing from
-            # the effect's own shift of the prediction.
+            # The latency adopted is the one the diagnosis node named, whose release it dated
+            # by the poses sent around the unstamped /tip_load (a pose or so off): the lag in
+            # each span separates that timing from the effect's own shift of the prediction.
             lag, aligned = prediction_lag(analysis.measured, analysis.predicted, start, end)
             found[f'prediction_{name}_lag_s'] = lag
             found[f'prediction_{name}_aligned_rms_m'] = aligned
@@ -199,7 +199,8 @@ def live_diagnosis_lines(live: dict[str, Any]) -> list[str]:
         if math.isfinite(lag) and abs(lag) > TIMING_SHOWN_S:
             lines.append(
                 f'  of which timing after it: the prediction runs {lag * 1e3:.1f} ms late '
-                '(the simulator dates the unstamped /tip_load on arrival); '
+                '(the latency named a pose or so off: the diagnosis dates the unstamped '
+                '/tip_load by the poses sent around it); '
                 f'{live["prediction_after_aligned_rms_m"] * 1e3:.3f} mm once aligned'
             )
     return lines

@@ -169,7 +169,7 @@ def summary_lines(summary: dict[str, Any]) -> list[str]:
     if summary.get('prediction_lag_s') is not None and math.isfinite(summary['prediction_lag_s']):
         lines.append(
             f'  of which timing: the prediction runs {summary["prediction_lag_s"] * 1e3:.1f} ms '
-            f'late (the /tip_load delivery delay, and any latency the camera hides); '
+            f'late (the latency the camera hides, until the simulator adopts it); '
             f'shifted by it, RMS '
             f'{summary["prediction_rms_aligned_m"] * 1e3:.3f} mm after the release'
         )

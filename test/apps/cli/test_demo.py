@@ -24,8 +24,8 @@ def test_demo_runs_the_graph_end_to_end(demo_results, mcap_doctor):
     # the live diagnosis has named it and the simulator adopted it during the replay, the
     # prediction is the 20 um noise from then on. Adopted at the replay's end (a slow
     # machine), the prediction before it is shifted by the one lag that aligns it best (the
-    # latency plus the /tip_load delivery delay: a Float64 has no stamp) and leaves a few
-    # times the noise.
+    # latency; the simulator dates the unstamped /tip_load by when it was sent) and leaves a
+    # few times the noise.
     live = summary['live_diagnosis']
     # Before the adoption (the whole record when none came), the hidden latency shows: over a
     # millimetre. Adopted early in the ring-down, the whole record's gap can fall below it.
@@ -182,8 +182,8 @@ def test_demo_names_the_hidden_latency_live_and_the_simulator_adopts_it(demo_res
     live = demo_results.summary['live_diagnosis']
     printed = demo_results.printed
     assert 'live diagnosis (diagnosis_node, ring-down' in printed
-    # Float64 /tip_load has no stamp: the node dates the release on arrival, and a reading
-    # delivered late shortens the latency it can see by as much (a busy machine: 5-20 ms).
+    # Float64 /tip_load has no stamp: the diagnosis node dates the release by the poses sent
+    # around it, and poses sent late (a busy machine: 5-20 ms) shift the latency it sees.
     late_s = live['window_s'][0] + 1.0 - 2.0  # pre_release_s before the 2 s release
     if abs(late_s) > 0.002:
         # Then the latency it sees is shorter than the hidden one: a smaller latency, or no
