@@ -43,7 +43,11 @@ from lumpbeam_ros.core.ident.identification import (
 )
 from lumpbeam_ros.core.ident.modes import choose_modes, structural_modes
 from lumpbeam_ros.core.ident.settings import MAX_MODES_LIMIT, IdentifierConfig
-from lumpbeam_ros.core.ident.sinusoid import DampedSinusoidFit, DampedSinusoidParameters
+from lumpbeam_ros.core.ident.sinusoid import (
+    DampedSinusoidFit,
+    DampedSinusoidParameters,
+    spectral_peak_hz,
+)
 
 #: Highest frequency looked for, as a fraction of the Nyquist frequency (above it a mode's
 #: few samples per period leave its damping undetermined).
@@ -192,12 +196,16 @@ def steady_lines(t: np.ndarray, y: np.ndarray) -> tuple[Line, ...]:
     Returns:
         The lines, strongest first (at most :data:`MAX_LINES`).
     """
-    part = t.size // LINE_PARTS
+    # The spectra on the record's own step: a sample dropped here and there would shift
+    # every later one's phase and smear a line (then left behind as a "mode").
+    step = 1.0 / sample_rate_hz(t)
+    u = np.interp(np.arange(t[0], t[-1], step), t, y)
+    part = u.size // LINE_PARTS
     if part < 64:
         return ()
     n_fft = 1 << int(math.ceil(math.log2(4 * part)))
     spectra = np.array(
-        [_amplitude_spectrum(y[k * part : (k + 1) * part], n_fft) for k in range(LINE_PARTS)]
+        [_amplitude_spectrum(u[k * part : (k + 1) * part], n_fft) for k in range(LINE_PARTS)]
     )
     weakest, strongest = spectra.min(axis=0), spectra.max(axis=0)
     floor = np.median(spectra, axis=1).max()
@@ -258,15 +266,6 @@ def _envelope(y: np.ndarray, width: int) -> np.ndarray:
     return np.sqrt(np.maximum(power, 0.0))
 
 
-def _strongest_frequency(t: np.ndarray, y: np.ndarray) -> float:
-    """The frequency of the record's highest spectral peak (above the lowest bins), Hz."""
-    n_fft = 1 << int(math.ceil(math.log2(2 * y.size)))
-    spectrum = _amplitude_spectrum(y, n_fft)
-    low = max(2, int(n_fft / y.size))  # below two cycles in the record: a trend, not a mode
-    k = low + int(np.argmax(spectrum[low:]))
-    return k * sample_rate_hz(t) / n_fft
-
-
 def find_free_vibrations(
     t: np.ndarray, y: np.ndarray, hints: Sequence[tuple[float, str]] = ()
 ) -> tuple[FreeVibration, ...]:
@@ -284,7 +283,10 @@ def find_free_vibrations(
     """
     if t.size < MIN_SAMPLES:
         return ()
-    f = _strongest_frequency(t, y)
+    # Below two cycles in the record: a trend, not a vibration.
+    f = spectral_peak_hz(t, y, min_hz=2.0 / float(t[-1] - t[0]))
+    if not f > 0.0:
+        return ()
     width = int(np.clip(round(2.0 * sample_rate_hz(t) / f), 4, max(4, t.size // 16)))
     envelope = _envelope(y, width)
     floor = max(float(np.quantile(envelope, FLOOR_QUANTILE)), 1e-300)

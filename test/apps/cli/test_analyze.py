@@ -429,3 +429,29 @@ def test_measured_shocks_of_one_board_agree_within_their_standard_deviations(tmp
                 assert apart <= 3 * math.hypot(mode[f'{key}_std'], first[key][1]), (trial, key)
             else:
                 first[key] = (mode[key], mode[f'{key}_std'])
+
+
+def _imu_bag(path, values, rate=1000.0):
+    with BagWriter(path) as bag:
+        for i, a in enumerate(values):
+            bag.write_acceleration('/tip_imu', i / rate, (0.0, 0.0, a), 'tip')
+    return path
+
+
+def test_an_accelerometer_bag_too_short_is_one_line(tmp_path, capsys):
+    bag = _imu_bag(tmp_path / 'short', [0.1, -0.2, 0.3, math.nan, 0.1])
+    assert main(['analyze', str(bag)]) == 2
+    assert '/tip_imu holds 4 usable samples' in _error_line(capsys)
+
+
+def test_non_finite_accelerations_are_dropped_and_said(tmp_path, capsys):
+    t, y = TAPPED.record()
+    y = y.copy()
+    y[::500] = math.nan  # a logger's dropouts
+    bag = _imu_bag(tmp_path / 'gaps', y, rate=TAPPED.rate_hz)
+    out = tmp_path / 'r.json'
+    assert main(['analyze', str(bag), '--json', str(out)]) == 0
+    captured = capsys.readouterr()
+    assert 'non-finite' in captured.err or 'dropped' in captured.err, captured.err
+    data = json.loads(out.read_text())
+    assert data['status'] != 'ERROR' and len(data['modes']) == 3
